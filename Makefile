@@ -1,0 +1,60 @@
+# contactlink: `make demo` and `make test` work from a clean clone on Debian 12.
+SHELL := /bin/bash
+NP ?= 2
+MPIRUN ?= mpirun --allow-run-as-root --oversubscribe
+CARGO ?= cargo
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+# Shared-memory transport only: the machines have no usable network between ranks.
+export OMPI_MCA_btl := self,vader
+export OMPI_MCA_btl_vader_single_copy_mechanism := none
+
+.PHONY: deps build demo test test-serial test-mpi bench scaling lint fmt clean
+
+deps:
+	@bash scripts/install-deps.sh
+
+build: deps
+	$(CARGO) build --release
+
+demo: build
+	@mkdir -p out
+	$(MPIRUN) -n $(NP) target/release/contactlink run $(or $(SCENE),block-compress) -o out/demo.h5
+	@echo "demo: results in out/demo.h5 (open out/demo.xmf in ParaView; h5ls -r out/demo.h5 lists it)"
+
+# Every test: unit, verification and end-to-end (serial and mpirun -n 1/2/3),
+# then the MPI harness under 2 and 3 ranks.
+test: deps
+	$(CARGO) build --release --bins
+	$(CARGO) test --release
+	$(MAKE) --no-print-directory test-mpi
+
+test-mpi:
+	@bin=$$($(CARGO) test --release --test mpi --no-run 2>&1 | grep -o 'target/release/deps/mpi-[0-9a-f]*' | head -1); \
+	test -n "$$bin" || { echo "could not find the mpi test harness"; exit 1; }; \
+	for n in 2 3; do \
+	  echo "mpi-tests on $$n ranks"; \
+	  $(MPIRUN) -n $$n $$bin || exit 1; \
+	done
+
+# Assembly throughput and solve time against DOFs, 1 vs 2 ranks (CSV in bench-results/).
+bench: deps
+	@mkdir -p bench-results
+	@bin=$$($(CARGO) bench --bench assembly --no-run 2>&1 | grep -o 'target/release/deps/assembly-[0-9a-f]*' | head -1); \
+	test -n "$$bin" || { echo "could not find the assembly benchmark"; exit 1; }; \
+	for n in 1 2; do \
+	  echo "assembly benchmark on $$n rank(s)"; \
+	  $(MPIRUN) -n $$n $$bin | tee bench-results/assembly-$$n.csv || exit 1; \
+	done
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --all-targets --release -- -D warnings
+
+fmt:
+	$(CARGO) fmt --all
+
+clean:
+	$(CARGO) clean
+	rm -rf out

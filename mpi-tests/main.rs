@@ -1,0 +1,480 @@
+//! MPI test harness: every case asserts what must hold at any rank count.
+//! `cargo test` runs it on one rank (singleton); `make test` runs it again
+//! under `mpirun -n 2` and `-n 3`.
+//!
+//! Cases here need MPI and PETSc, which can be initialised once per process,
+//! so this is one program (harness = false) rather than libtest threads.
+use contactlink::dofs::{DofMap, LocalNode, NaturalNode, DIM};
+use contactlink::fem::{self, ElementGeometry, Material, QuadRule};
+use contactlink::mesh::generate::{self, BoxSpec, Grading};
+use contactlink::mesh::Mesh;
+use contactlink::petsc::GhostedVector;
+use contactlink::pipeline;
+use contactlink::runtime::Runtime;
+use contactlink::solve::{DirichletSpec, Model, SolverSettings};
+use mpi::collective::SystemOperation;
+use mpi::traits::*;
+use std::process::ExitCode;
+
+type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
+
+const CASES: &[Case] = &[
+    (
+        "halo_exchange_refreshes_ghosts",
+        halo_exchange_refreshes_ghosts,
+    ),
+    (
+        "dof_numbering_is_a_permutation",
+        dof_numbering_is_a_permutation,
+    ),
+    ("bulk_patch_test_linear_elastic_distorted", |rt| {
+        bulk_patch_test(rt, linear())
+    }),
+    ("bulk_patch_test_neo_hookean_distorted", |rt| {
+        bulk_patch_test(rt, neo_hookean())
+    }),
+    (
+        "manufactured_solution_converges_at_second_order",
+        manufactured_solution_converges,
+    ),
+    (
+        "neo_hookean_uniaxial_stretch_matches_closed_form",
+        uniaxial_stretch_closed_form,
+    ),
+];
+
+fn main() -> ExitCode {
+    let rt = match Runtime::start(&[]) {
+        Ok(rt) => rt,
+        Err(e) => {
+            eprintln!("mpi-tests: start-up failed: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let filter: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let world = rt.world();
+    let (mut passed, mut failed) = (0, 0);
+    for (name, case) in CASES {
+        if filter.as_deref().is_some_and(|f| !name.contains(f)) {
+            continue;
+        }
+        let mine = case(&rt);
+        let ok_here = i32::from(mine.is_ok());
+        let mut ok_all = 0;
+        world.all_reduce_into(&ok_here, &mut ok_all, SystemOperation::min());
+        if let Err(msg) = &mine {
+            eprintln!("[rank {}] {name}: {msg}", rt.rank());
+        }
+        if rt.rank() == 0 {
+            println!(
+                "test {name} ({} ranks) ... {}",
+                rt.size(),
+                if ok_all == 1 { "ok" } else { "FAILED" }
+            );
+        }
+        if ok_all == 1 {
+            passed += 1;
+        } else {
+            failed += 1;
+        }
+    }
+    if rt.rank() == 0 {
+        println!("mpi-tests: {passed} passed, {failed} failed");
+    }
+    drop(rt);
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+fn linear() -> Material {
+    Material::LinearElastic {
+        youngs: 1000.0,
+        poisson: 0.3,
+    }
+}
+
+fn neo_hookean() -> Material {
+    Material::NeoHookean {
+        youngs: 1000.0,
+        poisson: 0.3,
+    }
+}
+
+fn ensure(cond: bool, msg: impl FnOnce() -> String) -> Result<(), String> {
+    if cond {
+        Ok(())
+    } else {
+        Err(msg())
+    }
+}
+
+fn unit_box(n: usize, grading: Grading) -> Result<Mesh, String> {
+    generate::graded_box(&BoxSpec {
+        body: "block".into(),
+        origin: [0.0; 3],
+        size: [1.0; 3],
+        divisions: [n; 3],
+        grading: [grading; 3],
+        ..Default::default()
+    })
+    .map_err(|e| e.to_string())
+}
+
+fn partition_for(rt: &Runtime, mesh: &Mesh) -> Result<Vec<i32>, String> {
+    let mut part =
+        contactlink::partition::partition_cells(mesh, rt.size()).map_err(|e| e.to_string())?;
+    rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
+    Ok(part)
+}
+
+/// Ghost entries of a ghosted vector take their owners' values after the
+/// exchange: the owned entry of every node holds its natural id, so every
+/// ghost must read its own node's natural id.
+fn halo_exchange_refreshes_ghosts(rt: &Runtime) -> Result<(), String> {
+    let mesh = unit_box(6, Grading::Uniform)?;
+    let part = partition_for(rt, &mesh)?;
+    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size());
+    let mut v =
+        GhostedVector::new(dofs.num_owned_dofs(), &dofs.ghost_dofs()).map_err(|e| e.to_string())?;
+    v.with_local_mut(|a| {
+        a.fill(-1.0);
+        for l in 0..dofs.num_owned_nodes() {
+            for c in 0..DIM {
+                a[DIM * l + c] = (DIM * dofs.natural(LocalNode(l)).0 + c) as f64;
+            }
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    v.update_ghosts().map_err(|e| e.to_string())?;
+    let bad = v
+        .with_local(|a| {
+            (0..dofs.num_local_nodes())
+                .flat_map(|l| (0..DIM).map(move |c| (l, c)))
+                .filter(|&(l, c)| a[DIM * l + c] != (DIM * dofs.natural(LocalNode(l)).0 + c) as f64)
+                .count()
+        })
+        .map_err(|e| e.to_string())?;
+    ensure(bad == 0, || {
+        format!("{bad} ghost entries hold the wrong value after the exchange")
+    })?;
+    // Reverse: every rank adds 1 into each local entry; owners then hold the
+    // number of ranks that see the node.
+    v.with_local_mut(|a| a.fill(1.0))
+        .map_err(|e| e.to_string())?;
+    v.accumulate_ghosts().map_err(|e| e.to_string())?;
+    let total = v
+        .global()
+        .with_array(|a| a.iter().sum::<f64>())
+        .map_err(|e| e.to_string())?;
+    let mut sum = 0.0;
+    rt.world()
+        .all_reduce_into(&total, &mut sum, SystemOperation::sum());
+    let mut local_entries = (DIM * dofs.num_local_nodes()) as f64;
+    let mut expected = 0.0;
+    rt.world()
+        .all_reduce_into(&local_entries, &mut expected, SystemOperation::sum());
+    local_entries = expected;
+    ensure(sum == local_entries, || {
+        format!("reverse exchange summed to {sum}, expected {local_entries}")
+    })
+}
+
+/// Every natural node has exactly one owner and the owned ranges tile 0..N.
+fn dof_numbering_is_a_permutation(rt: &Runtime) -> Result<(), String> {
+    let mesh = unit_box(
+        5,
+        Grading::Toward {
+            point: 0.0,
+            ratio: 3.0,
+        },
+    )?;
+    let part = partition_for(rt, &mesh)?;
+    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size());
+    let n = mesh.num_nodes();
+    let mut seen = vec![0i32; n];
+    for nat in 0..n {
+        seen[dofs.petsc_node(NaturalNode(nat))] += 1;
+    }
+    ensure(seen.iter().all(|&s| s == 1), || {
+        "PETSc node numbers are not a permutation".into()
+    })?;
+    let mut owned = dofs.num_owned_nodes() as u64;
+    let mut total = 0u64;
+    rt.world()
+        .all_reduce_into(&owned, &mut total, SystemOperation::sum());
+    ensure(total == n as u64, || {
+        format!("owned nodes sum to {total}, mesh has {n}")
+    })?;
+    let start = dofs.owned_dof_start() as u64;
+    let mut starts = vec![0u64; rt.size()];
+    rt.world().all_gather_into(&start, &mut starts[..]);
+    owned *= DIM as u64;
+    ensure(starts.windows(2).all(|w| w[0] <= w[1]), || {
+        format!("owned ranges out of order: {starts:?}")
+    })?;
+    ensure(start + owned <= DIM as u64 * n as u64, || {
+        "owned range exceeds the DOF count".into()
+    })
+}
+
+/// Boundary node ids of a box mesh: union of its six face sets.
+fn boundary_nodes(mesh: &Mesh, body: &str) -> Vec<usize> {
+    let mut nodes: Vec<usize> = ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"]
+        .iter()
+        .flat_map(|f| {
+            mesh.node_sets
+                .get(&format!("{body}.{f}"))
+                .cloned()
+                .unwrap_or_default()
+        })
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+fn model_with(
+    mesh: Mesh,
+    material: Material,
+    dirichlet: Vec<DirichletSpec>,
+    steps: usize,
+) -> Model {
+    let bodies = mesh.bodies.len();
+    Model {
+        name: "mpi-test".into(),
+        mesh,
+        materials: vec![material; bodies],
+        dirichlet,
+        facet_loads: Vec::new(),
+        body_force: vec![[0.0; 3]; bodies],
+        body_force_fn: None,
+        steps,
+        solver: SolverSettings {
+            rtol: 1e-12,
+            atol: Some(1e-11),
+            ..Default::default()
+        },
+    }
+}
+
+/// A linear displacement field prescribed on the boundary of a distorted mesh
+/// is reproduced at every interior node to round-off (homogeneous deformation
+/// is exact for both materials).
+fn bulk_patch_test(rt: &Runtime, material: Material) -> Result<(), String> {
+    let mesh = unit_box(4, Grading::Uniform)?;
+    let mesh = generate::perturb_interior(&mesh, 0.3, 7).map_err(|e| e.to_string())?;
+    let grad = [
+        [0.05, 0.02, -0.01],
+        [0.01, -0.03, 0.02],
+        [-0.02, 0.01, 0.04],
+    ];
+    let exact = |x: [f64; 3]| -> [f64; 3] {
+        let mut u = [1e-3, -2e-3, 5e-4];
+        for i in 0..3 {
+            for j in 0..3 {
+                u[i] += grad[i][j] * x[j];
+            }
+        }
+        u
+    };
+    let nodes = boundary_nodes(&mesh, "block");
+    let values = nodes.iter().map(|&v| exact(mesh.nodes[v])).collect();
+    let bc = DirichletSpec {
+        set: "boundary".into(),
+        nodes,
+        components: vec![0, 1, 2],
+        values,
+    };
+    let interior_moved = mesh.nodes.clone();
+    let model = model_with(mesh, material, vec![bc], 1);
+    let summary = pipeline::run_model(rt, &model, None, false).map_err(|e| e.to_string())?;
+    let u = &summary.report.displacement;
+    let mut worst: f64 = 0.0;
+    for (v, x) in interior_moved.iter().enumerate() {
+        let e = exact(*x);
+        for c in 0..3 {
+            worst = worst.max((u[3 * v + c] - e[c]).abs());
+        }
+    }
+    ensure(worst < 1e-10, || {
+        format!("patch test error {worst:.3e} (max |u_h − u|)")
+    })
+}
+
+/// The exact field of the manufactured problem (smooth, not polynomial).
+fn mms_exact(x: [f64; 3]) -> [f64; 3] {
+    use std::f64::consts::PI;
+    let a = 1e-2;
+    [
+        a * (PI * x[0]).sin() * (0.5 * PI * x[1]).cos() * (1.0 + x[2]),
+        a * (x[0] * x[1] + (PI * x[2]).sin()),
+        a * (0.5 * PI * x[0]).cos() * (PI * x[1] * x[2]).sin(),
+    ]
+}
+
+/// b = −div σ(u*) for linear elasticity, by nested central differences
+/// (their error, ~1e-9 relative, is far below the discretisation error).
+fn mms_body_force(material: &Material, x: [f64; 3]) -> [f64; 3] {
+    let h = 1e-4;
+    let stress = |p: [f64; 3]| -> [[f64; 3]; 3] {
+        let mut g = [[0.0; 3]; 3];
+        for j in 0..3 {
+            let (mut xp, mut xm) = (p, p);
+            xp[j] += 1e-5;
+            xm[j] -= 1e-5;
+            let (up, um) = (mms_exact(xp), mms_exact(xm));
+            for i in 0..3 {
+                g[i][j] = (up[i] - um[i]) / 2e-5;
+            }
+        }
+        let (lambda, mu) = material.lame();
+        let tr = g[0][0] + g[1][1] + g[2][2];
+        let mut s = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                s[i][j] = mu * (g[i][j] + g[j][i]) + if i == j { lambda * tr } else { 0.0 };
+            }
+        }
+        s
+    };
+    let mut b = [0.0; 3];
+    for j in 0..3 {
+        let (mut xp, mut xm) = (x, x);
+        xp[j] += h;
+        xm[j] -= h;
+        let (sp, sm) = (stress(xp), stress(xm));
+        for i in 0..3 {
+            b[i] -= (sp[i][j] - sm[i][j]) / (2.0 * h);
+        }
+    }
+    b
+}
+
+/// L2 error of the nodal field `u` (natural order) against `exact`, over the
+/// whole mesh with a 3×3×3 rule, relative to the L2 norm of `exact`.
+fn relative_l2_error(
+    mesh: &Mesh,
+    u: &[f64],
+    exact: impl Fn([f64; 3]) -> [f64; 3],
+) -> Result<f64, String> {
+    let rule = QuadRule::hex_3x3x3();
+    let (mut err2, mut norm2) = (0.0, 0.0);
+    for c in 0..mesh.num_cells() {
+        let cell = mesh.cell(c);
+        let x: Vec<[f64; 3]> = cell.iter().map(|&v| mesh.nodes[v]).collect();
+        let nodal: Vec<[f64; 3]> = cell
+            .iter()
+            .map(|&v| [u[3 * v], u[3 * v + 1], u[3 * v + 2]])
+            .collect();
+        let geom = ElementGeometry::new(mesh.cell_type, &x, &rule).map_err(|e| e.to_string())?;
+        let points = fem::qp_positions(&geom, &x).map_err(|e| e.to_string())?;
+        for (qp, p) in points.iter().enumerate() {
+            let uh = fem::interpolate(&geom, qp, &nodal).map_err(|e| e.to_string())?;
+            let ue = exact(*p);
+            let w = geom.jxw[qp];
+            for i in 0..3 {
+                err2 += w * (uh[i] - ue[i]).powi(2);
+                norm2 += w * ue[i].powi(2);
+            }
+        }
+    }
+    Ok((err2 / norm2).sqrt())
+}
+
+/// Linear elasticity with a manufactured smooth solution on graded meshes of
+/// 4³, 8³, 16³ cells: the L2 error must fall like h² (observed rate within
+/// [1.8, 2.3] on the last refinement).
+fn manufactured_solution_converges(rt: &Runtime) -> Result<(), String> {
+    let material = linear();
+    let mut errors = Vec::new();
+    for n in [4, 8, 16] {
+        let mesh = unit_box(
+            n,
+            Grading::Toward {
+                point: 0.0,
+                ratio: 2.0,
+            },
+        )?;
+        let nodes = boundary_nodes(&mesh, "block");
+        let values = nodes.iter().map(|&v| mms_exact(mesh.nodes[v])).collect();
+        let bc = DirichletSpec {
+            set: "boundary".into(),
+            nodes,
+            components: vec![0, 1, 2],
+            values,
+        };
+        let mut model = model_with(mesh, material, vec![bc], 1);
+        let m = material;
+        model.body_force_fn = Some(Box::new(move |x| mms_body_force(&m, x)));
+        let summary = pipeline::run_model(rt, &model, None, false).map_err(|e| e.to_string())?;
+        errors.push(relative_l2_error(
+            &model.mesh,
+            &summary.report.displacement,
+            mms_exact,
+        )?);
+    }
+    let rates: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    if rt.rank() == 0 {
+        let errs: Vec<String> = errors.iter().map(|e| format!("{e:.3e}")).collect();
+        let rs: Vec<String> = rates.iter().map(|r| format!("{r:.3}")).collect();
+        println!(
+            "  manufactured solution: relative L2 errors [{}], rates [{}]",
+            errs.join(", "),
+            rs.join(", ")
+        );
+    }
+    let last = rates[rates.len() - 1];
+    ensure((1.8..=2.3).contains(&last), || {
+        format!("L2 convergence rate {last:.3} is not 2 (errors {errors:?})")
+    })
+}
+
+/// The built-in `uniaxial-stretch` scene: a Neo-Hookean cube stretched to
+/// λ = 2 with free lateral faces. Closed form: μ(λt² − 1) + λ ln J = 0 with
+/// J = λ λt², nominal stress P11 = μ(λ − 1/λ) + λ_L ln J / λ.
+fn uniaxial_stretch_closed_form(rt: &Runtime) -> Result<(), String> {
+    let (model, _) = pipeline::load_model("uniaxial-stretch", &[]).map_err(|e| e.to_string())?;
+    let summary = pipeline::run_model(rt, &model, None, false).map_err(|e| e.to_string())?;
+    let (lam_l, mu) = model.materials[0].lame();
+    let stretch = 2.0;
+    let residual = |t: f64| mu * (t * t - 1.0) + lam_l * (stretch * t * t).ln();
+    let (mut lo, mut hi) = (1e-3, 1.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if residual(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let lateral = 0.5 * (lo + hi);
+    let j = stretch * lateral * lateral;
+    let p11 = mu * (stretch - 1.0 / stretch) + lam_l * j.ln() / stretch;
+    // Lateral stretch from the displacement of the corner (1, 1, 1).
+    let corner = model
+        .mesh
+        .nodes
+        .iter()
+        .position(|x| x == &[1.0, 1.0, 1.0])
+        .ok_or("no corner node")?;
+    let u = &summary.report.displacement;
+    let computed_lateral = 1.0 + u[3 * corner + 1];
+    let last = summary.report.steps.last().ok_or("no steps")?;
+    let force = last
+        .reactions
+        .iter()
+        .find(|(s, _)| s == "cube.xmax")
+        .ok_or("no reaction on cube.xmax")?
+        .1[0];
+    let e_lat = (computed_lateral - lateral).abs() / lateral;
+    let e_p = (force - p11).abs() / p11;
+    if rt.rank() == 0 {
+        println!("  uniaxial λ=2: λt {computed_lateral:.10} (exact {lateral:.10}), P11 {force:.8} (exact {p11:.8})");
+    }
+    ensure(e_lat < 1e-8 && e_p < 1e-8, || {
+        format!("lateral stretch error {e_lat:.2e}, stress error {e_p:.2e}")
+    })
+}

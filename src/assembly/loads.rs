@@ -1,0 +1,163 @@
+//! Surface loads on facet sets: dead tractions and follower pressures.
+use super::{element_dofs, gather_nodal, scatter_add};
+use crate::dofs::{DofMap, NaturalNode};
+use crate::error::{Error, Result};
+use crate::fem::{self, FacetType};
+use crate::mesh::{FacetRef, Mesh};
+use crate::petsc::{Matrix, PetscInt};
+
+/// One load on a facet set, at full load factor.
+#[derive(Debug, Clone)]
+pub enum FacetLoad {
+    /// Pressure p > 0 pushes into the body, normal to the deformed facet.
+    Pressure(f64),
+    /// Force per unit reference area, fixed in direction.
+    Traction([f64; 3]),
+}
+
+struct LocalFacet {
+    /// Natural id of the cell the facet belongs to (for error messages).
+    cell: usize,
+    nodes: Vec<u32>,
+    x_ref: Vec<[f64; 3]>,
+    dofs: Vec<PetscInt>,
+    load: FacetLoad,
+}
+
+impl LocalFacet {
+    fn error(&self, source: fem::FemError) -> Error {
+        Error::Element {
+            cell: self.cell,
+            source,
+        }
+    }
+}
+
+/// The facet loads this rank evaluates: those on facets of its own cells, so
+/// every facet is counted exactly once over all ranks.
+pub struct SurfaceLoads {
+    facet_type: FacetType,
+    facets: Vec<LocalFacet>,
+}
+
+impl SurfaceLoads {
+    /// `loads` pairs a facet set's facets with the load applied to them.
+    pub fn new(mesh: &Mesh, dofs: &DofMap, loads: &[(&[FacetRef], FacetLoad)]) -> Result<Self> {
+        let facet_type = mesh.cell_type.facet_type();
+        let mut local_cell = vec![false; mesh.num_cells()];
+        for &c in &dofs.local_cells {
+            local_cell[c] = true;
+        }
+        let mut facets = Vec::new();
+        for (set, load) in loads {
+            for f in set.iter().filter(|f| local_cell[f.cell]) {
+                let natural = mesh.facet_nodes(f)?;
+                let nodes: Vec<u32> = natural
+                    .iter()
+                    .map(|&v| {
+                        dofs.local(NaturalNode(v))
+                            .expect("nodes of a local cell are local")
+                            .0 as u32
+                    })
+                    .collect();
+                let x_ref = natural.iter().map(|&v| mesh.nodes[v]).collect();
+                let mut d = Vec::new();
+                element_dofs(dofs, &nodes, &mut d);
+                facets.push(LocalFacet {
+                    cell: f.cell,
+                    nodes,
+                    x_ref,
+                    dofs: d,
+                    load: load.clone(),
+                });
+            }
+        }
+        Ok(SurfaceLoads { facet_type, facets })
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.facets.is_empty()
+    }
+
+    /// True when some load follows the deformation (and so has a tangent).
+    pub fn has_follower(&self) -> bool {
+        self.facets
+            .iter()
+            .any(|f| matches!(f.load, FacetLoad::Pressure(_)))
+    }
+
+    /// Adds the external force at load factor `factor` into `f_local`.
+    pub fn add_external_force(
+        &self,
+        u_local: &[f64],
+        factor: f64,
+        f_local: &mut [f64],
+    ) -> Result<()> {
+        let n = self.facet_type.nodes();
+        let mut u = [[0.0; 3]; 4];
+        let mut fe = [0.0; 12];
+        for facet in &self.facets {
+            match facet.load {
+                FacetLoad::Traction(t) => {
+                    fem::dead_traction(self.facet_type, &facet.x_ref, t, &mut fe[..3 * n])
+                        .map_err(|e| facet.error(e))?;
+                }
+                FacetLoad::Pressure(p) => {
+                    gather_nodal(u_local, &facet.nodes, &mut u[..n]);
+                    fem::follower_pressure(
+                        self.facet_type,
+                        &facet.x_ref,
+                        &u[..n],
+                        p,
+                        &mut fe[..3 * n],
+                        None,
+                    )
+                    .map_err(|e| facet.error(e))?;
+                }
+            }
+            scatter_add(f_local, &facet.nodes, &fe[..3 * n], factor);
+        }
+        Ok(())
+    }
+
+    /// Inserts explicit zeros where follower loads couple DOFs (see
+    /// `BulkAssembler::add_pattern`).
+    pub fn add_pattern(&self, k: &mut Matrix) -> Result<()> {
+        for facet in self
+            .facets
+            .iter()
+            .filter(|f| matches!(f.load, FacetLoad::Pressure(_)))
+        {
+            let zeros = vec![0.0; facet.dofs.len() * facet.dofs.len()];
+            k.add_block(&facet.dofs, &facet.dofs, &zeros)?;
+        }
+        Ok(())
+    }
+
+    /// Adds −factor·∂f_ext/∂u of follower loads into the tangent `k`.
+    pub fn add_tangent(&self, u_local: &[f64], factor: f64, k: &mut Matrix) -> Result<()> {
+        let n = self.facet_type.nodes();
+        let mut u = [[0.0; 3]; 4];
+        let mut fe = [0.0; 12];
+        let mut ke = [0.0; 144];
+        for facet in &self.facets {
+            if let FacetLoad::Pressure(p) = facet.load {
+                gather_nodal(u_local, &facet.nodes, &mut u[..n]);
+                fem::follower_pressure(
+                    self.facet_type,
+                    &facet.x_ref,
+                    &u[..n],
+                    p,
+                    &mut fe[..3 * n],
+                    Some(&mut ke[..9 * n * n]),
+                )
+                .map_err(|e| facet.error(e))?;
+                for v in &mut ke[..9 * n * n] {
+                    *v *= -factor;
+                }
+                k.add_block(&facet.dofs, &facet.dofs, &ke[..9 * n * n])?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,43 @@
+//! Assembly: element and facet kernels (from `fem`) gathered from this rank's
+//! local arrays and added into PETSc storage.
+//!
+//! Local arrays are PETSc ghosted-vector local forms: entry 3·l + c is
+//! component c of local node l (owned nodes first, then ghosts). Residuals are
+//! accumulated there and summed into owners by a reverse ghost update, so only
+//! the matrix goes through PETSc's off-rank stash.
+pub mod bulk;
+pub mod loads;
+
+pub use bulk::BulkAssembler;
+pub use loads::{FacetLoad, SurfaceLoads};
+
+use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::petsc::PetscInt;
+
+/// The displacement of `nodes` (local indices) read out of a local-form array.
+pub(crate) fn gather_nodal(local: &[f64], nodes: &[u32], out: &mut [[f64; 3]]) {
+    for (o, &l) in out.iter_mut().zip(nodes) {
+        let base = DIM * l as usize;
+        *o = [local[base], local[base + 1], local[base + 2]];
+    }
+}
+
+/// Adds an element vector (node-major, 3 per node) into a local-form array.
+pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign: f64) {
+    for (a, &l) in nodes.iter().enumerate() {
+        let base = DIM * l as usize;
+        for c in 0..DIM {
+            local[base + c] += sign * values[DIM * a + c];
+        }
+    }
+}
+
+/// PETSc DOF numbers of `nodes` (local indices), node-major.
+pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[u32], out: &mut Vec<PetscInt>) {
+    out.clear();
+    for &l in nodes {
+        for c in 0..DIM {
+            out.push(dofs.dof(LocalNode(l as usize), c).0);
+        }
+    }
+}

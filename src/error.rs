@@ -1,0 +1,50 @@
+//! One error type for the program. Every variant says what went wrong and
+//! where (file, set, cell, step), so a user can act on it.
+use crate::fem::FemError;
+use crate::mesh::MeshError;
+use crate::output::OutputError;
+use crate::petsc::PetscError;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Petsc(#[from] PetscError),
+    #[error("mesh: {0}")]
+    Mesh(#[from] MeshError),
+    #[error("cell {cell}: {source}")]
+    Element { cell: usize, source: FemError },
+    #[error(
+        "cell {cell} is inverted in the reference configuration (det J = {det_j:.3e} at quadrature point {qp}); check the mesh and its node order"
+    )]
+    InvertedCell { cell: usize, qp: usize, det_j: f64 },
+    #[error("output: {0}")]
+    Output(#[from] OutputError),
+    #[error("scene {origin}: {message}")]
+    Scene { origin: String, message: String },
+    #[error("partition: {0}")]
+    Partition(String),
+    #[error("MPI: {0}")]
+    Mpi(String),
+    #[error(
+        "load step {step} (load factor {load_factor:.6}): Newton did not converge after {cutbacks} cutbacks; last attempt: {reason}"
+    )]
+    NoConvergence {
+        step: usize,
+        load_factor: f64,
+        cutbacks: usize,
+        reason: String,
+    },
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub fn scene(origin: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Scene {
+            origin: origin.into(),
+            message: message.into(),
+        }
+    }
+}

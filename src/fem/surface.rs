@@ -1,0 +1,433 @@
+//! Facet loads on quad4 / tri3 boundary facets.
+//!
+//! Facet node order fixes the orientation: the right-hand normal
+//! `∂x/∂ξ₁ × ∂x/∂ξ₂` must point OUT of the body (take faces from
+//! [`CellType::local_faces`](super::CellType::local_faces)).
+//!
+//! Sign convention. Every function here returns an EXTERNAL force `f_ext`
+//! (node-major, `3n` entries, overwritten) and, for the follower load, its
+//! derivative `k_ext = ∂f_ext/∂u` (row-major `(3n) × (3n)`, overwritten).
+//! The solver's residual is `R = f_int − f_ext` and Newton solves
+//! `K Δu = −R` with `K = ∂R/∂u`, so the solver SUBTRACTS `f` from `R` and
+//! SUBTRACTS `k` from `K`. The follower `k` is not symmetric per facet (it is
+//! only on a closed or fully clamped surface).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::shape::{self, FacetShape};
+use super::{check_finite_points, check_len, FacetType, FemError, QuadRule};
+
+/// The surface coordinates of a quadrature point (facet rules keep the third
+/// coordinate at zero).
+fn surface_point(p: &[f64; 3]) -> [f64; 2] {
+    [p[0], p[1]]
+}
+
+/// Tangents `(∂x/∂ξ₁, ∂x/∂ξ₂)` of the facet through the points `x`.
+fn tangents(s: &FacetShape, x: &[[f64; 3]]) -> (Vector3<f64>, Vector3<f64>) {
+    let mut t1 = Vector3::zeros();
+    let mut t2 = Vector3::zeros();
+    for (xa, da) in x.iter().zip(&s.dn[..s.nodes]) {
+        let xa = Vector3::from(*xa);
+        t1 += da[0] * xa;
+        t2 += da[1] * xa;
+    }
+    (t1, t2)
+}
+
+fn check_facet(facet: FacetType, what: &'static str, x: &[[f64; 3]]) -> Result<(), FemError> {
+    check_len(what, facet.nodes(), x.len())?;
+    check_finite_points(what, x)
+}
+
+fn check_finite_value(what: &'static str, v: f64) -> Result<(), FemError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(FemError::NonFinite { what })
+    }
+}
+
+/// `[v]×`, the matrix of `w ↦ v × w`.
+fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// Dead load: `f_{ai} = ∫ N_a t_i dA` over the reference facet (`t` is a
+/// force per reference area, fixed in direction).
+pub fn dead_traction(
+    facet: FacetType,
+    x_ref: &[[f64; 3]],
+    t: [f64; 3],
+    f: &mut [f64],
+) -> Result<(), FemError> {
+    check_facet(facet, "x_ref", x_ref)?;
+    check_finite_points("t", &[t])?;
+    check_len("f", 3 * facet.nodes(), f.len())?;
+    f.fill(0.0);
+    let rule = QuadRule::default_for_facet(facet);
+    for (p, w) in rule.points.iter().zip(&rule.weights) {
+        let s = shape::facet_shape(facet, surface_point(p));
+        let (t1, t2) = tangents(&s, x_ref);
+        let da = t1.cross(&t2).norm() * w;
+        for (fa, na) in f.chunks_exact_mut(3).zip(&s.n[..s.nodes]) {
+            for (fi, ti) in fa.iter_mut().zip(t) {
+                *fi += na * ti * da;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Follower pressure on the current facet `x = X + u`; `p > 0` pushes into
+/// the body: `f = −p ∫ N (∂x/∂ξ₁ × ∂x/∂ξ₂) dξ`. With `k` given, also writes
+/// the exact `k = ∂f/∂u`. The default rules (2×2, 3-point) integrate both
+/// exactly, since the integrands are polynomial.
+pub fn follower_pressure(
+    facet: FacetType,
+    x_ref: &[[f64; 3]],
+    u: &[[f64; 3]],
+    p: f64,
+    f: &mut [f64],
+    mut k: Option<&mut [f64]>,
+) -> Result<(), FemError> {
+    check_facet(facet, "x_ref", x_ref)?;
+    check_facet(facet, "u", u)?;
+    check_finite_value("pressure", p)?;
+    let nodes = facet.nodes();
+    let ndof = 3 * nodes;
+    check_len("f", ndof, f.len())?;
+    f.fill(0.0);
+    if let Some(k) = k.as_deref_mut() {
+        check_len("k", ndof * ndof, k.len())?;
+        k.fill(0.0);
+    }
+    let mut x = [[0.0; 3]; super::MAX_FACET_NODES];
+    for ((xa, xr), ua) in x.iter_mut().zip(x_ref).zip(u) {
+        *xa = [xr[0] + ua[0], xr[1] + ua[1], xr[2] + ua[2]];
+    }
+    let x = &x[..nodes];
+    let rule = QuadRule::default_for_facet(facet);
+    for (pt, w) in rule.points.iter().zip(&rule.weights) {
+        let s = shape::facet_shape(facet, surface_point(pt));
+        let (t1, t2) = tangents(&s, x);
+        let scale = -p * w;
+        add_pressure_force(&s, &t1.cross(&t2), scale, f);
+        if let Some(k) = k.as_deref_mut() {
+            add_pressure_tangent(&s, &t1, &t2, scale, k);
+        }
+    }
+    Ok(())
+}
+
+fn add_pressure_force(s: &FacetShape, normal: &Vector3<f64>, scale: f64, f: &mut [f64]) {
+    for (fa, na) in f.chunks_exact_mut(3).zip(&s.n[..s.nodes]) {
+        for (fi, ni) in fa.iter_mut().zip(normal.iter()) {
+            *fi += scale * na * ni;
+        }
+    }
+}
+
+/// `∂(t₁ × t₂)/∂x_b = ∂N_b/∂ξ₂ [t₁]× − ∂N_b/∂ξ₁ [t₂]×`, since
+/// `δt₁ × t₂ = −[t₂]× δt₁` and `t₁ × δt₂ = [t₁]× δt₂`.
+fn add_pressure_tangent(
+    s: &FacetShape,
+    t1: &Vector3<f64>,
+    t2: &Vector3<f64>,
+    scale: f64,
+    k: &mut [f64],
+) {
+    let ndof = 3 * s.nodes;
+    let (s1, s2) = (skew(t1), skew(t2));
+    for (node_b, db) in s.dn[..s.nodes].iter().enumerate() {
+        let dn_db = db[1] * s1 - db[0] * s2;
+        for (node_a, na) in s.n[..s.nodes].iter().enumerate() {
+            for i in 0..3 {
+                let row = (3 * node_a + i) * ndof + 3 * node_b;
+                for (kk, kv) in k[row..row + 3].iter_mut().enumerate() {
+                    *kv += scale * na * dn_db[(i, kk)];
+                }
+            }
+        }
+    }
+}
+
+/// Area of the facet through the points `x` (reference or current).
+pub fn facet_area(facet: FacetType, x: &[[f64; 3]]) -> Result<f64, FemError> {
+    check_facet(facet, "x", x)?;
+    // 4×4 because |t₁ × t₂| of a warped quad is not polynomial; for planar
+    // facets any default rule is already exact.
+    let rule = match facet {
+        FacetType::Quad4 => QuadRule::quad_4x4(),
+        FacetType::Tri3 => QuadRule::tri_1(),
+    };
+    Ok(rule
+        .points
+        .iter()
+        .zip(&rule.weights)
+        .map(|(p, w)| {
+            let (t1, t2) = tangents(&shape::facet_shape(facet, surface_point(p)), x);
+            t1.cross(&t2).norm() * w
+        })
+        .sum())
+}
+
+/// Unit outward normal at the facet centre (`ξ = (0,0)` for quad4,
+/// `(⅓,⅓)` for tri3).
+pub fn facet_normal_at_centre(facet: FacetType, x: &[[f64; 3]]) -> Result<[f64; 3], FemError> {
+    check_facet(facet, "x", x)?;
+    let centre = match facet {
+        FacetType::Quad4 => [0.0, 0.0],
+        FacetType::Tri3 => [1.0 / 3.0, 1.0 / 3.0],
+    };
+    let (t1, t2) = tangents(&shape::facet_shape(facet, centre), x);
+    let n = t1.cross(&t2);
+    let area = n.norm();
+    // Relative to the tangent lengths, so the test does not depend on units.
+    let scale = t1.norm() * t2.norm();
+    if area.is_nan() || area <= 1e-14 * scale || scale == 0.0 {
+        return Err(FemError::DegenerateFacet {
+            facet: facet.name(),
+            area,
+        });
+    }
+    let n = n / area;
+    Ok([n.x, n.y, n.z])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::{hex8_unit, perturb, rel_err, tet4_unit, Lcg};
+    use super::super::CellType;
+    use super::*;
+
+    const H: f64 = 1e-6;
+
+    fn warped(facet: FacetType, seed: u64) -> Vec<[f64; 3]> {
+        let mut x = match facet {
+            FacetType::Quad4 => vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            FacetType::Tri3 => vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        };
+        perturb(&mut x, &mut Lcg::new(seed), 0.2);
+        x
+    }
+
+    fn pressure_force(facet: FacetType, x: &[[f64; 3]], u: &[[f64; 3]], p: f64) -> Vec<f64> {
+        let mut f = vec![0.0; 3 * facet.nodes()];
+        follower_pressure(facet, x, u, p, &mut f, None).unwrap();
+        f
+    }
+
+    #[test]
+    fn follower_tangent_matches_finite_differences() {
+        for facet in [FacetType::Quad4, FacetType::Tri3] {
+            let x = warped(facet, 21);
+            let mut rng = Lcg::new(22);
+            let u: Vec<[f64; 3]> = (0..facet.nodes()).map(|_| rng.vec3(0.2)).collect();
+            let p = 3.7;
+            let ndof = 3 * facet.nodes();
+            let mut f = vec![0.0; ndof];
+            let mut k = vec![0.0; ndof * ndof];
+            follower_pressure(facet, &x, &u, p, &mut f, Some(&mut k)).unwrap();
+            assert_eq!(f, pressure_force(facet, &x, &u, p));
+            let mut fd = vec![0.0; ndof * ndof];
+            for col in 0..ndof {
+                let mut up = u.clone();
+                let mut um = u.clone();
+                up[col / 3][col % 3] += H;
+                um[col / 3][col % 3] -= H;
+                let fp = pressure_force(facet, &x, &up, p);
+                let fm = pressure_force(facet, &x, &um, p);
+                for row in 0..ndof {
+                    fd[row * ndof + col] = (fp[row] - fm[row]) / (2.0 * H);
+                }
+            }
+            let err = rel_err(&k, &fd);
+            println!("follower k vs FD {}: {err:.2e}", facet.name());
+            assert!(err < 1e-6, "{}: {err:e}", facet.name());
+            // Not symmetric per facet: a symmetric bug would hide here.
+            let asym = (0..ndof * ndof)
+                .map(|e| (k[e] - k[(e % ndof) * ndof + e / ndof]).abs())
+                .fold(0.0f64, f64::max);
+            assert!(asym > 1e-3);
+        }
+    }
+
+    fn total(f: &[f64]) -> [f64; 3] {
+        let mut t = [0.0; 3];
+        for fa in f.chunks_exact(3) {
+            for i in 0..3 {
+                t[i] += fa[i];
+            }
+        }
+        t
+    }
+
+    /// Sum of the follower forces over all faces of a deformed cell: the
+    /// vector area of a closed surface vanishes.
+    fn closed_surface_total(cell: CellType, x: &[[f64; 3]], u: &[[f64; 3]]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for face in cell.local_faces() {
+            let xf: Vec<[f64; 3]> = face.iter().map(|&a| x[a]).collect();
+            let uf: Vec<[f64; 3]> = face.iter().map(|&a| u[a]).collect();
+            let t = total(&pressure_force(cell.facet_type(), &xf, &uf, 2.5));
+            for i in 0..3 {
+                sum[i] += t[i];
+            }
+        }
+        sum
+    }
+
+    #[test]
+    fn pressure_on_closed_surface_sums_to_zero() {
+        let mut rng = Lcg::new(23);
+        for cell in [CellType::Hex8, CellType::Tet4] {
+            let x = match cell {
+                CellType::Hex8 => hex8_unit().to_vec(),
+                CellType::Tet4 => tet4_unit().to_vec(),
+            };
+            let u: Vec<[f64; 3]> = (0..cell.nodes()).map(|_| rng.vec3(0.2)).collect();
+            let sum = closed_surface_total(cell, &x, &u);
+            assert!(
+                sum.iter().all(|v| v.abs() < 1e-13),
+                "{}: {sum:?}",
+                cell.name()
+            );
+            // One face alone must not vanish, or the sum proves nothing.
+            let face = cell.local_faces()[0];
+            let xf: Vec<[f64; 3]> = face.iter().map(|&a| x[a]).collect();
+            let uf: Vec<[f64; 3]> = face.iter().map(|&a| u[a]).collect();
+            let single = total(&pressure_force(cell.facet_type(), &xf, &uf, 2.5));
+            assert!(single.iter().any(|v| v.abs() > 0.1));
+        }
+    }
+
+    #[test]
+    fn pressure_on_one_face_is_minus_p_area_normal() {
+        let p = 4.0;
+        for cell in [CellType::Hex8, CellType::Tet4] {
+            let x = match cell {
+                CellType::Hex8 => hex8_unit().to_vec(),
+                CellType::Tet4 => tet4_unit().to_vec(),
+            };
+            let facet = cell.facet_type();
+            for face in cell.local_faces() {
+                let xf: Vec<[f64; 3]> = face.iter().map(|&a| x[a]).collect();
+                let area = facet_area(facet, &xf).unwrap();
+                let n = facet_normal_at_centre(facet, &xf).unwrap();
+                let zero = vec![[0.0; 3]; face.len()];
+                let t = total(&pressure_force(facet, &xf, &zero, p));
+                for i in 0..3 {
+                    assert!(
+                        (t[i] + p * area * n[i]).abs() < 1e-14,
+                        "{} {face:?}",
+                        cell.name()
+                    );
+                }
+            }
+            // The slanted tet face: area √3/2, normal (1,1,1)/√3.
+            if cell == CellType::Tet4 {
+                let xf: Vec<[f64; 3]> = [1, 2, 3].iter().map(|&a| x[a]).collect();
+                let area = facet_area(facet, &xf).unwrap();
+                assert!((area - 3f64.sqrt() / 2.0).abs() < 1e-15);
+                let n = facet_normal_at_centre(facet, &xf).unwrap();
+                assert!(n.iter().all(|v| (v - 1.0 / 3f64.sqrt()).abs() < 1e-15));
+            }
+        }
+        // Bottom face of the unit cube: pressure pushes up (+z, into the body).
+        let bottom: Vec<[f64; 3]> = [0, 3, 2, 1].iter().map(|&a| hex8_unit()[a]).collect();
+        let t = total(&pressure_force(
+            FacetType::Quad4,
+            &bottom,
+            &[[0.0; 3]; 4],
+            p,
+        ));
+        assert!((t[2] - p).abs() < 1e-14 && t[0].abs() < 1e-14 && t[1].abs() < 1e-14);
+    }
+
+    #[test]
+    fn dead_traction_distributes_total_force() {
+        let t = [1.0, -2.0, 0.5];
+        for facet in [FacetType::Quad4, FacetType::Tri3] {
+            let x: Vec<[f64; 3]> = match facet {
+                FacetType::Quad4 => vec![
+                    [0.0, 0.0, 0.0],
+                    [2.0, 0.0, 0.0],
+                    [2.5, 1.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                ],
+                FacetType::Tri3 => vec![[0.0, 0.0, 1.0], [2.0, 0.0, 1.0], [0.0, 3.0, 1.0]],
+            };
+            let area = match facet {
+                FacetType::Quad4 => 2.25,
+                FacetType::Tri3 => 3.0,
+            };
+            assert!((facet_area(facet, &x).unwrap() - area).abs() < 1e-14);
+            let mut f = vec![0.0; 3 * facet.nodes()];
+            dead_traction(facet, &x, t, &mut f).unwrap();
+            let tot = total(&f);
+            for i in 0..3 {
+                assert!((tot[i] - t[i] * area).abs() < 1e-14);
+            }
+            if facet == FacetType::Tri3 {
+                // Linear triangle: each node carries a third.
+                for fa in f.chunks_exact(3) {
+                    assert!((fa[0] - t[0] * area / 3.0).abs() < 1e-14);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn warped_quad_area_converges() {
+        let x = warped(FacetType::Quad4, 24);
+        let reference: f64 = {
+            // 16×16 sub-quads of the 4×4 rule as an independent reference.
+            let m = 16;
+            let rule = QuadRule::quad_4x4();
+            let mut a = 0.0;
+            for i in 0..m {
+                for j in 0..m {
+                    for (p, w) in rule.points.iter().zip(&rule.weights) {
+                        let h = 2.0 / m as f64;
+                        let xi = [
+                            -1.0 + h * (i as f64 + 0.5 * (p[0] + 1.0)),
+                            -1.0 + h * (j as f64 + 0.5 * (p[1] + 1.0)),
+                        ];
+                        let (t1, t2) = tangents(&shape::quad4(xi), &x);
+                        a += t1.cross(&t2).norm() * w * h * h / 4.0;
+                    }
+                }
+            }
+            a
+        };
+        let area = facet_area(FacetType::Quad4, &x).unwrap();
+        assert!(
+            (area - reference).abs() < 1e-6 * reference,
+            "{area} vs {reference}"
+        );
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let x = warped(FacetType::Tri3, 25);
+        let mut f = vec![0.0; 9];
+        let u = [[0.0; 3]; 3];
+        assert!(follower_pressure(FacetType::Tri3, &x, &u, f64::NAN, &mut f, None).is_err());
+        assert!(follower_pressure(FacetType::Quad4, &x, &u, 1.0, &mut f, None).is_err());
+        let mut short = vec![0.0; 8];
+        assert!(follower_pressure(FacetType::Tri3, &x, &u, 1.0, &mut f, Some(&mut short)).is_err());
+        assert!(dead_traction(FacetType::Tri3, &x, [f64::INFINITY, 0.0, 0.0], &mut f).is_err());
+        let line = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        assert!(matches!(
+            facet_normal_at_centre(FacetType::Tri3, &line),
+            Err(FemError::DegenerateFacet { .. })
+        ));
+        assert!(facet_area(FacetType::Tri3, &x[..2]).is_err());
+    }
+}

@@ -1,0 +1,28 @@
+//! contactlink: a parallel, PETSc-backed solver for 3D frictional contact
+//! between deformable bodies (the ContactLink3D condition: surface-to-surface
+//! augmented Lagrangian with Uzawa updates, finite deformation).
+//!
+//! The modules follow the data flow of a run:
+//!
+//! ```text
+//! scene (TOML) ──► mesh (generators, sets) ──► partition (METIS) ──► dofs (owned/ghost, PETSc numbering)
+//!      ──► fem (element kernels) ──► assembly (into PETSc Mat/Vec) ──► solve (load steps → SNES Newton)
+//!      ──► output (parallel HDF5 + XDMF)
+//! ```
+//!
+//! `pipeline` strings these together for one run; `petsc` and `runtime` are
+//! the only places that touch C libraries directly.
+pub mod assembly;
+pub mod dofs;
+pub mod error;
+pub mod fem;
+pub mod mesh;
+pub mod output;
+pub mod partition;
+pub mod petsc;
+pub mod pipeline;
+pub mod runtime;
+pub mod scene;
+pub mod solve;
+
+pub use error::{Error, Result};

@@ -1,0 +1,343 @@
+//! Result output: one parallel HDF5 file per run plus an XDMF sidecar.
+//!
+//! Every rank holds a contiguous block of rows of each nodal or cell array in
+//! the global (input) order; [`ResultFile`] writes those blocks through
+//! MPI-IO into one dataset per array, so files written by 1, 2 or N ranks hold
+//! the same datasets with the same values and compare directly.
+//!
+//! # File layout
+//!
+//! ```text
+//! /mesh/nodes                      (N,3) f64  reference coordinates
+//! /mesh/cells                      (M,k) i64  connectivity; attr cell_type ("hex8" | "tet4")
+//! /mesh/partition                  (M,)  i32  owning rank of each cell
+//! /mesh/cell_body                  (M,)  i32  body index of each cell;
+//!                                             attr bodies = 1-D string array (body names)
+//! /mesh/node_sets/<name>           (n,)  i64  node ids
+//! /mesh/facet_sets/<name>/         group; attr cell_type ("quad4" | "tri3")
+//!     nodes                        (F,k) i64  facet node connectivity
+//!     cell                         (F,)  i64  cell owning each facet
+//!     face                         (F,)  i8   local face number of the facet in that cell
+//! /steps/<NNNNNN>/                 attrs: time f64, load_factor f64,
+//!                                  newton_iterations i64, uzawa_iterations i64,
+//!                                  converged u8 (0 | 1), wall_seconds f64
+//!     displacement                 (N,3) f64
+//!     reaction                     (N,3) f64
+//!     <nodal field>                (N,c) f64
+//!     <cell field>                 (M,c) f64
+//!     <any relative path>          (K,) or (K,c) f64 from [`ResultFile::write_step_block`],
+//!                                  (n,) f64 from [`ResultFile::write_step_small`]
+//! ```
+//!
+//! A facet set is a group rather than a single `(F,k)` dataset because each
+//! facet needs three arrays of different types and widths (nodes, owning cell,
+//! local face); keeping them side by side under the set's name means one name
+//! finds all three, and a reader that only wants connectivity reads `nodes`.
+//!
+//! String attributes are HDF5 variable-length UTF-8 strings (h5py returns
+//! `str`); `bodies` is a 1-D array of them rather than a comma-joined string so
+//! body names may contain commas. `converged` is `u8` rather than HDF5's
+//! enum-based bool because every reader (h5py, h5dump, ParaView) shows it as a
+//! plain number.
+//!
+//! `<NNNNNN>` is the step index zero-padded to six digits (more digits past
+//! 999999), so the groups sort in step order under a plain name sort.
+//!
+//! # XDMF sidecar
+//!
+//! `out.xmf` next to `out.h5` (same stem) is rewritten by rank 0 after the
+//! mesh and after every step, so it always lists exactly the steps in the
+//! file; see [`xdmf`] for its shape.
+//!
+//! # Collective calls
+//!
+//! Every method of [`ResultFile`] is collective over the communicator given
+//! to [`ResultFile::create`]: all ranks call it, in the same order, with the
+//! same names, shapes and set data (only the row blocks differ). The module
+//! checks this (a fingerprint of the call is compared across ranks) and every
+//! failure is agreed on, so when one rank fails all ranks return an error
+//! instead of leaving the others blocked in the next collective call.
+
+mod hdf5_file;
+pub mod xdmf;
+
+use std::path::{Path, PathBuf};
+
+pub use hdf5_file::{list_steps, read_dataset, read_nodal, read_step_attrs, ResultFile};
+
+/// One rank's contiguous block `[start, start + data.len() / cols)` of the rows
+/// of a `(global_rows, cols)` array, row-major.
+///
+/// The blocks of all ranks must tile `0..global_rows` in rank order (rank 0
+/// first); a rank with no rows passes an empty `data` and `start` equal to
+/// where its block would begin.
+#[derive(Debug, Clone, Copy)]
+pub struct BlockRows<'a, T> {
+    pub global_rows: usize,
+    pub start: usize,
+    pub cols: usize,
+    pub data: &'a [T],
+}
+
+impl<'a, T> BlockRows<'a, T> {
+    /// The whole array held by one rank (the serial case, or a rank that owns
+    /// everything while the others pass [`BlockRows::empty`]).
+    pub fn whole(data: &'a [T], cols: usize) -> Self {
+        let global_rows = data.len().checked_div(cols).unwrap_or(0);
+        Self {
+            global_rows,
+            start: 0,
+            cols,
+            data,
+        }
+    }
+
+    /// No rows on this rank; `start` is where this rank's block would begin.
+    pub fn empty(global_rows: usize, start: usize, cols: usize) -> Self {
+        Self {
+            global_rows,
+            start,
+            cols,
+            data: &[],
+        }
+    }
+}
+
+/// Mesh-level data written once by [`ResultFile::create`].
+///
+/// `nodes`, `cells`, `partition` and `cell_body` are row blocks; everything
+/// else must be identical on every rank (rank 0's copy is what gets written).
+#[derive(Debug, Clone, Copy)]
+pub struct MeshHeader<'a> {
+    /// "hex8" or "tet4".
+    pub cell_type: &'a str,
+    /// "quad4" or "tri3"; the type of every facet set.
+    pub facet_type: &'a str,
+    /// (N,3) reference coordinates.
+    pub nodes: BlockRows<'a, f64>,
+    /// (M,k) connectivity, 0-based global node ids, VTK node order (XDMF uses it as is).
+    pub cells: BlockRows<'a, i64>,
+    /// (M,1) owning rank of each cell.
+    pub partition: BlockRows<'a, i32>,
+    /// (M,1) index into `bodies` of each cell.
+    pub cell_body: BlockRows<'a, i32>,
+    pub bodies: &'a [String],
+    pub node_sets: &'a std::collections::BTreeMap<String, Vec<usize>>,
+    pub facet_sets: &'a std::collections::BTreeMap<String, FacetSetOut>,
+}
+
+/// One facet set: `F = cell.len()` facets of `k` nodes each.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct FacetSetOut {
+    /// F*k node ids, row-major.
+    pub nodes: Vec<i64>,
+    pub k: usize,
+    /// Global cell id owning each facet.
+    pub cell: Vec<i64>,
+    /// Local face number of each facet within its cell.
+    pub face: Vec<i8>,
+}
+
+/// Per-step metadata, written as attributes of `/steps/<NNNNNN>`.
+///
+/// All fields except `wall_seconds` must be equal on every rank; the
+/// attribute gets the maximum `wall_seconds` over the ranks (the step ends
+/// when its slowest rank does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepInfo {
+    pub index: usize,
+    pub time: f64,
+    pub load_factor: f64,
+    pub newton_iterations: usize,
+    pub uzawa_iterations: usize,
+    pub converged: bool,
+    pub wall_seconds: f64,
+}
+
+/// Errors of this module. Each names the file and the HDF5 object concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("cannot create result file {}: {source}", .path.display())]
+    Create { path: PathBuf, source: hdf5::Error },
+
+    #[error("cannot open result file {}: {source}", .path.display())]
+    Open { path: PathBuf, source: hdf5::Error },
+
+    #[error("HDF5 failed to {action} '{object}' in {}: {source}", .path.display())]
+    Hdf5 {
+        path: PathBuf,
+        object: String,
+        action: &'static str,
+        source: hdf5::Error,
+    },
+
+    #[error("invalid data for '{object}' in {}: {reason}", .path.display())]
+    Invalid {
+        path: PathBuf,
+        object: String,
+        reason: String,
+    },
+
+    #[error("ranks disagree on '{object}' in {}: {reason}", .path.display())]
+    RankMismatch {
+        path: PathBuf,
+        object: String,
+        reason: String,
+    },
+
+    /// Another rank failed; its own error (on that rank) says why.
+    #[error("rank {rank} failed on '{object}' in {} (see that rank's error)", .path.display())]
+    PeerFailed {
+        path: PathBuf,
+        object: String,
+        rank: i32,
+    },
+
+    #[error("cannot write XDMF sidecar {}: {source}", .path.display())]
+    Xdmf {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl OutputError {
+    pub(crate) fn invalid(path: &Path, object: &str, reason: impl Into<String>) -> Self {
+        Self::Invalid {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            reason: reason.into(),
+        }
+    }
+
+    pub(crate) fn hdf5(
+        path: &Path,
+        object: &str,
+        action: &'static str,
+        source: hdf5::Error,
+    ) -> Self {
+        Self::Hdf5 {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            action,
+            source,
+        }
+    }
+}
+
+/// The group name of step `index`: six digits, zero-padded.
+pub fn step_group_name(index: usize) -> String {
+    format!("{index:06}")
+}
+
+/// Element kinds this module can describe to XDMF; the string is the
+/// `cell_type` attribute value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum CellKind {
+    Hex8,
+    Tet4,
+}
+
+impl CellKind {
+    pub(crate) fn parse(s: &str) -> Option<Self> {
+        match s {
+            "hex8" => Some(Self::Hex8),
+            "tet4" => Some(Self::Tet4),
+            _ => None,
+        }
+    }
+
+    pub(crate) fn nodes(self) -> usize {
+        match self {
+            Self::Hex8 => 8,
+            Self::Tet4 => 4,
+        }
+    }
+
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Self::Hex8 => "hex8",
+            Self::Tet4 => "tet4",
+        }
+    }
+}
+
+/// Number of nodes of a facet type, or `None` if the type is not supported.
+pub(crate) fn facet_nodes(facet_type: &str) -> Option<usize> {
+    match facet_type {
+        "quad4" => Some(4),
+        "tri3" => Some(3),
+        _ => None,
+    }
+}
+
+/// Checks that `name` can be one HDF5 link name (one path component).
+pub(crate) fn check_name(path: &Path, object: &str, name: &str) -> Result<(), OutputError> {
+    if name.is_empty() || name == "." || name == ".." || name.contains(['/', '\0']) {
+        return Err(OutputError::invalid(
+            path,
+            object,
+            format!("'{name}' is not a valid HDF5 name (empty, '.', '..', or contains '/' or NUL)"),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn step_names_are_six_digits_and_sort() {
+        assert_eq!(step_group_name(0), "000000");
+        assert_eq!(step_group_name(42), "000042");
+        assert_eq!(step_group_name(1_234_567), "1234567");
+        let mut v = vec![
+            step_group_name(10),
+            step_group_name(2),
+            step_group_name(100),
+        ];
+        v.sort();
+        assert_eq!(v, ["000002", "000010", "000100"]);
+    }
+
+    #[test]
+    fn names_are_checked() {
+        let p = Path::new("x.h5");
+        assert!(check_name(p, "o", "top").is_ok());
+        for bad in ["", ".", "..", "a/b", "a\0b"] {
+            let err = check_name(p, "o", bad).err();
+            assert!(err.is_some(), "{bad:?} accepted");
+        }
+    }
+
+    #[test]
+    fn errors_name_path_and_object() {
+        let e = OutputError::invalid(Path::new("/tmp/run/out.h5"), "/mesh/nodes", "bad");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("/tmp/run/out.h5") && msg.contains("/mesh/nodes"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn block_rows_helpers() {
+        let d = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let b = BlockRows::whole(&d, 3);
+        assert_eq!((b.global_rows, b.start, b.cols), (2, 0, 3));
+        let z = BlockRows::whole(&d, 0);
+        assert_eq!(z.global_rows, 0);
+        let e: BlockRows<f64> = BlockRows::empty(7, 7, 3);
+        assert!(e.data.is_empty());
+    }
+
+    #[test]
+    fn cell_kinds() {
+        assert_eq!(CellKind::parse("hex8").map(CellKind::nodes), Some(8));
+        assert_eq!(CellKind::parse("tet4").map(CellKind::nodes), Some(4));
+        assert_eq!(CellKind::parse("hex20"), None);
+        assert_eq!(facet_nodes("quad4"), Some(4));
+        assert_eq!(facet_nodes("tri3"), Some(3));
+        assert_eq!(facet_nodes("tri6"), None);
+    }
+}

@@ -1,0 +1,289 @@
+//! XDMF 3 sidecar describing a result file to ParaView / VisIt.
+//!
+//! Shape: one `Domain` holding a `Temporal` collection of `Uniform` grids,
+//! one grid per step with `<Time Value=step time>`. Every grid repeats the
+//! same Topology (`/mesh/cells`) and Geometry (`/mesh/nodes`) DataItems
+//! rather than using XInclude/xpointer references, because plain repeated
+//! items are understood by every XDMF reader (and by a plain XML parser in
+//! tests) at the cost of a few hundred bytes per step. Attributes per grid:
+//! every nodal and cell field of the step, then `partition` and `cell_body`
+//! (Scalar, Cell).
+//!
+//! HDF5 references use the bare file name (`out.h5:/mesh/nodes`), which
+//! XDMF readers resolve relative to the `.xmf` file, so the pair can be
+//! moved or copied together.
+
+use std::fmt::Write as _;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use super::CellKind;
+
+/// The mesh part of the sidecar: what every grid references.
+#[derive(Debug, Clone)]
+pub(crate) struct MeshDesc {
+    /// File name of the HDF5 file (no directory), as written into DataItems.
+    pub h5_name: String,
+    pub cell_kind: CellKind,
+    pub n_nodes: usize,
+    pub n_cells: usize,
+}
+
+/// Where a step field lives: on nodes (N rows) or cells (M rows).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Center {
+    Node,
+    Cell,
+}
+
+/// One f64 field of a step, stored as `(rows, cols)` at `/steps/<NNNNNN>/<name>`.
+#[derive(Debug, Clone)]
+pub(crate) struct FieldDesc {
+    pub name: String,
+    pub cols: usize,
+    pub center: Center,
+}
+
+/// One step grid.
+#[derive(Debug, Clone)]
+pub(crate) struct StepDesc {
+    pub group: String,
+    pub time: f64,
+    pub fields: Vec<FieldDesc>,
+}
+
+/// `out.h5` -> `out.xmf` in the same directory.
+pub fn sidecar_path(h5_path: &Path) -> PathBuf {
+    h5_path.with_extension("xmf")
+}
+
+/// Renders the whole sidecar for `steps` (in the order given).
+pub(crate) fn render(mesh: &MeshDesc, steps: &[StepDesc]) -> String {
+    let mut s = String::new();
+    s.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
+    s.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
+    s.push_str(
+        "    <Grid Name=\"contactlink\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+    );
+    for step in steps {
+        render_step(&mut s, mesh, step);
+    }
+    s.push_str("    </Grid>\n  </Domain>\n</Xdmf>\n");
+    s
+}
+
+fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
+    let h5 = escape(&mesh.h5_name);
+    let group = escape(&step.group);
+    let (topo, k) = match mesh.cell_kind {
+        CellKind::Hex8 => ("Hexahedron", CellKind::Hex8.nodes()),
+        CellKind::Tet4 => ("Tetrahedron", CellKind::Tet4.nodes()),
+    };
+    // `write!` into a String cannot fail; the results are ignored on purpose
+    // (`let _`) so that no error path or panic exists here.
+    let _ = writeln!(s, "      <Grid Name=\"step_{group}\" GridType=\"Uniform\">");
+    let _ = writeln!(s, "        <Time Value=\"{}\"/>", fmt_f64(step.time));
+    let _ = writeln!(
+        s,
+        "        <Topology TopologyType=\"{topo}\" NumberOfElements=\"{}\" NodesPerElement=\"{k}\">",
+        mesh.n_cells
+    );
+    data_item(
+        s,
+        "Int",
+        8,
+        &dims(mesh.n_cells, k, false),
+        &h5,
+        "/mesh/cells",
+    );
+    s.push_str("        </Topology>\n");
+    s.push_str("        <Geometry GeometryType=\"XYZ\">\n");
+    data_item(
+        s,
+        "Float",
+        8,
+        &dims(mesh.n_nodes, 3, false),
+        &h5,
+        "/mesh/nodes",
+    );
+    s.push_str("        </Geometry>\n");
+    for f in &step.fields {
+        let (center, rows) = match f.center {
+            Center::Node => ("Node", mesh.n_nodes),
+            Center::Cell => ("Cell", mesh.n_cells),
+        };
+        let _ = writeln!(
+            s,
+            "        <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{center}\">",
+            escape(&f.name),
+            attribute_type(f.cols)
+        );
+        let h5path = format!("/steps/{group}/{}", escape(&f.name));
+        data_item(s, "Float", 8, &dims(rows, f.cols, false), &h5, &h5path);
+        s.push_str("        </Attribute>\n");
+    }
+    for name in ["partition", "cell_body"] {
+        let _ = writeln!(
+            s,
+            "        <Attribute Name=\"{name}\" AttributeType=\"Scalar\" Center=\"Cell\">"
+        );
+        let h5path = format!("/mesh/{name}");
+        data_item(s, "Int", 4, &dims(mesh.n_cells, 1, true), &h5, &h5path);
+        s.push_str("        </Attribute>\n");
+    }
+    s.push_str("      </Grid>\n");
+}
+
+fn data_item(
+    s: &mut String,
+    number_type: &str,
+    precision: usize,
+    dims: &str,
+    h5: &str,
+    h5path: &str,
+) {
+    let _ = writeln!(
+        s,
+        "          <DataItem Format=\"HDF\" NumberType=\"{number_type}\" Precision=\"{precision}\" \
+         Dimensions=\"{dims}\">{h5}:{h5path}</DataItem>"
+    );
+}
+
+fn dims(rows: usize, cols: usize, one_d: bool) -> String {
+    if one_d {
+        format!("{rows}")
+    } else {
+        format!("{rows} {cols}")
+    }
+}
+
+/// XDMF attribute type by component count; anything without a name of its
+/// own is a Matrix (ParaView shows it as a multi-component array).
+fn attribute_type(cols: usize) -> &'static str {
+    match cols {
+        1 => "Scalar",
+        3 => "Vector",
+        6 => "Tensor6",
+        9 => "Tensor",
+        _ => "Matrix",
+    }
+}
+
+/// Shortest text that parses back to the same f64 (Rust's `{:?}` switches to
+/// exponent form for very large/small magnitudes, which strtod reads).
+fn fmt_f64(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// Escapes the five XML special characters (names come from the caller).
+fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// Writes `text` to `path` through a temporary file and a rename, so a run
+/// killed mid-write leaves the previous complete sidecar, never a torn one.
+pub(crate) fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
+    let mut tmp = path.as_os_str().to_os_string();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh() -> MeshDesc {
+        MeshDesc {
+            h5_name: "out.h5".into(),
+            cell_kind: CellKind::Hex8,
+            n_nodes: 12,
+            n_cells: 2,
+        }
+    }
+
+    fn step(i: usize, t: f64) -> StepDesc {
+        StepDesc {
+            group: super::super::step_group_name(i),
+            time: t,
+            fields: vec![
+                FieldDesc {
+                    name: "displacement".into(),
+                    cols: 3,
+                    center: Center::Node,
+                },
+                FieldDesc {
+                    name: "stress<&>".into(),
+                    cols: 6,
+                    center: Center::Cell,
+                },
+            ],
+        }
+    }
+
+    #[test]
+    fn sidecar_name() {
+        assert_eq!(
+            sidecar_path(Path::new("/a/b/out.h5")),
+            Path::new("/a/b/out.xmf")
+        );
+        assert_eq!(sidecar_path(Path::new("run")), Path::new("run.xmf"));
+    }
+
+    #[test]
+    fn render_lists_each_step_with_relative_refs() {
+        let text = render(&mesh(), &[step(1, 0.5), step(2, 1.0)]);
+        assert_eq!(text.matches("GridType=\"Uniform\"").count(), 2);
+        assert!(text.contains("<Time Value=\"0.5\"/>"));
+        assert!(text.contains("<Time Value=\"1.0\"/>"));
+        assert!(text.contains("TopologyType=\"Hexahedron\" NumberOfElements=\"2\""));
+        assert!(text.contains("Dimensions=\"12 3\">out.h5:/mesh/nodes<"));
+        assert!(text.contains("Dimensions=\"2 8\">out.h5:/mesh/cells<"));
+        assert!(text.contains(">out.h5:/steps/000002/displacement<"));
+        assert!(
+            text.contains("Name=\"stress&lt;&amp;&gt;\" AttributeType=\"Tensor6\" Center=\"Cell\"")
+        );
+        assert!(text.contains("Precision=\"4\" Dimensions=\"2\">out.h5:/mesh/partition<"));
+        assert!(!text.contains("/work") && !text.contains("stress<"));
+    }
+
+    #[test]
+    fn empty_collection_is_still_a_document() {
+        let text = render(&mesh(), &[]);
+        assert!(text.starts_with("<?xml"));
+        assert!(text.trim_end().ends_with("</Xdmf>"));
+        assert!(!text.contains("Uniform"));
+    }
+
+    #[test]
+    fn float_text_round_trips() {
+        for v in [0.0, 0.1, 1.0, 1e-7, 2.5e300, -3.25] {
+            let back: f64 = fmt_f64(v).parse().unwrap_or(f64::NAN);
+            assert_eq!(back, v);
+        }
+    }
+
+    #[test]
+    fn atomic_write_replaces() {
+        let dir = std::env::temp_dir().join(format!("xdmf_atomic_{}", std::process::id()));
+        let _ = std::fs::create_dir_all(&dir);
+        let p = dir.join("a.xmf");
+        assert!(write_atomic(&p, "one").is_ok());
+        assert!(write_atomic(&p, "two").is_ok());
+        assert_eq!(std::fs::read_to_string(&p).ok().as_deref(), Some("two"));
+        assert!(!dir.join("a.xmf.tmp").exists());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

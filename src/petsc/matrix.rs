@@ -1,0 +1,215 @@
+//! Distributed sparse matrices (MPIAIJ) with exact preallocation.
+use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result, Vector};
+
+/// Per owned row: how many non-zeros fall in the diagonal block (columns this
+/// rank owns) and in the off-diagonal block.
+#[derive(Debug, Clone, Default)]
+pub struct Preallocation {
+    pub diag: Vec<PetscInt>,
+    pub offdiag: Vec<PetscInt>,
+}
+
+pub struct Matrix {
+    raw: sys::Mat,
+    owned: bool,
+}
+
+impl Matrix {
+    /// A square AIJ matrix with `local_rows` owned rows, preallocated exactly;
+    /// inserting outside the preallocated pattern is an error, not a silent slowdown.
+    pub fn new_aij(local_rows: usize, prealloc: &Preallocation, block_size: usize) -> Result<Self> {
+        let n = to_petsc_int(local_rows)?;
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: the nnz slices have `local_rows` entries each (asserted), PETSc
+        // copies them; out-pointer valid.
+        unsafe {
+            assert_eq!(prealloc.diag.len(), local_rows);
+            assert_eq!(prealloc.offdiag.len(), local_rows);
+            petsc_call!(MatCreate(comm_world(), &mut raw))?;
+            petsc_call!(MatSetSizes(
+                raw,
+                n,
+                n,
+                sys::PETSC_DETERMINE,
+                sys::PETSC_DETERMINE
+            ))?;
+            petsc_call!(MatSetBlockSize(raw, to_petsc_int(block_size)?))?;
+            petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
+            petsc_call!(MatSeqAIJSetPreallocation(raw, 0, prealloc.diag.as_ptr()))?;
+            petsc_call!(MatMPIAIJSetPreallocation(
+                raw,
+                0,
+                prealloc.diag.as_ptr(),
+                0,
+                prealloc.offdiag.as_ptr()
+            ))?;
+            petsc_call!(MatSetOption(
+                raw,
+                sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+            // Zeroed rows (Dirichlet) keep their entries, so the pattern, and
+            // the preconditioner's symbolic set-up, survive from one Newton
+            // iteration to the next.
+            petsc_call!(MatSetOption(
+                raw,
+                sys::MatOption_MAT_KEEP_NONZERO_PATTERN,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+        }
+        Ok(Matrix { raw, owned: true })
+    }
+
+    /// # Safety
+    /// `raw` must be valid for the lifetime of the returned value.
+    pub(crate) unsafe fn borrowed(raw: sys::Mat) -> Self {
+        Matrix { raw, owned: false }
+    }
+
+    pub(crate) fn raw(&self) -> sys::Mat {
+        self.raw
+    }
+
+    pub fn zero_entries(&mut self) -> Result<()> {
+        // SAFETY: valid mat.
+        unsafe { petsc_call!(MatZeroEntries(self.raw)) }
+    }
+
+    /// Adds a dense row-major block at global (rows, cols); negative indices are
+    /// skipped by PETSc (used for constrained DOFs).
+    pub fn add_block(
+        &mut self,
+        rows: &[PetscInt],
+        cols: &[PetscInt],
+        values: &[f64],
+    ) -> Result<()> {
+        debug_assert_eq!(rows.len() * cols.len(), values.len());
+        // SAFETY: values has rows*cols entries in row-major order as MatSetValues expects.
+        unsafe {
+            petsc_call!(MatSetValues(
+                self.raw,
+                rows.len() as PetscInt,
+                rows.as_ptr(),
+                cols.len() as PetscInt,
+                cols.as_ptr(),
+                values.as_ptr(),
+                sys::InsertMode_ADD_VALUES
+            ))
+        }
+    }
+
+    pub fn assemble(&mut self) -> Result<()> {
+        // SAFETY: valid mat; begin/end paired.
+        unsafe {
+            petsc_call!(MatAssemblyBegin(
+                self.raw,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+            ))?;
+            petsc_call!(MatAssemblyEnd(
+                self.raw,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+            ))
+        }
+    }
+
+    /// Replaces rows and columns of constrained DOFs by the identity, keeping
+    /// the matrix symmetric (so CG stays usable). Collective.
+    pub fn zero_rows_columns_identity(&mut self, rows: &[PetscInt]) -> Result<()> {
+        // SAFETY: rows valid for its length; null x/b mean no right-hand-side fix-up.
+        unsafe {
+            petsc_call!(MatZeroRowsColumns(
+                self.raw,
+                rows.len() as PetscInt,
+                rows.as_ptr(),
+                1.0,
+                std::ptr::null_mut(),
+                std::ptr::null_mut()
+            ))
+        }
+    }
+
+    /// Copies values from `other` (same non-zero pattern).
+    pub fn copy_from(&mut self, other: &Matrix) -> Result<()> {
+        // SAFETY: both valid; PETSc checks the patterns.
+        unsafe {
+            petsc_call!(MatCopy(
+                other.raw,
+                self.raw,
+                sys::MatStructure_SAME_NONZERO_PATTERN
+            ))
+        }
+    }
+
+    pub fn duplicate(&self) -> Result<Matrix> {
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: valid mat and out-pointer.
+        unsafe {
+            petsc_call!(MatDuplicate(
+                self.raw,
+                sys::MatDuplicateOption_MAT_COPY_VALUES,
+                &mut raw
+            ))?
+        };
+        Ok(Matrix { raw, owned: true })
+    }
+
+    /// y = A x
+    pub fn mult(&self, x: &Vector, y: &mut Vector) -> Result<()> {
+        // SAFETY: all valid; PETSc checks layouts.
+        unsafe { petsc_call!(MatMult(self.raw, x.raw(), y.raw())) }
+    }
+
+    /// Attaches the rigid-body modes computed from nodal coordinates (a blocked
+    /// vector of owned coordinates, block size 3) as the near-null space, which
+    /// algebraic multigrid needs for elasticity.
+    pub fn set_rigid_body_near_null_space(&mut self, coords: &Vector) -> Result<()> {
+        let mut ns: sys::MatNullSpace = std::ptr::null_mut();
+        // SAFETY: coords valid with block size 3; the matrix keeps its own reference
+        // to the null space, so ours is destroyed here.
+        unsafe {
+            petsc_call!(MatNullSpaceCreateRigidBody(coords.raw(), &mut ns))?;
+            petsc_call!(MatSetNearNullSpace(self.raw, ns))?;
+            petsc_call!(MatNullSpaceDestroy(&mut ns))
+        }
+    }
+
+    /// Total number of stored non-zeros over all ranks.
+    pub fn global_nonzeros(&self) -> Result<f64> {
+        let mut info = sys::MatInfo::default();
+        // SAFETY: valid mat and out-pointer.
+        unsafe {
+            petsc_call!(MatGetInfo(
+                self.raw,
+                sys::MatInfoType_MAT_GLOBAL_SUM,
+                &mut info
+            ))?
+        };
+        Ok(info.nz_used)
+    }
+}
+
+impl Drop for Matrix {
+    fn drop(&mut self) {
+        if self.owned && !self.raw.is_null() {
+            // SAFETY: owned and destroyed exactly once.
+            unsafe {
+                sys::MatDestroy(&mut self.raw);
+            }
+        }
+    }
+}
+
+impl Matrix {
+    /// self += a · other, where other's non-zeros are a subset of self's.
+    pub fn add_scaled_subset(&mut self, a: f64, other: &Matrix) -> Result<()> {
+        // SAFETY: both valid; PETSc checks sizes and the subset property.
+        unsafe {
+            petsc_call!(MatAXPY(
+                self.raw,
+                a,
+                other.raw,
+                sys::MatStructure_SUBSET_NONZERO_PATTERN
+            ))
+        }
+    }
+}

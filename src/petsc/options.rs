@@ -1,0 +1,88 @@
+//! The PETSc options database: defaults set by the program, which the command
+//! line and PETSC_OPTIONS can override.
+use super::{petsc_call, PetscError, Result};
+use std::ffi::CString;
+
+fn c_string(s: &str) -> Result<CString> {
+    CString::new(s).map_err(|_| PetscError {
+        call: "PetscOptions",
+        code: -1,
+        message: format!("option text contains a NUL byte: {s:?}"),
+    })
+}
+
+/// Sets `name` (with its leading dash) to `value` unless the user already set it.
+pub fn set_default(name: &str, value: &str) -> Result<()> {
+    if has(name)? {
+        return Ok(());
+    }
+    set(name, value)
+}
+
+/// Sets `name` to `value` unconditionally.
+pub fn set(name: &str, value: &str) -> Result<()> {
+    let n = c_string(name)?;
+    let v = c_string(value)?;
+    // SAFETY: both strings are valid NUL-terminated C strings; PETSc copies them.
+    unsafe {
+        petsc_call!(PetscOptionsSetValue(
+            std::ptr::null_mut(),
+            n.as_ptr(),
+            v.as_ptr()
+        ))
+    }
+}
+
+/// True when the option is present in the database.
+pub fn has(name: &str) -> Result<bool> {
+    let n = c_string(name)?;
+    let mut set = super::sys::PetscBool_PETSC_FALSE;
+    // SAFETY: valid C string, `set` is a valid out-pointer.
+    unsafe {
+        petsc_call!(PetscOptionsHasName(
+            std::ptr::null_mut(),
+            std::ptr::null(),
+            n.as_ptr(),
+            &mut set
+        ))?;
+    }
+    Ok(set == super::sys::PetscBool_PETSC_TRUE)
+}
+
+/// Inserts a whole option string such as "-ksp_type cg -pc_type gamg".
+pub fn insert_string(opts: &str) -> Result<()> {
+    let s = c_string(opts)?;
+    // SAFETY: valid C string; PETSc parses and copies it.
+    unsafe { petsc_call!(PetscOptionsInsertString(std::ptr::null_mut(), s.as_ptr())) }
+}
+
+/// Inserts "-key value" pairs from `opts` as defaults: keys the user already
+/// set (command line, PETSC_OPTIONS) keep the user's value.
+pub fn insert_string_defaults(opts: &str) -> Result<()> {
+    let words: Vec<&str> = opts.split_whitespace().collect();
+    let mut i = 0;
+    while i < words.len() {
+        let key = words[i];
+        if !key.starts_with('-') {
+            return Err(PetscError {
+                call: "PetscOptions",
+                code: -1,
+                message: format!("expected an option starting with '-', found {key:?} in {opts:?}"),
+            });
+        }
+        let value = words
+            .get(i + 1)
+            .filter(|w| !w.starts_with('-') || w.parse::<f64>().is_ok());
+        match value {
+            Some(v) => {
+                set_default(key, v)?;
+                i += 2;
+            }
+            None => {
+                set_default(key, "")?;
+                i += 1;
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,255 @@
+//! Newton's method through PETSc SNES, with residual and Jacobian computed by
+//! Rust code behind the [`NonlinearProblem`] trait.
+use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
+use std::ffi::c_void;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// What a callback can report besides success.
+#[derive(Debug)]
+pub enum CallbackError {
+    /// The state is outside the problem's domain (e.g. an inverted element): SNES
+    /// treats the step as failed and the caller can cut the load step back.
+    Domain(String),
+    /// Anything else: the solve stops and the error is reported.
+    Fatal(String),
+}
+
+/// The residual R(x) and its Jacobian, evaluated by the application.
+pub trait NonlinearProblem {
+    fn residual(&mut self, x: &Vector, r: &mut Vector) -> std::result::Result<(), CallbackError>;
+    fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError>;
+}
+
+/// The result of one SNES solve.
+#[derive(Debug, Clone)]
+pub struct SnesOutcome {
+    pub converged: bool,
+    /// PETSc's SNESConvergedReason (positive: converged, negative: diverged).
+    pub reason: i32,
+    pub reason_text: String,
+    pub iterations: usize,
+    pub linear_iterations: usize,
+    pub residual_norm: f64,
+    /// Residual norm after each Newton iteration (index 0: initial).
+    pub history: Vec<f64>,
+    /// Set when a callback hit a domain error (inverted element, ...).
+    pub domain_error: Option<String>,
+}
+
+struct Context<'a> {
+    problem: &'a mut dyn NonlinearProblem,
+    fatal: Option<String>,
+    domain: Option<String>,
+}
+
+pub struct Snes {
+    raw: sys::SNES,
+}
+
+impl Snes {
+    /// A Newton solver that reads its settings from the options database under
+    /// `prefix` (e.g. "" or "contact_").
+    pub fn new() -> Result<Self> {
+        let mut raw: sys::SNES = std::ptr::null_mut();
+        // SAFETY: PETSc is initialised; out-pointer valid.
+        unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
+        Ok(Snes { raw })
+    }
+
+    pub fn set_tolerances(&mut self, atol: f64, rtol: f64, stol: f64, max_it: usize) -> Result<()> {
+        // SAFETY: valid snes.
+        unsafe {
+            petsc_call!(SNESSetTolerances(
+                self.raw,
+                atol,
+                rtol,
+                stol,
+                max_it as sys::PetscInt,
+                -1
+            ))
+        }
+    }
+
+    /// Applies the options database (after the program's defaults are set).
+    pub fn set_from_options(&mut self) -> Result<()> {
+        // SAFETY: valid snes.
+        unsafe {
+            petsc_call!(SNESSetFromOptions(self.raw))?;
+            let mut ksp: sys::KSP = std::ptr::null_mut();
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPSetFromOptions(ksp))
+        }
+    }
+
+    /// Solves R(x) = 0 starting from `x`, overwriting it. `r` and `j` are the
+    /// work residual and Jacobian storage.
+    pub fn solve(
+        &mut self,
+        problem: &mut dyn NonlinearProblem,
+        x: &mut Vector,
+        r: &mut Vector,
+        j: &mut Matrix,
+    ) -> Result<SnesOutcome> {
+        let mut ctx = Context {
+            problem,
+            fatal: None,
+            domain: None,
+        };
+        let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
+        const HIST: usize = 200;
+        let mut hist = [0.0f64; HIST];
+        let mut hist_its = [0 as sys::PetscInt; HIST];
+        // SAFETY: the context lives on this stack frame and SNES calls back into it
+        // only during SNESSolve below; callbacks are reset to this context before
+        // every solve. The history arrays outlive the solve and are detached after.
+        let outcome = unsafe {
+            petsc_call!(SNESSetFunction(
+                self.raw,
+                r.raw(),
+                Some(residual_trampoline),
+                ctx_ptr
+            ))?;
+            petsc_call!(SNESSetJacobian(
+                self.raw,
+                j.raw(),
+                j.raw(),
+                Some(jacobian_trampoline),
+                ctx_ptr
+            ))?;
+            petsc_call!(SNESSetConvergenceHistory(
+                self.raw,
+                hist.as_mut_ptr(),
+                hist_its.as_mut_ptr(),
+                HIST as sys::PetscInt,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+            let solved = petsc_call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()));
+            let mut reason: sys::SNESConvergedReason = 0;
+            let mut its: sys::PetscInt = 0;
+            let mut lits: sys::PetscInt = 0;
+            let mut norm = 0.0;
+            let mut nhist: sys::PetscInt = 0;
+            let mut hptr: *mut f64 = std::ptr::null_mut();
+            let mut iptr: *mut sys::PetscInt = std::ptr::null_mut();
+            sys::SNESGetConvergedReason(self.raw, &mut reason);
+            sys::SNESGetIterationNumber(self.raw, &mut its);
+            sys::SNESGetLinearSolveIterations(self.raw, &mut lits);
+            sys::SNESGetFunctionNorm(self.raw, &mut norm);
+            sys::SNESGetConvergenceHistory(self.raw, &mut hptr, &mut iptr, &mut nhist);
+            let history = hist[..(nhist.max(0) as usize).min(HIST)].to_vec();
+            sys::SNESSetConvergenceHistory(
+                self.raw,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                0,
+                sys::PetscBool_PETSC_TRUE,
+            );
+            (solved, reason, its, lits, norm, history)
+        };
+        let (solved, reason, its, lits, norm, history) = outcome;
+        if let Some(msg) = ctx.fatal.take() {
+            return Err(PetscError {
+                call: "SNESSolve callback",
+                code: -1,
+                message: msg,
+            });
+        }
+        solved?;
+        Ok(SnesOutcome {
+            converged: reason > 0,
+            reason,
+            reason_text: reason_text(reason),
+            iterations: its as usize,
+            linear_iterations: lits as usize,
+            residual_norm: norm,
+            history,
+            domain_error: ctx.domain.take(),
+        })
+    }
+}
+
+impl Drop for Snes {
+    fn drop(&mut self) {
+        // SAFETY: owned and destroyed once.
+        unsafe {
+            sys::SNESDestroy(&mut self.raw);
+        }
+    }
+}
+
+fn reason_text(reason: i32) -> String {
+    // PETSc's own name table (SNESConvergedReasons) is a macro-indexed array
+    // bindgen cannot see, so the documented meanings are spelled out here.
+    match reason {
+        2 => "converged: |F| < atol",
+        3 => "converged: |F| < rtol |F0|",
+        4 => "converged: |dx| < stol |x|",
+        5 => "converged: iteration limit (ksponly)",
+        -1 => "diverged: function count",
+        -2 => "diverged: linear solve failed",
+        -3 => "diverged: NaN or Inf in the residual",
+        -4 => "diverged: |F| exceeded divergence tolerance",
+        -5 => "diverged: maximum iterations reached",
+        -6 => "diverged: line search failed",
+        -7 => "diverged: inner solve failed",
+        -8 => "diverged: local minimum",
+        -10 => "diverged: domain error (inverted element?)",
+        -11 => "diverged: Jacobian domain error",
+        -12 => "diverged: trust region delta",
+        _ => "unknown",
+    }
+    .to_owned()
+}
+
+fn run_callback(
+    ctx: *mut c_void,
+    snes: sys::SNES,
+    f: impl FnOnce(&mut dyn NonlinearProblem) -> std::result::Result<(), CallbackError>,
+) -> sys::PetscErrorCode {
+    // SAFETY: ctx is the `Context` set in `solve`, alive for the whole SNESSolve.
+    let ctx = unsafe { &mut *(ctx as *mut Context) };
+    let result = catch_unwind(AssertUnwindSafe(|| f(&mut *ctx.problem)));
+    match result {
+        Ok(Ok(())) => 0,
+        Ok(Err(CallbackError::Domain(msg))) => {
+            ctx.domain = Some(msg);
+            // SAFETY: valid snes handed to the callback by PETSc.
+            unsafe {
+                sys::SNESSetFunctionDomainError(snes);
+            }
+            0
+        }
+        Ok(Err(CallbackError::Fatal(msg))) => {
+            ctx.fatal = Some(msg);
+            sys::PETSC_ERR_USER
+        }
+        Err(_) => {
+            ctx.fatal = Some("panic inside a SNES callback".into());
+            sys::PETSC_ERR_USER
+        }
+    }
+}
+
+unsafe extern "C" fn residual_trampoline(
+    snes: sys::SNES,
+    x: sys::Vec,
+    r: sys::Vec,
+    ctx: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: PETSc passes valid vectors owned by the SNES for the call's duration.
+    let (xv, mut rv) = unsafe { (Vector::borrowed(x), Vector::borrowed(r)) };
+    run_callback(ctx, snes, |p| p.residual(&xv, &mut rv))
+}
+
+unsafe extern "C" fn jacobian_trampoline(
+    snes: sys::SNES,
+    x: sys::Vec,
+    a: sys::Mat,
+    _p: sys::Mat,
+    ctx: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: PETSc passes valid objects for the call's duration; A and P are the
+    // same matrix (set in `solve`).
+    let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(a)) };
+    run_callback(ctx, snes, |p| p.jacobian(&xv, &mut am))
+}

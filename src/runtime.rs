@@ -1,0 +1,43 @@
+//! Process start-up and shut-down: MPI first, then PETSc on the same
+//! communicator; PETSc finalised before MPI.
+use crate::error::{Error, Result};
+use crate::petsc::PetscGuard;
+use mpi::topology::{Communicator, SimpleCommunicator};
+
+/// Owns MPI and PETSc for the life of the program.
+///
+/// Field order matters: Rust drops fields in declaration order, and
+/// PetscFinalize must run before rsmpi's Universe calls MPI_Finalize.
+pub struct Runtime {
+    _petsc: PetscGuard,
+    universe: mpi::environment::Universe,
+}
+
+impl Runtime {
+    /// `petsc_args` are PETSc options in command-line form (program name not
+    /// included), e.g. `["-ksp_type", "cg"]`.
+    pub fn start(petsc_args: &[String]) -> Result<Self> {
+        let universe =
+            mpi::initialize().ok_or_else(|| Error::Mpi("MPI was already initialised".into()))?;
+        let world = universe.world();
+        let mut args = vec!["contactlink".to_owned()];
+        args.extend(petsc_args.iter().cloned());
+        let petsc = PetscGuard::initialize(&world, &args)?;
+        Ok(Runtime {
+            _petsc: petsc,
+            universe,
+        })
+    }
+
+    pub fn world(&self) -> SimpleCommunicator {
+        self.universe.world()
+    }
+
+    pub fn rank(&self) -> usize {
+        self.universe.world().rank() as usize
+    }
+
+    pub fn size(&self) -> usize {
+        self.universe.world().size() as usize
+    }
+}

@@ -1,0 +1,578 @@
+//! Scene files (TOML) → a validated [`Model`].
+//!
+//! A scene names the mesh (a generator and its parameters), a material per
+//! body, Dirichlet conditions, loads, load steps, solver options and the
+//! output path. Built-in scenes live in `scenes/` and are compiled in.
+//! Every error names the key (and, for syntax errors, the line).
+use crate::assembly::FacetLoad;
+use crate::error::{Error, Result};
+use crate::fem::{CellType, Material};
+use crate::mesh::generate::{
+    self, BoxSpec, Grading, HertzCylinderSpec, HertzSphereSpec, StackedSpec,
+};
+use crate::mesh::Mesh;
+use crate::solve::{DirichletSpec, Model, SolverSettings};
+use serde::Deserialize;
+use std::path::Path;
+
+/// The scenes compiled into the binary: (name, one-line description, TOML).
+pub const BUILTIN: &[(&str, &str, &str)] = &[
+    (
+        "block-compress",
+        "Neo-Hookean block compressed 20 % by a follower pressure (finite strain)",
+        include_str!("../scenes/block-compress.toml"),
+    ),
+    (
+        "uniaxial-stretch",
+        "Neo-Hookean cube stretched to twice its length (closed form known)",
+        include_str!("../scenes/uniaxial-stretch.toml"),
+    ),
+    (
+        "cantilever",
+        "Linear-elastic cantilever under an end traction, graded tet mesh",
+        include_str!("../scenes/cantilever.toml"),
+    ),
+];
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    pub title: Option<String>,
+    pub mesh: MeshSection,
+    #[serde(rename = "body")]
+    pub bodies: Vec<BodySection>,
+    #[serde(default)]
+    pub dirichlet: Vec<DirichletSection>,
+    #[serde(default)]
+    pub pressure: Vec<PressureSection>,
+    #[serde(default)]
+    pub traction: Vec<TractionSection>,
+    #[serde(default)]
+    pub body_force: Vec<BodyForceSection>,
+    #[serde(default)]
+    pub steps: StepsSection,
+    #[serde(default)]
+    pub solver: SolverSection,
+    #[serde(default)]
+    pub output: OutputSection,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "generator", rename_all = "kebab-case")]
+pub enum MeshSection {
+    Box(BoxSection),
+    HertzCylinder(HertzCylinderSection),
+    HertzSphere(HertzSphereSection),
+    StackedBlocks(StackedSection),
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum CellTypeName {
+    #[default]
+    Hex8,
+    Tet4,
+}
+
+impl From<CellTypeName> for CellType {
+    fn from(c: CellTypeName) -> Self {
+        match c {
+            CellTypeName::Hex8 => CellType::Hex8,
+            CellTypeName::Tet4 => CellType::Tet4,
+        }
+    }
+}
+
+/// Element size variation along one axis.
+#[derive(Debug, Deserialize, Clone, Copy, Default)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum GradingSection {
+    #[default]
+    Uniform,
+    Geometric {
+        ratio: f64,
+    },
+    Toward {
+        point: f64,
+        ratio: f64,
+    },
+}
+
+impl From<GradingSection> for Grading {
+    fn from(g: GradingSection) -> Self {
+        match g {
+            GradingSection::Uniform => Grading::Uniform,
+            GradingSection::Geometric { ratio } => Grading::Geometric { ratio },
+            GradingSection::Toward { point, ratio } => Grading::Toward { point, ratio },
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSection {
+    #[serde(default = "default_block")]
+    pub body: String,
+    #[serde(default)]
+    pub origin: [f64; 3],
+    pub size: [f64; 3],
+    pub divisions: [usize; 3],
+    #[serde(default)]
+    pub grading: [GradingSection; 3],
+    #[serde(default)]
+    pub cell_type: CellTypeName,
+}
+
+fn default_block() -> String {
+    "block".into()
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct HertzCylinderSection {
+    pub radius: Option<f64>,
+    pub block_width: Option<f64>,
+    pub block_height: Option<f64>,
+    pub thickness: Option<f64>,
+    pub gap: Option<f64>,
+    pub fine_size: Option<f64>,
+    pub fine_half_width: Option<f64>,
+    pub growth: Option<f64>,
+    pub level: Option<u32>,
+    pub cell_type: Option<CellTypeName>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct HertzSphereSection {
+    pub radius: Option<f64>,
+    pub block_width: Option<f64>,
+    pub block_height: Option<f64>,
+    pub gap: Option<f64>,
+    pub fine_size: Option<f64>,
+    pub fine_half_width: Option<f64>,
+    pub growth: Option<f64>,
+    pub level: Option<u32>,
+    pub cell_type: Option<CellTypeName>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct StackedSection {
+    pub length: Option<f64>,
+    pub height: Option<f64>,
+    pub gap: Option<f64>,
+    pub lower_divisions: Option<[usize; 3]>,
+    pub upper_divisions: Option<[usize; 3]>,
+    pub cell_type: Option<CellTypeName>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+pub enum MaterialName {
+    LinearElastic,
+    NeoHookean,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySection {
+    pub name: String,
+    pub material: MaterialName,
+    pub youngs: f64,
+    pub poisson: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirichletSection {
+    pub set: String,
+    /// Subset of "x", "y", "z"; all three when absent.
+    pub components: Option<Vec<String>>,
+    /// Displacement of each listed component at full load; zero when absent.
+    pub value: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSection {
+    pub set: String,
+    pub value: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSection {
+    pub set: String,
+    pub vector: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyForceSection {
+    pub body: String,
+    pub vector: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepsSection {
+    #[serde(default = "one")]
+    pub count: usize,
+}
+
+impl Default for StepsSection {
+    fn default() -> Self {
+        StepsSection { count: 1 }
+    }
+}
+
+fn one() -> usize {
+    1
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSection {
+    pub max_newton: Option<usize>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub max_cutbacks: Option<usize>,
+    pub petsc_options: Option<String>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    pub path: Option<String>,
+}
+
+/// Where a scene came from, for messages.
+#[derive(Debug, Clone)]
+pub struct SceneSource {
+    pub origin: String,
+    pub text: String,
+}
+
+impl SceneSource {
+    /// A built-in scene by name, or a file by path.
+    pub fn resolve(name_or_path: &str) -> Result<Self> {
+        if let Some((name, _, text)) = BUILTIN.iter().find(|(n, _, _)| *n == name_or_path) {
+            return Ok(SceneSource {
+                origin: format!("built-in scene '{name}'"),
+                text: (*text).to_owned(),
+            });
+        }
+        let path = Path::new(name_or_path);
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            let known: Vec<&str> = BUILTIN.iter().map(|(n, _, _)| *n).collect();
+            Error::scene(
+                name_or_path,
+                format!(
+                    "cannot read it ({e}); it is not a built-in scene either (built-ins: {})",
+                    known.join(", ")
+                ),
+            )
+        })?;
+        Ok(SceneSource {
+            origin: path.display().to_string(),
+            text,
+        })
+    }
+}
+
+/// Parses a scene, applying `overrides` ("a.b=value", TOML values) first.
+pub fn parse(src: &SceneSource, overrides: &[String]) -> Result<Scene> {
+    if overrides.is_empty() {
+        // Straight from the text, so errors carry the line and column.
+        return toml::from_str(&src.text).map_err(|e| Error::scene(&src.origin, e.to_string()));
+    }
+    let mut doc: toml::Table =
+        toml::from_str(&src.text).map_err(|e| Error::scene(&src.origin, e.to_string()))?;
+    for o in overrides {
+        apply_override(&mut doc, o)
+            .map_err(|m| Error::scene(&src.origin, format!("--set {o}: {m}")))?;
+    }
+    Scene::deserialize(toml::Value::Table(doc))
+        .map_err(|e| Error::scene(&src.origin, e.to_string()))
+}
+
+fn apply_override(doc: &mut toml::Table, assignment: &str) -> std::result::Result<(), String> {
+    let (path, value) = assignment
+        .split_once('=')
+        .ok_or("expected key.path=value")?;
+    let parsed: toml::Value = toml::from_str::<toml::Table>(&format!("v = {value}"))
+        .map(|mut t| {
+            t.remove("v")
+                .unwrap_or(toml::Value::String(value.to_owned()))
+        })
+        .unwrap_or_else(|_| toml::Value::String(value.to_owned()));
+    let keys: Vec<&str> = path.trim().split('.').collect();
+    let (last, parents) = keys.split_last().ok_or("empty key")?;
+    let mut table = doc;
+    for k in parents {
+        let entry = table
+            .entry((*k).to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = match entry {
+            toml::Value::Table(t) => t,
+            toml::Value::Array(a) if a.len() == 1 => match &mut a[0] {
+                toml::Value::Table(t) => t,
+                _ => return Err(format!("'{k}' is not a table")),
+            },
+            _ => return Err(format!("'{k}' is not a table")),
+        };
+    }
+    table.insert((*last).to_owned(), parsed);
+    Ok(())
+}
+
+impl Scene {
+    /// The output path the scene asks for, if any.
+    pub fn output_path(&self) -> Option<&str> {
+        self.output.path.as_deref()
+    }
+
+    /// Builds the mesh and checks every reference in the scene against it.
+    pub fn build(&self, origin: &str) -> Result<Model> {
+        let err = |m: String| Error::scene(origin, m);
+        let mesh = self.build_mesh()?;
+        mesh.validate()?;
+        let mut materials = Vec::with_capacity(mesh.bodies.len());
+        for body in &mesh.bodies {
+            let section = self
+                .bodies
+                .iter()
+                .find(|b| &b.name == body)
+                .ok_or_else(|| {
+                    err(format!(
+                        "the mesh has a body '{body}' but no [[body]] gives its material"
+                    ))
+                })?;
+            let m = match section.material {
+                MaterialName::LinearElastic => Material::LinearElastic {
+                    youngs: section.youngs,
+                    poisson: section.poisson,
+                },
+                MaterialName::NeoHookean => Material::NeoHookean {
+                    youngs: section.youngs,
+                    poisson: section.poisson,
+                },
+            };
+            m.validate()
+                .map_err(|e| err(format!("[[body]] '{}': {e}", section.name)))?;
+            materials.push(m);
+        }
+        for b in &self.bodies {
+            if !mesh.bodies.contains(&b.name) {
+                return Err(err(format!(
+                    "[[body]] '{}' is not a body of the mesh (bodies: {})",
+                    b.name,
+                    mesh.bodies.join(", ")
+                )));
+            }
+        }
+        let dirichlet = self
+            .dirichlet
+            .iter()
+            .map(|d| dirichlet_spec(&mesh, d).map_err(&err))
+            .collect::<Result<Vec<_>>>()?;
+        let mut facet_loads = Vec::new();
+        for p in &self.pressure {
+            check_facet_set(&mesh, &p.set, "[[pressure]]").map_err(&err)?;
+            check_finite(p.value, "[[pressure]] value").map_err(&err)?;
+            facet_loads.push((p.set.clone(), FacetLoad::Pressure(p.value)));
+        }
+        for t in &self.traction {
+            check_facet_set(&mesh, &t.set, "[[traction]]").map_err(&err)?;
+            t.vector
+                .iter()
+                .try_for_each(|&v| check_finite(v, "[[traction]] vector"))
+                .map_err(&err)?;
+            facet_loads.push((t.set.clone(), FacetLoad::Traction(t.vector)));
+        }
+        let mut body_force = vec![[0.0; 3]; mesh.bodies.len()];
+        for bf in &self.body_force {
+            let i = mesh
+                .bodies
+                .iter()
+                .position(|b| b == &bf.body)
+                .ok_or_else(|| {
+                    err(format!(
+                        "[[body_force]] body '{}' does not exist (bodies: {})",
+                        bf.body,
+                        mesh.bodies.join(", ")
+                    ))
+                })?;
+            for (acc, v) in body_force[i].iter_mut().zip(bf.vector) {
+                *acc += v;
+            }
+        }
+        if self.steps.count == 0 {
+            return Err(err("[steps] count must be at least 1".into()));
+        }
+        let solver = self.solver_settings().map_err(&err)?;
+        Ok(Model {
+            name: self.title.clone().unwrap_or_else(|| origin.to_owned()),
+            mesh,
+            materials,
+            dirichlet,
+            facet_loads,
+            body_force,
+            body_force_fn: None,
+            steps: self.steps.count,
+            solver,
+        })
+    }
+
+    fn solver_settings(&self) -> std::result::Result<SolverSettings, String> {
+        let d = SolverSettings::default();
+        let s = &self.solver;
+        let positive = |v: f64, key: &str| {
+            if v > 0.0 && v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("[solver] {key} must be positive (got {v})"))
+            }
+        };
+        Ok(SolverSettings {
+            max_newton: s.max_newton.unwrap_or(d.max_newton).max(1),
+            rtol: positive(s.rtol.unwrap_or(d.rtol), "rtol")?,
+            atol: s.atol.map(|a| positive(a, "atol")).transpose()?,
+            max_cutbacks: s.max_cutbacks.unwrap_or(d.max_cutbacks),
+            petsc_options: s.petsc_options.clone().unwrap_or_default(),
+        })
+    }
+
+    fn build_mesh(&self) -> Result<Mesh> {
+        let mesh = match &self.mesh {
+            MeshSection::Box(b) => generate::graded_box(&BoxSpec {
+                body: b.body.clone(),
+                origin: b.origin,
+                size: b.size,
+                divisions: b.divisions,
+                grading: b.grading.map(Grading::from),
+                cell_type: b.cell_type.into(),
+            })?,
+            MeshSection::HertzCylinder(h) => {
+                let d = HertzCylinderSpec::default();
+                generate::hertz_cylinder(&HertzCylinderSpec {
+                    radius: h.radius.unwrap_or(d.radius),
+                    block_width: h.block_width.unwrap_or(d.block_width),
+                    block_height: h.block_height.unwrap_or(d.block_height),
+                    thickness: h.thickness.unwrap_or(d.thickness),
+                    gap: h.gap.unwrap_or(d.gap),
+                    fine_size: h.fine_size.unwrap_or(d.fine_size),
+                    fine_half_width: h.fine_half_width.unwrap_or(d.fine_half_width),
+                    growth: h.growth.unwrap_or(d.growth),
+                    level: h.level.unwrap_or(d.level),
+                    cell_type: h.cell_type.map(CellType::from).unwrap_or(d.cell_type),
+                })?
+            }
+            MeshSection::HertzSphere(h) => {
+                let d = HertzSphereSpec::default();
+                generate::hertz_sphere(&HertzSphereSpec {
+                    radius: h.radius.unwrap_or(d.radius),
+                    block_width: h.block_width.unwrap_or(d.block_width),
+                    block_height: h.block_height.unwrap_or(d.block_height),
+                    gap: h.gap.unwrap_or(d.gap),
+                    fine_size: h.fine_size.unwrap_or(d.fine_size),
+                    fine_half_width: h.fine_half_width.unwrap_or(d.fine_half_width),
+                    growth: h.growth.unwrap_or(d.growth),
+                    level: h.level.unwrap_or(d.level),
+                    cell_type: h.cell_type.map(CellType::from).unwrap_or(d.cell_type),
+                })?
+            }
+            MeshSection::StackedBlocks(s) => {
+                let d = StackedSpec::default();
+                generate::stacked_blocks(&StackedSpec {
+                    length: s.length.unwrap_or(d.length),
+                    height: s.height.unwrap_or(d.height),
+                    gap: s.gap.unwrap_or(d.gap),
+                    lower_divisions: s.lower_divisions.unwrap_or(d.lower_divisions),
+                    upper_divisions: s.upper_divisions.unwrap_or(d.upper_divisions),
+                    cell_type: s.cell_type.map(CellType::from).unwrap_or(d.cell_type),
+                    ..d
+                })?
+            }
+        };
+        Ok(mesh)
+    }
+}
+
+fn check_finite(v: f64, what: &str) -> std::result::Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{what} must be a finite number (got {v})"))
+    }
+}
+
+fn check_facet_set(mesh: &Mesh, set: &str, section: &str) -> std::result::Result<(), String> {
+    if mesh.facet_sets.contains_key(set) {
+        return Ok(());
+    }
+    let known: Vec<&str> = mesh.facet_sets.keys().map(String::as_str).collect();
+    Err(format!(
+        "{section} set '{set}' is not a facet set of the mesh (facet sets: {})",
+        known.join(", ")
+    ))
+}
+
+fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<DirichletSpec, String> {
+    let nodes = match mesh.node_sets.get(&d.set) {
+        Some(n) => n.clone(),
+        None => {
+            let known: Vec<&str> = mesh.node_sets.keys().map(String::as_str).collect();
+            return Err(format!(
+                "[[dirichlet]] set '{}' is not a node set of the mesh (node sets: {})",
+                d.set,
+                known.join(", ")
+            ));
+        }
+    };
+    let names = d
+        .components
+        .clone()
+        .unwrap_or_else(|| vec!["x".into(), "y".into(), "z".into()]);
+    let mut components = Vec::new();
+    for n in &names {
+        let c = match n.as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            other => {
+                return Err(format!(
+                    "[[dirichlet]] set '{}': component '{other}' is not one of x, y, z",
+                    d.set
+                ))
+            }
+        };
+        if components.contains(&c) {
+            return Err(format!(
+                "[[dirichlet]] set '{}': component '{n}' listed twice",
+                d.set
+            ));
+        }
+        components.push(c);
+    }
+    let values = d
+        .value
+        .clone()
+        .unwrap_or_else(|| vec![0.0; components.len()]);
+    if values.len() != components.len() {
+        return Err(format!(
+            "[[dirichlet]] set '{}': {} values for {} components ({})",
+            d.set,
+            values.len(),
+            components.len(),
+            names.join(", ")
+        ));
+    }
+    let mut full = [0.0; 3];
+    for (&c, &v) in components.iter().zip(&values) {
+        check_finite(v, "[[dirichlet]] value")?;
+        full[c] = v;
+    }
+    Ok(DirichletSpec::uniform(&d.set, nodes, components, full))
+}

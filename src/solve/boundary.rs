@@ -1,0 +1,127 @@
+//! Dirichlet conditions as this rank's constrained DOFs.
+use crate::dofs::{DofMap, NaturalNode, DIM};
+use crate::error::{Error, Result};
+use std::collections::BTreeMap;
+
+/// One Dirichlet condition: a node set, the components it fixes, and their
+/// displacement at full load (ramped with the load factor), per node.
+#[derive(Debug, Clone)]
+pub struct DirichletSpec {
+    pub set: String,
+    pub nodes: Vec<usize>,
+    pub components: Vec<usize>,
+    /// Full-load displacement of each node in `nodes` (only `components` used).
+    pub values: Vec<[f64; 3]>,
+}
+
+impl DirichletSpec {
+    /// The same displacement for every node of the set.
+    pub fn uniform(set: &str, nodes: Vec<usize>, components: Vec<usize>, value: [f64; 3]) -> Self {
+        let values = vec![value; nodes.len()];
+        DirichletSpec {
+            set: set.to_owned(),
+            nodes,
+            components,
+            values,
+        }
+    }
+}
+
+/// A constrained DOF this rank owns.
+#[derive(Debug, Clone, Copy)]
+pub struct ConstrainedDof {
+    /// Index into this rank's owned part of a PETSc vector.
+    pub owned_index: usize,
+    pub global: i32,
+    /// Displacement at load factor 1.
+    pub value: f64,
+}
+
+/// The owned constrained DOFs (sorted by owned index) and, for reporting, the
+/// set each belongs to.
+#[derive(Debug, Clone, Default)]
+pub struct Dirichlet {
+    pub dofs: Vec<ConstrainedDof>,
+    pub set_of_dof: Vec<u16>,
+    pub set_names: Vec<String>,
+}
+
+impl Dirichlet {
+    /// Collects the owned DOFs fixed by `specs`. Two conditions prescribing
+    /// different values on one DOF are an error naming both sets.
+    pub fn new(dofs: &DofMap, specs: &[DirichletSpec]) -> Result<Self> {
+        let mut by_index: BTreeMap<usize, (ConstrainedDof, u16)> = BTreeMap::new();
+        let start = dofs.owned_dof_start();
+        for (s, spec) in specs.iter().enumerate() {
+            for (&nat, node_value) in spec.nodes.iter().zip(&spec.values) {
+                let Some(l) = dofs.local(NaturalNode(nat)) else {
+                    continue;
+                };
+                if !dofs.is_owned(l) {
+                    continue;
+                }
+                for &c in &spec.components {
+                    let value = node_value[c];
+                    let g = dofs.dof(l, c);
+                    let owned_index = g.0 as usize - start;
+                    let entry = ConstrainedDof {
+                        owned_index,
+                        global: g.0,
+                        value,
+                    };
+                    if let Some((prev, ps)) = by_index.get(&owned_index) {
+                        if (prev.value - value).abs() > 1e-14 * (1.0 + value.abs()) {
+                            return Err(Error::scene(
+                                "dirichlet",
+                                format!(
+                                    "node {nat} component {} is prescribed {} by set '{}' and {} by set '{}'",
+                                    ["x", "y", "z"][c],
+                                    prev.value,
+                                    specs[*ps as usize].set,
+                                    value,
+                                    spec.set
+                                ),
+                            ));
+                        }
+                    }
+                    by_index.insert(owned_index, (entry, s as u16));
+                }
+            }
+        }
+        let (dofs_v, sets): (Vec<_>, Vec<_>) = by_index.into_values().unzip();
+        Ok(Dirichlet {
+            dofs: dofs_v,
+            set_of_dof: sets,
+            set_names: specs.iter().map(|s| s.set.clone()).collect(),
+        })
+    }
+
+    pub fn global_rows(&self) -> Vec<i32> {
+        self.dofs.iter().map(|d| d.global).collect()
+    }
+
+    /// Writes the prescribed values at load factor `factor` into owned entries.
+    pub fn apply(&self, owned: &mut [f64], factor: f64) {
+        for d in &self.dofs {
+            owned[d.owned_index] = factor * d.value;
+        }
+    }
+
+    /// Replaces constrained residual entries by x − ū(factor).
+    pub fn constrain_residual(&self, x: &[f64], r: &mut [f64], factor: f64) {
+        for d in &self.dofs {
+            r[d.owned_index] = x[d.owned_index] - factor * d.value;
+        }
+    }
+
+    /// Sum of the reaction force over each set's owned DOFs on this rank
+    /// (the caller reduces over ranks). `raw` is f_int − f_ext.
+    pub fn reaction_sums(&self, raw: &[f64], start_dof: usize) -> Vec<[f64; 3]> {
+        let mut sums = vec![[0.0; 3]; self.set_names.len()];
+        for (d, &s) in self.dofs.iter().zip(&self.set_of_dof) {
+            let c = (d.global as usize - start_dof) % DIM;
+            sums[s as usize][c] += raw[d.owned_index];
+        }
+        sums
+    }
+}

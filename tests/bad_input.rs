@@ -1,0 +1,165 @@
+//! Bad input gets a clear error naming the problem, a non-zero exit code, and
+//! no solve; never a panic.
+mod common;
+use common::*;
+
+const GOOD: &str = r#"
+[mesh]
+generator = "box"
+size = [1.0, 1.0, 1.0]
+divisions = [2, 2, 2]
+
+[[body]]
+name = "block"
+material = "linear-elastic"
+youngs = 100.0
+poisson = 0.3
+
+[[dirichlet]]
+set = "block.bottom"
+
+[[pressure]]
+set = "block.top"
+value = 1.0
+"#;
+
+fn check_fails(name: &str, scene: &str, expect: &[&str]) {
+    let dir = scratch(&format!("bad-{name}"));
+    let path = write(&dir, "scene.toml", scene);
+    let o = run(&["check", path.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{name}: accepted a bad scene:\n{t}");
+    assert!(!t.contains("panicked"), "{name}: panicked:\n{t}");
+    for e in expect {
+        assert!(
+            t.contains(e),
+            "{name}: message does not mention {e:?}:\n{t}"
+        );
+    }
+}
+
+#[test]
+fn good_scene_passes_check() {
+    let dir = scratch("good");
+    let path = write(&dir, "scene.toml", GOOD);
+    let o = run(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("DOFs 81"), "{}", text(&o));
+}
+
+#[test]
+fn unknown_key_is_named() {
+    check_fails(
+        "unknown-key",
+        &GOOD.replace("poisson = 0.3", "poisson = 0.3\nyoung = 5.0"),
+        &["young"],
+    );
+}
+
+#[test]
+fn missing_set_is_named() {
+    check_fails(
+        "missing-set",
+        &GOOD.replace("set = \"block.top\"", "set = \"block.roof\""),
+        &["block.roof", "block.top"],
+    );
+}
+
+#[test]
+fn negative_modulus_is_rejected() {
+    check_fails(
+        "negative-e",
+        &GOOD.replace("youngs = 100.0", "youngs = -5.0"),
+        &["block", "-5"],
+    );
+}
+
+#[test]
+fn poisson_out_of_range_is_rejected() {
+    check_fails(
+        "nu",
+        &GOOD.replace("poisson = 0.3", "poisson = 0.5"),
+        &["0.5"],
+    );
+}
+
+#[test]
+fn body_without_material_is_named() {
+    check_fails(
+        "no-body",
+        &GOOD.replace("name = \"block\"", "name = \"brick\""),
+        &["block"],
+    );
+}
+
+#[test]
+fn syntax_error_names_the_line() {
+    check_fails(
+        "syntax",
+        &GOOD.replace("divisions = [2, 2, 2]", "divisions = [2, 2,"),
+        &["line"],
+    );
+}
+
+#[test]
+fn bad_component_is_named() {
+    check_fails(
+        "component",
+        &GOOD.replace(
+            "set = \"block.bottom\"",
+            "set = \"block.bottom\"\ncomponents = [\"w\"]",
+        ),
+        &["'w'"],
+    );
+}
+
+#[test]
+fn unknown_scene_lists_builtins() {
+    let o = run(&["check", "no-such-scene"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("block-compress"), "{}", text(&o));
+}
+
+#[test]
+fn unwritable_output_fails_before_solving() {
+    let dir = scratch("unwritable");
+    let blocker = write(&dir, "file", "not a directory");
+    let out = blocker.join("out.h5");
+    let o = mpirun(2, &["run", "block-compress", "-o", out.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(
+        t.contains(out.to_str().unwrap()),
+        "error does not name the path:\n{t}"
+    );
+    assert!(!t.contains("step    1"), "solved before failing:\n{t}");
+}
+
+#[test]
+fn newton_failure_is_reported_after_cutbacks() {
+    // A pressure far beyond what the block can carry inverts elements at any
+    // step size the cutbacks reach: a clear error, non-zero exit, and a file
+    // that still holds the steps that converged.
+    let dir = scratch("diverge");
+    let scene = GOOD
+        .replace(
+            "material = \"linear-elastic\"",
+            "material = \"neo-hookean\"",
+        )
+        .replace("value = 1.0", "value = 1.0e6")
+        .replace(
+            "[[dirichlet]]\nset = \"block.bottom\"",
+            "[[dirichlet]]\nset = \"block.bottom\"\n[solver]\nmax_cutbacks = 2\nmax_newton = 8",
+        );
+    let path = write(&dir, "scene.toml", &scene);
+    let out = dir.join("out.h5");
+    let o = run(&["run", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("did not converge after 2 cutbacks"), "{t}");
+    assert!(!t.contains("panicked"), "{t}");
+    assert!(
+        contactlink::output::list_steps(&out).is_ok(),
+        "the output file is not readable"
+    );
+}
