@@ -20,7 +20,7 @@ build: deps
 
 demo: build
 	@mkdir -p out
-	$(MPIRUN) -n $(NP) target/release/contactlink run $(or $(SCENE),block-compress) -o out/demo.h5
+	$(MPIRUN) -n $(NP) target/release/contactlink run $(or $(SCENE),hertz-cylinder) -o out/demo.h5
 	@echo "demo: results in out/demo.h5 (open out/demo.xmf in ParaView; h5ls -r out/demo.h5 lists it)"
 
 # Every test: unit, verification and end-to-end (serial and mpirun -n 1/2/3),

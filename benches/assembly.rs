@@ -8,7 +8,7 @@ use contactlink::assembly::FacetLoad;
 use contactlink::dofs::{DofMap, DIM};
 use contactlink::fem::Material;
 use contactlink::mesh::generate::{self, BoxSpec};
-use contactlink::petsc::{GhostedVector, Matrix};
+use contactlink::petsc::{GhostedVector, PatternBuilder};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
 use contactlink::solve::{DirichletSpec, Model, SolverSettings};
@@ -63,6 +63,8 @@ fn model(n: usize) -> Model {
         facet_loads: vec![("block.top".into(), FacetLoad::Pressure(50.0))],
         body_force: vec![[0.0; 3]],
         body_force_fn: None,
+        contact: Vec::new(),
+        hertz: None,
         steps: 1,
         solver: SolverSettings::default(),
         mesh,
@@ -85,12 +87,11 @@ fn main() {
         let mut part =
             contactlink::partition::partition_cells(&m.mesh, rt.size()).expect("partition");
         rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
-        let dofs = DofMap::new(&m.mesh, &part, rt.rank(), rt.size());
+        let dofs = DofMap::new(&m.mesh, &part, rt.rank(), rt.size(), &[]);
         let bulk = BulkAssembler::new(&m.mesh, &dofs, m.materials.clone()).expect("bulk");
-        let pre = dofs.bulk_preallocation(&m.mesh, &[]);
-        let mut jac = Matrix::new_aij(dofs.num_owned_dofs(), &pre, DIM).expect("matrix");
-        bulk.add_pattern(&mut jac).expect("pattern");
-        jac.assemble().expect("assemble");
+        let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM).expect("pattern");
+        bulk.add_pattern(&mut pattern).expect("pattern");
+        let mut jac = pattern.build().expect("matrix");
         let mut r = GhostedVector::new(dofs.num_owned_dofs(), &dofs.ghost_dofs()).expect("vector");
         // A small non-zero state so the Neo-Hookean kernel does real work.
         let u: Vec<f64> = (0..DIM * dofs.num_local_nodes())

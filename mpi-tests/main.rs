@@ -136,7 +136,7 @@ fn partition_for(rt: &Runtime, mesh: &Mesh) -> Result<Vec<i32>, String> {
 fn halo_exchange_refreshes_ghosts(rt: &Runtime) -> Result<(), String> {
     let mesh = unit_box(6, Grading::Uniform)?;
     let part = partition_for(rt, &mesh)?;
-    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size());
+    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size(), &[]);
     let mut v =
         GhostedVector::new(dofs.num_owned_dofs(), &dofs.ghost_dofs()).map_err(|e| e.to_string())?;
     v.with_local_mut(|a| {
@@ -192,7 +192,7 @@ fn dof_numbering_is_a_permutation(rt: &Runtime) -> Result<(), String> {
         },
     )?;
     let part = partition_for(rt, &mesh)?;
-    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size());
+    let dofs = DofMap::new(&mesh, &part, rt.rank(), rt.size(), &[]);
     let n = mesh.num_nodes();
     let mut seen = vec![0i32; n];
     for nat in 0..n {
@@ -251,6 +251,8 @@ fn model_with(
         facet_loads: Vec::new(),
         body_force: vec![[0.0; 3]; bodies],
         body_force_fn: None,
+        contact: Vec::new(),
+        hertz: None,
         steps,
         solver: SolverSettings {
             rtol: 1e-12,

@@ -6,7 +6,7 @@
 //! - [`LocalNode`]: index into this rank's owned-then-ghost node arrays;
 //! - [`GlobalDof`]: PETSc row/column, 3·(PETSc node) + component, contiguous per rank.
 use crate::mesh::Mesh;
-use crate::petsc::{PetscInt, Preallocation};
+use crate::petsc::PetscInt;
 
 pub const DIM: usize = 3;
 
@@ -47,7 +47,16 @@ impl DofMap {
     /// A node belongs to the lowest rank among the cells that contain it, and
     /// PETSc numbers the nodes rank by rank, each rank's in natural order, so
     /// the numbering is the same whatever the process that computes it.
-    pub fn new(mesh: &Mesh, partition: &[i32], rank: usize, nranks: usize) -> Self {
+    ///
+    /// `extra_ghosts` are further nodes this rank must see (master contact
+    /// surfaces, whose current position every rank's search needs).
+    pub fn new(
+        mesh: &Mesh,
+        partition: &[i32],
+        rank: usize,
+        nranks: usize,
+        extra_ghosts: &[usize],
+    ) -> Self {
         let n = mesh.num_nodes();
         let node_owner = node_owners(mesh, partition);
         let mut count_per_rank = vec![0usize; nranks];
@@ -75,6 +84,7 @@ impl DofMap {
         let mut ghosts: Vec<usize> = local_cells
             .iter()
             .flat_map(|&c| mesh.cell(c).iter().copied())
+            .chain(extra_ghosts.iter().copied())
             .filter(|&v| node_owner[v] as usize != rank)
             .collect();
         ghosts.sort_unstable_by_key(|&v| petsc_node[v]);
@@ -165,53 +175,6 @@ impl DofMap {
     /// PETSc node number of a natural node.
     pub fn petsc_node(&self, nat: NaturalNode) -> usize {
         self.petsc_node[nat.0] as usize
-    }
-
-    /// Exact preallocation of the bulk stiffness for the owned rows: a row
-    /// couples to every node of every cell (on any rank) containing its node.
-    /// `extra` adds node couplings (owned natural node, any natural node) such as
-    /// contact links; both directions must be listed by the callers that own them.
-    pub fn bulk_preallocation(
-        &self,
-        mesh: &Mesh,
-        extra: &[(NaturalNode, NaturalNode)],
-    ) -> Preallocation {
-        let owned_range = self.owned_node_start..self.owned_node_start + self.n_owned;
-        let mut cols: Vec<Vec<u32>> = vec![Vec::new(); self.n_owned];
-        for c in 0..mesh.num_cells() {
-            let nodes = mesh.cell(c);
-            for &a in nodes {
-                let pa = self.petsc_node[a] as usize;
-                if owned_range.contains(&pa) {
-                    let row = &mut cols[pa - self.owned_node_start];
-                    row.extend(nodes.iter().map(|&b| self.petsc_node[b]));
-                }
-            }
-        }
-        for &(a, b) in extra {
-            let pa = self.petsc_node[a.0] as usize;
-            if owned_range.contains(&pa) {
-                cols[pa - self.owned_node_start].push(self.petsc_node[b.0]);
-            }
-        }
-        let mut pre = Preallocation {
-            diag: Vec::with_capacity(self.num_owned_dofs()),
-            offdiag: Vec::with_capacity(self.num_owned_dofs()),
-        };
-        for row in &mut cols {
-            row.sort_unstable();
-            row.dedup();
-            let diag = row
-                .iter()
-                .filter(|&&b| owned_range.contains(&(b as usize)))
-                .count();
-            let off = row.len() - diag;
-            for _ in 0..DIM {
-                pre.diag.push((DIM * diag) as PetscInt);
-                pre.offdiag.push((DIM * off) as PetscInt);
-            }
-        }
-        pre
     }
 
     /// The contiguous block of natural node ids this rank writes to the output

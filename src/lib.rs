@@ -13,6 +13,7 @@
 //! `pipeline` strings these together for one run; `petsc` and `runtime` are
 //! the only places that touch C libraries directly.
 pub mod assembly;
+pub mod contact;
 pub mod dofs;
 pub mod error;
 pub mod fem;
@@ -24,5 +25,6 @@ pub mod pipeline;
 pub mod runtime;
 pub mod scene;
 pub mod solve;
+pub mod verify;
 
 pub use error::{Error, Result};

@@ -190,6 +190,18 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         );
                     }
                 }
+                if let Some(h) = &summary.hertz {
+                    println!(
+                        "  Hertz: load {:.6e}; p0 computed {:.6e}, analytic {:.6e} ({:+.3} %); half-width/radius computed {:.6e}, analytic {:.6e} ({:+.3} %)",
+                        h.load,
+                        h.p0,
+                        h.p0_exact,
+                        100.0 * h.p0_error(),
+                        h.width,
+                        h.width_exact,
+                        100.0 * h.width_error()
+                    );
+                }
                 match &summary.output {
                     Some(p) => println!(
                         "output: {} (+ {})",

@@ -7,8 +7,9 @@ use crate::output::{BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
-use crate::solve::{Model, NaturalOrder, RunReport, Simulation, StepReport, StepSink};
-use mpi::traits::CommunicatorCollectives;
+use crate::solve::{Model, NaturalOrder, PairFields, RunReport, Simulation, StepReport, StepSink};
+use crate::verify::{HertzCheck, HertzComparison};
+use mpi::traits::{Communicator, CommunicatorCollectives};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -27,6 +28,8 @@ pub struct RunOptions {
 pub struct RunSummary {
     pub model_name: String,
     pub report: RunReport,
+    /// Hertz comparison at the last step, when the scene asks for one.
+    pub hertz: Option<HertzComparison>,
     pub output: Option<PathBuf>,
     pub cells: usize,
     pub nodes: usize,
@@ -66,6 +69,7 @@ pub fn run_model(
             model.steps
         );
     }
+    let mut hertz = HertzObserver::new(rt, model);
     let report = match output {
         Some(path) => {
             if rt.rank() == 0 {
@@ -77,37 +81,198 @@ pub fn run_model(
             }
             rt.world().barrier();
             let file = create_result_file(rt, &sim, path)?;
-            let mut sink = Hdf5Sink {
-                file,
-                natural: NaturalOrder::new(sim.dofs())?,
-                nodes: model.mesh.num_nodes(),
-            };
+            let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut hertz);
             sim.run(rt, &mut sink, echo)?
         }
-        None => sim.run(rt, &mut NoOutput, echo)?,
+        None => sim.run(rt, &mut hertz, echo)?,
     };
     Ok(RunSummary {
         model_name: model.name.clone(),
         report,
+        hertz: hertz.last,
         output: output.map(Path::to_path_buf),
         cells: model.mesh.num_cells(),
         nodes: model.mesh.num_nodes(),
     })
 }
 
-struct NoOutput;
+/// Two sinks in a row.
+struct Tee<'a, A: StepSink>(A, &'a mut dyn StepSink);
 
-impl StepSink for NoOutput {
-    fn step(&mut self, _: &StepReport, _: &Vector, _: &Vector) -> Result<()> {
+impl<A: StepSink> StepSink for Tee<'_, A> {
+    fn step(
+        &mut self,
+        report: &StepReport,
+        u: &Vector,
+        r: &Vector,
+        contact: &[PairFields],
+        nodal: &[f64],
+    ) -> Result<()> {
+        self.0.step(report, u, r, contact, nodal)?;
+        self.1.step(report, u, r, contact, nodal)
+    }
+}
+
+/// Compares the named pair against Hertz after every step (all ranks take
+/// part: the pair's points are gathered from every rank).
+struct HertzObserver {
+    world: mpi::topology::SimpleCommunicator,
+    check: Option<HertzCheck>,
+    last: Option<HertzComparison>,
+}
+
+impl HertzObserver {
+    fn new(rt: &Runtime, model: &Model) -> Self {
+        HertzObserver {
+            world: rt.world(),
+            check: model.hertz.clone(),
+            last: None,
+        }
+    }
+}
+
+impl StepSink for HertzObserver {
+    fn step(
+        &mut self,
+        report: &StepReport,
+        _: &Vector,
+        _: &Vector,
+        contact: &[PairFields],
+        _: &[f64],
+    ) -> Result<()> {
+        let Some(check) = &self.check else {
+            return Ok(());
+        };
+        let Some((i, fields)) = contact
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.pair.spec.name == check.pair)
+        else {
+            return Ok(());
+        };
+        // Nodal pressures: the point multipliers of an over-constrained slave
+        // surface are not unique, the nodal forces they add up to are.
+        let points: Vec<f64> = fields
+            .values
+            .nodes
+            .iter()
+            .flat_map(|(x, _)| x.iter().copied())
+            .collect();
+        let pressure: Vec<f64> = fields.values.nodes.iter().map(|(_, p)| *p).collect();
+        let points = gather_all(&self.world, &points);
+        let pressure = gather_all(&self.world, &pressure);
+        let points: Vec<[f64; 3]> = points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
+        self.last = crate::verify::compare(check, &points, &pressure, force);
         Ok(())
     }
 }
 
-/// Writes every converged step to the HDF5 file, in natural node order.
+/// Concatenates every rank's slice, in rank order, on every rank.
+fn gather_all(world: &mpi::topology::SimpleCommunicator, local: &[f64]) -> Vec<f64> {
+    use mpi::datatype::PartitionMut;
+    let n = local.len() as i32;
+    let mut counts = vec![0i32; world.size() as usize];
+    world.all_gather_into(&n, &mut counts[..]);
+    let displs: Vec<i32> = counts
+        .iter()
+        .scan(0, |acc, &c| {
+            let d = *acc;
+            *acc += c;
+            Some(d)
+        })
+        .collect();
+    let mut all = vec![0.0; counts.iter().sum::<i32>() as usize];
+    let mut partition = PartitionMut::new(&mut all[..], counts, displs);
+    world.all_gather_varcount_into(local, &mut partition);
+    all
+}
+
+/// Scatters of one contact pair's point arrays into output order.
+struct PairOrder {
+    scalar: NaturalOrder,
+    vector: NaturalOrder,
+    rows: usize,
+}
+
+/// Writes every converged step to the HDF5 file, in natural (input) order.
 struct Hdf5Sink {
     file: ResultFile,
     natural: NaturalOrder,
+    natural_scalar: NaturalOrder,
+    pairs: Vec<PairOrder>,
     nodes: usize,
+}
+
+impl Hdf5Sink {
+    fn new(file: ResultFile, sim: &Simulation) -> Result<Self> {
+        let dofs = sim.dofs();
+        let mut pairs = Vec::new();
+        for p in sim.contact() {
+            let nqp = p.slave.nqp;
+            let rows = p.slave.global_facets * nqp;
+            let petsc_row = |nat: usize| p.multipliers.petsc_point(nat / nqp, nat % nqp, nqp);
+            let owned = p.slave.num_qps();
+            pairs.push(PairOrder {
+                scalar: NaturalOrder::new(rows, 1, owned, petsc_row, dofs.rank, dofs.nranks)?,
+                vector: NaturalOrder::new(rows, 3, owned, petsc_row, dofs.rank, dofs.nranks)?,
+                rows,
+            });
+        }
+        Ok(Hdf5Sink {
+            file,
+            natural: NaturalOrder::nodal(dofs)?,
+            natural_scalar: NaturalOrder::nodal_scalar(dofs)?,
+            pairs,
+            nodes: sim.model().mesh.num_nodes(),
+        })
+    }
+
+    fn write_pair(
+        &mut self,
+        step: usize,
+        i: usize,
+        fields: &PairFields,
+        report: &StepReport,
+    ) -> Result<()> {
+        let name = &fields.pair.spec.name;
+        let order = &mut self.pairs[i];
+        let v = &fields.values;
+        let points: Vec<f64> = v.points.iter().flatten().copied().collect();
+        let (start, data) = order.vector.block_of_owned(&points)?;
+        let rows = order.rows;
+        self.file.write_step_block(
+            step,
+            &format!("contact/{name}/points"),
+            BlockRows {
+                global_rows: rows,
+                start,
+                cols: 3,
+                data: &data,
+            },
+        )?;
+        for (label, values) in [
+            ("pressure", &v.pressure),
+            ("gap", &v.gap),
+            ("lambda_n", &v.lambda),
+        ] {
+            let (start, data) = order.scalar.block_of_owned(values)?;
+            self.file.write_step_block(
+                step,
+                &format!("contact/{name}/{label}"),
+                BlockRows {
+                    global_rows: rows,
+                    start,
+                    cols: 1,
+                    data: &data,
+                },
+            )?;
+        }
+        let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
+        self.file
+            .write_step_small(step, &format!("contact/{name}/force"), &force)?;
+        Ok(())
+    }
 }
 
 impl StepSink for Hdf5Sink {
@@ -116,6 +281,8 @@ impl StepSink for Hdf5Sink {
         report: &StepReport,
         displacement: &Vector,
         reaction: &Vector,
+        contact: &[PairFields],
+        nodal_pressure: &[f64],
     ) -> Result<()> {
         let (start, u) = self.natural.block_of(displacement)?;
         let (_, r) = self.natural.block_of(reaction)?;
@@ -124,7 +291,7 @@ impl StepSink for Hdf5Sink {
             time: report.load_factor,
             load_factor: report.load_factor,
             newton_iterations: report.newton_iterations,
-            uzawa_iterations: 0,
+            uzawa_iterations: report.uzawa_iterations,
             converged: true,
             wall_seconds: report.wall_seconds,
         };
@@ -140,8 +307,31 @@ impl StepSink for Hdf5Sink {
             cols: 3,
             data: &r,
         };
-        self.file
-            .write_step(&info, &[("displacement", ub), ("reaction", rb)], &[])?;
+        if contact.is_empty() {
+            self.file
+                .write_step(&info, &[("displacement", ub), ("reaction", rb)], &[])?;
+            return Ok(());
+        }
+        let (pstart, p) = self.natural_scalar.block_of_owned(nodal_pressure)?;
+        let pb = BlockRows {
+            global_rows: self.nodes,
+            start: pstart,
+            cols: 1,
+            data: &p,
+        };
+        self.file.write_step(
+            &info,
+            &[
+                ("displacement", ub),
+                ("reaction", rb),
+                ("contact_pressure", pb),
+            ],
+            &[],
+        )?;
+        for (i, fields) in contact.iter().enumerate() {
+            self.write_pair(report.index, i, fields, report)?;
+        }
+        self.file.flush()?;
         Ok(())
     }
 }

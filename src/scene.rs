@@ -5,6 +5,7 @@
 //! output path. Built-in scenes live in `scenes/` and are compiled in.
 //! Every error names the key (and, for syntax errors, the line).
 use crate::assembly::FacetLoad;
+use crate::contact::{MasterSpec, PairSpec, SlaveQuadrature};
 use crate::error::{Error, Result};
 use crate::fem::{CellType, Material};
 use crate::mesh::generate::{
@@ -12,11 +13,32 @@ use crate::mesh::generate::{
 };
 use crate::mesh::Mesh;
 use crate::solve::{DirichletSpec, Model, SolverSettings};
+use crate::verify::{HertzCheck, HertzKind};
 use serde::Deserialize;
 use std::path::Path;
 
 /// The scenes compiled into the binary: (name, one-line description, TOML).
 pub const BUILTIN: &[(&str, &str, &str)] = &[
+    (
+        "hertz-cylinder",
+        "Hertz line contact: half-cylinder on a block, plane strain, frictionless",
+        include_str!("../scenes/hertz-cylinder.toml"),
+    ),
+    (
+        "hertz-sphere",
+        "Hertz point contact: sphere cap on a block, frictionless",
+        include_str!("../scenes/hertz-sphere.toml"),
+    ),
+    (
+        "patch-test",
+        "Contact patch test: stacked blocks with non-matching meshes, uniform compression",
+        include_str!("../scenes/patch-test.toml"),
+    ),
+    (
+        "block-on-plane",
+        "Neo-Hookean block pressed onto a rigid plane (rigid analytic master)",
+        include_str!("../scenes/block-on-plane.toml"),
+    ),
     (
         "block-compress",
         "Neo-Hookean block compressed 20 % by a follower pressure (finite strain)",
@@ -49,6 +71,9 @@ pub struct Scene {
     pub traction: Vec<TractionSection>,
     #[serde(default)]
     pub body_force: Vec<BodyForceSection>,
+    #[serde(default)]
+    pub contact: Vec<ContactSection>,
+    pub hertz: Option<HertzSection>,
     #[serde(default)]
     pub steps: StepsSection,
     #[serde(default)]
@@ -214,6 +239,55 @@ pub struct BodyForceSection {
     pub vector: [f64; 3],
 }
 
+/// Compare a pair against Hertz (printed after the run).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzSection {
+    /// "line" (cylinder, plane strain) or "point" (sphere).
+    pub kind: String,
+    pub pair: String,
+    pub radius: f64,
+    /// Out-of-plane thickness of a line contact model.
+    pub thickness: Option<f64>,
+}
+
+/// A contact pair: `slave` and `master` facet sets, or `slave` and a `rigid` surface.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSection {
+    pub name: Option<String>,
+    pub slave: String,
+    pub master: Option<String>,
+    pub rigid: Option<RigidSection>,
+    /// Translation of the rigid surface at full load.
+    pub motion: Option<[f64; 3]>,
+    pub penalty: Option<f64>,
+    pub penetration_tol: Option<f64>,
+    pub multiplier_tol: Option<f64>,
+    pub max_uzawa: Option<usize>,
+    pub search_distance: Option<f64>,
+    /// "gauss" (default) or "nodal": where the slave links sit.
+    pub quadrature: Option<String>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum RigidSection {
+    Plane {
+        point: [f64; 3],
+        normal: [f64; 3],
+    },
+    Sphere {
+        centre: [f64; 3],
+        radius: f64,
+    },
+    Cylinder {
+        point: [f64; 3],
+        axis: [f64; 3],
+        radius: f64,
+    },
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StepsSection {
@@ -238,6 +312,8 @@ pub struct SolverSection {
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
     pub max_cutbacks: Option<usize>,
+    /// Up to this many DOFs the default linear solver is direct (MUMPS).
+    pub direct_max_dofs: Option<usize>,
     pub petsc_options: Option<String>,
 }
 
@@ -302,29 +378,50 @@ fn apply_override(doc: &mut toml::Table, assignment: &str) -> std::result::Resul
         .split_once('=')
         .ok_or("expected key.path=value")?;
     let parsed: toml::Value = toml::from_str::<toml::Table>(&format!("v = {value}"))
-        .map(|mut t| {
-            t.remove("v")
-                .unwrap_or(toml::Value::String(value.to_owned()))
-        })
-        .unwrap_or_else(|_| toml::Value::String(value.to_owned()));
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(value.to_owned()));
     let keys: Vec<&str> = path.trim().split('.').collect();
-    let (last, parents) = keys.split_last().ok_or("empty key")?;
-    let mut table = doc;
-    for k in parents {
-        let entry = table
-            .entry((*k).to_owned())
+    let mut node = doc;
+    let mut i = 0;
+    while i < keys.len() {
+        let k = keys[i];
+        if i + 1 == keys.len() {
+            node.insert(k.to_owned(), parsed);
+            return Ok(());
+        }
+        let entry = node
+            .entry(k.to_owned())
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        table = match entry {
+        i += 1;
+        node = match entry {
             toml::Value::Table(t) => t,
-            toml::Value::Array(a) if a.len() == 1 => match &mut a[0] {
-                toml::Value::Table(t) => t,
-                _ => return Err(format!("'{k}' is not a table")),
-            },
+            // An array of tables ([[contact]]): the only one, or the one the
+            // next key names by index (dirichlet.2.value).
+            toml::Value::Array(a) => {
+                let index = match keys[i].parse::<usize>() {
+                    Ok(n) if i + 1 < keys.len() => {
+                        i += 1;
+                        n
+                    }
+                    _ if a.len() == 1 => 0,
+                    _ => {
+                        return Err(format!(
+                            "'{k}' has {} entries: name one as {k}.N.key (N from 0)",
+                            a.len()
+                        ))
+                    }
+                };
+                let len = a.len();
+                match a.get_mut(index) {
+                    Some(toml::Value::Table(t)) => t,
+                    _ => return Err(format!("'{k}' has no table entry {index} (it has {len})")),
+                }
+            }
             _ => return Err(format!("'{k}' is not a table")),
         };
     }
-    table.insert((*last).to_owned(), parsed);
-    Ok(())
+    Err("empty key".into())
 }
 
 impl Scene {
@@ -408,6 +505,21 @@ impl Scene {
                 *acc += v;
             }
         }
+        let contact = self
+            .contact
+            .iter()
+            .enumerate()
+            .map(|(i, c)| contact_spec(&mesh, c, i).map_err(&err))
+            .collect::<Result<Vec<_>>>()?;
+        let mut names: Vec<&str> = contact.iter().map(|c| c.name.as_str()).collect();
+        names.sort_unstable();
+        if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+            return Err(err(format!("two [[contact]] pairs are named '{}'", w[0])));
+        }
+        let hertz = match &self.hertz {
+            Some(h) => Some(hertz_check(&mesh, &materials, &contact, h).map_err(&err)?),
+            None => None,
+        };
         if self.steps.count == 0 {
             return Err(err("[steps] count must be at least 1".into()));
         }
@@ -420,6 +532,8 @@ impl Scene {
             facet_loads,
             body_force,
             body_force_fn: None,
+            contact,
+            hertz,
             steps: self.steps.count,
             solver,
         })
@@ -440,6 +554,7 @@ impl Scene {
             rtol: positive(s.rtol.unwrap_or(d.rtol), "rtol")?,
             atol: s.atol.map(|a| positive(a, "atol")).transpose()?,
             max_cutbacks: s.max_cutbacks.unwrap_or(d.max_cutbacks),
+            direct_max_dofs: s.direct_max_dofs.unwrap_or(d.direct_max_dofs),
             petsc_options: s.petsc_options.clone().unwrap_or_default(),
         })
     }
@@ -575,4 +690,165 @@ fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<Diri
         full[c] = v;
     }
     Ok(DirichletSpec::uniform(&d.set, nodes, components, full))
+}
+
+fn contact_spec(
+    mesh: &Mesh,
+    c: &ContactSection,
+    index: usize,
+) -> std::result::Result<PairSpec, String> {
+    let name = c.name.clone().unwrap_or_else(|| format!("pair{index}"));
+    let at = format!("[[contact]] '{name}'");
+    check_facet_set(mesh, &c.slave, &format!("{at} slave"))?;
+    let master = match (&c.master, &c.rigid) {
+        (Some(m), None) => {
+            check_facet_set(mesh, m, &format!("{at} master"))?;
+            if m == &c.slave {
+                return Err(format!("{at}: slave and master are the same facet set '{m}'; a surface cannot contact itself here"));
+            }
+            MasterSpec::Surface { set: m.clone() }
+        }
+        (None, Some(r)) => rigid_spec(r, &at)?,
+        (Some(_), Some(_)) => {
+            return Err(format!(
+                "{at}: give either master (a facet set) or rigid (an analytic surface), not both"
+            ))
+        }
+        (None, None) => return Err(format!("{at}: needs a master facet set or a rigid surface")),
+    };
+    if c.motion.is_some() && !master.is_rigid() {
+        return Err(format!("{at}: motion applies to rigid masters only; move a deformable master with [[dirichlet]] values"));
+    }
+    let mut spec = PairSpec::new(&name, &c.slave, master);
+    spec.motion = c.motion.unwrap_or([0.0; 3]);
+    spec.quadrature = match c.quadrature.as_deref() {
+        None | Some("gauss") => SlaveQuadrature::Gauss,
+        Some("nodal") => SlaveQuadrature::Nodal,
+        Some("centroid") => SlaveQuadrature::Centroid,
+        Some(other) => {
+            return Err(format!(
+                "{at}: quadrature '{other}' is not \"nodal\" or \"gauss\""
+            ))
+        }
+    };
+    let positive = |v: f64, key: &str| {
+        if v > 0.0 && v.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!("{at}: {key} must be positive (got {v})"))
+        }
+    };
+    spec.penalty = c.penalty.map(|p| positive(p, "penalty")).transpose()?;
+    spec.penetration_tol = positive(
+        c.penetration_tol.unwrap_or(spec.penetration_tol),
+        "penetration_tol",
+    )?;
+    spec.multiplier_tol = positive(
+        c.multiplier_tol.unwrap_or(spec.multiplier_tol),
+        "multiplier_tol",
+    )?;
+    spec.search_distance = c
+        .search_distance
+        .map(|d| positive(d, "search_distance"))
+        .transpose()?;
+    spec.max_uzawa = c.max_uzawa.unwrap_or(spec.max_uzawa);
+    if spec.max_uzawa == 0 {
+        return Err(format!("{at}: max_uzawa must be at least 1"));
+    }
+    Ok(spec)
+}
+
+fn rigid_spec(r: &RigidSection, at: &str) -> std::result::Result<MasterSpec, String> {
+    let nonzero = |v: [f64; 3], key: &str| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if n > 0.0 && n.is_finite() {
+            Ok(v)
+        } else {
+            Err(format!("{at}: rigid {key} must be a non-zero vector"))
+        }
+    };
+    Ok(match *r {
+        RigidSection::Plane { point, normal } => MasterSpec::Plane {
+            point,
+            normal: nonzero(normal, "normal")?,
+        },
+        RigidSection::Sphere { centre, radius } => {
+            if radius.is_nan() || radius <= 0.0 {
+                return Err(format!(
+                    "{at}: rigid sphere radius must be positive (got {radius})"
+                ));
+            }
+            MasterSpec::Sphere { centre, radius }
+        }
+        RigidSection::Cylinder {
+            point,
+            axis,
+            radius,
+        } => {
+            if radius.is_nan() || radius <= 0.0 {
+                return Err(format!(
+                    "{at}: rigid cylinder radius must be positive (got {radius})"
+                ));
+            }
+            MasterSpec::Cylinder {
+                point,
+                axis: nonzero(axis, "axis")?,
+                radius,
+            }
+        }
+    })
+}
+
+/// The body a facet set lies on (its first facet's cell).
+fn body_of_set(mesh: &Mesh, set: &str) -> Option<usize> {
+    mesh.facet_sets
+        .get(set)?
+        .first()
+        .map(|f| mesh.cell_body[f.cell] as usize)
+}
+
+fn hertz_check(
+    mesh: &Mesh,
+    materials: &[Material],
+    pairs: &[PairSpec],
+    h: &HertzSection,
+) -> std::result::Result<HertzCheck, String> {
+    let pair = pairs
+        .iter()
+        .find(|p| p.name == h.pair)
+        .ok_or_else(|| format!("[hertz] pair '{}' is not a [[contact]] name", h.pair))?;
+    if h.radius.is_nan() || h.radius <= 0.0 {
+        return Err(format!(
+            "[hertz] radius must be positive (got {})",
+            h.radius
+        ));
+    }
+    let kind = match (h.kind.as_str(), h.thickness) {
+        ("line", Some(t)) if t > 0.0 => HertzKind::Line { thickness: t },
+        ("line", _) => return Err("[hertz] kind = \"line\" needs a positive thickness".into()),
+        ("point", None) => HertzKind::Point,
+        ("point", Some(_)) => {
+            return Err("[hertz] thickness applies to kind = \"line\" only".into())
+        }
+        (other, _) => {
+            return Err(format!(
+                "[hertz] kind '{other}' is not \"line\" or \"point\""
+            ))
+        }
+    };
+    let slave = body_of_set(mesh, &pair.slave).ok_or("[hertz] the pair's slave set is empty")?;
+    let (e1, nu1) = (materials[slave].youngs(), materials[slave].poisson());
+    let inverse_master = match &pair.master {
+        MasterSpec::Surface { set } => {
+            let m = body_of_set(mesh, set).ok_or("[hertz] the pair's master set is empty")?;
+            (1.0 - materials[m].poisson().powi(2)) / materials[m].youngs()
+        }
+        _ => 0.0,
+    };
+    Ok(HertzCheck {
+        kind,
+        pair: h.pair.clone(),
+        radius: h.radius,
+        effective_modulus: 1.0 / ((1.0 - nu1 * nu1) / e1 + inverse_master),
+    })
 }

@@ -4,7 +4,7 @@ use crate::dofs::DofMap;
 use crate::error::{Error, Result};
 use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
 use crate::mesh::Mesh;
-use crate::petsc::{Matrix, PetscInt};
+use crate::petsc::{Matrix, PatternBuilder, PetscInt};
 
 /// Everything a rank needs to evaluate its cells, computed once: reference
 /// geometry (shape gradients at the quadrature points), materials and DOFs.
@@ -130,14 +130,10 @@ impl BulkAssembler {
         Ok(())
     }
 
-    /// Inserts explicit zeros at every entry a cell couples, fixing the matrix's
-    /// non-zero pattern once (values are added later with the same pattern).
-    pub fn add_pattern(&self, k: &mut Matrix) -> Result<()> {
-        let n = 3 * self.npc();
-        let zeros = vec![0.0; n * n];
+    /// Records the entries every local cell couples.
+    pub fn add_pattern(&self, pattern: &mut PatternBuilder) -> Result<()> {
         for i in 0..self.geometry.len() {
-            let d = self.dofs(i);
-            k.add_block(d, d, &zeros)?;
+            pattern.add_square(self.dofs(i))?;
         }
         Ok(())
     }

@@ -4,7 +4,7 @@ use crate::dofs::{DofMap, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
 use crate::mesh::{FacetRef, Mesh};
-use crate::petsc::{Matrix, PetscInt};
+use crate::petsc::{Matrix, PatternBuilder, PetscInt};
 
 /// One load on a facet set, at full load factor.
 #[derive(Debug, Clone)]
@@ -120,16 +120,14 @@ impl SurfaceLoads {
         Ok(())
     }
 
-    /// Inserts explicit zeros where follower loads couple DOFs (see
-    /// `BulkAssembler::add_pattern`).
-    pub fn add_pattern(&self, k: &mut Matrix) -> Result<()> {
+    /// Records the entries follower loads couple.
+    pub fn add_pattern(&self, pattern: &mut PatternBuilder) -> Result<()> {
         for facet in self
             .facets
             .iter()
             .filter(|f| matches!(f.load, FacetLoad::Pressure(_)))
         {
-            let zeros = vec![0.0; facet.dofs.len() * facet.dofs.len()];
-            k.add_block(&facet.dofs, &facet.dofs, &zeros)?;
+            pattern.add_square(&facet.dofs)?;
         }
         Ok(())
     }

@@ -196,6 +196,27 @@ impl QuadRule {
         }
     }
 
+    /// Nodal (Lobatto / vertex) rule on a facet: the points are the facet's
+    /// nodes, exact for linear integrands. Contact uses it to put one
+    /// constraint at each slave node instead of several per facet.
+    pub fn nodal_for_facet(facet: FacetType) -> Self {
+        match facet {
+            FacetType::Quad4 => Self {
+                points: vec![
+                    [-1.0, -1.0, 0.0],
+                    [1.0, -1.0, 0.0],
+                    [1.0, 1.0, 0.0],
+                    [-1.0, 1.0, 0.0],
+                ],
+                weights: vec![1.0; 4],
+            },
+            FacetType::Tri3 => Self {
+                points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                weights: vec![1.0 / 6.0; 3],
+            },
+        }
+    }
+
     fn with_capacity(n: usize) -> Self {
         Self {
             points: Vec::with_capacity(n),

@@ -1,30 +1,30 @@
 //! Distributed sparse matrices (MPIAIJ) with exact preallocation.
 use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result, Vector};
 
-/// Per owned row: how many non-zeros fall in the diagonal block (columns this
-/// rank owns) and in the off-diagonal block.
-#[derive(Debug, Clone, Default)]
-pub struct Preallocation {
-    pub diag: Vec<PetscInt>,
-    pub offdiag: Vec<PetscInt>,
+/// Anything dense element blocks can be added to: a matrix, or a pattern
+/// builder that only records where the non-zeros are.
+pub trait BlockSink {
+    /// Adds a dense row-major block at global (rows, cols).
+    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()>;
 }
 
-pub struct Matrix {
+/// Records the non-zero pattern of a matrix, including entries in rows other
+/// ranks own, and then creates the matrix exactly preallocated for it
+/// (PETSc's MATPREALLOCATOR: the off-rank bookkeeping is PETSc's).
+pub struct PatternBuilder {
     raw: sys::Mat,
-    owned: bool,
+    local_rows: usize,
+    block_size: usize,
+    zeros: Vec<f64>,
 }
 
-impl Matrix {
-    /// A square AIJ matrix with `local_rows` owned rows, preallocated exactly;
-    /// inserting outside the preallocated pattern is an error, not a silent slowdown.
-    pub fn new_aij(local_rows: usize, prealloc: &Preallocation, block_size: usize) -> Result<Self> {
+impl PatternBuilder {
+    pub fn new(local_rows: usize, block_size: usize) -> Result<Self> {
         let n = to_petsc_int(local_rows)?;
         let mut raw: sys::Mat = std::ptr::null_mut();
-        // SAFETY: the nnz slices have `local_rows` entries each (asserted), PETSc
-        // copies them; out-pointer valid.
+        // SAFETY: PETSc is initialised; out-pointer valid; the matrix is destroyed
+        // in Drop.
         unsafe {
-            assert_eq!(prealloc.diag.len(), local_rows);
-            assert_eq!(prealloc.offdiag.len(), local_rows);
             petsc_call!(MatCreate(comm_world(), &mut raw))?;
             petsc_call!(MatSetSizes(
                 raw,
@@ -34,32 +34,112 @@ impl Matrix {
                 sys::PETSC_DETERMINE
             ))?;
             petsc_call!(MatSetBlockSize(raw, to_petsc_int(block_size)?))?;
-            petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
-            petsc_call!(MatSeqAIJSetPreallocation(raw, 0, prealloc.diag.as_ptr()))?;
-            petsc_call!(MatMPIAIJSetPreallocation(
-                raw,
-                0,
-                prealloc.diag.as_ptr(),
-                0,
-                prealloc.offdiag.as_ptr()
+            petsc_call!(MatSetType(raw, c"preallocator".as_ptr()))?;
+            petsc_call!(MatSetUp(raw))?;
+        }
+        Ok(PatternBuilder {
+            raw,
+            local_rows,
+            block_size,
+            zeros: Vec::new(),
+        })
+    }
+
+    /// Records the couplings of `dofs` with themselves (a square element block).
+    pub fn add_square(&mut self, dofs: &[PetscInt]) -> Result<()> {
+        let n = dofs.len() * dofs.len();
+        if self.zeros.len() < n {
+            self.zeros.resize(n, 0.0);
+        }
+        let zeros = std::mem::take(&mut self.zeros);
+        let r = self.add_block(dofs, dofs, &zeros[..n]);
+        self.zeros = zeros;
+        r
+    }
+
+    /// Creates the AIJ matrix with this pattern, filled with explicit zeros so
+    /// the pattern is fixed from the start. Collective.
+    pub fn build(self) -> Result<Matrix> {
+        let n = to_petsc_int(self.local_rows)?;
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: the preallocator is assembled before use; the new matrix has the
+        // same sizes; out-pointer valid.
+        unsafe {
+            petsc_call!(MatAssemblyBegin(
+                self.raw,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
             ))?;
+            petsc_call!(MatAssemblyEnd(
+                self.raw,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+            ))?;
+            petsc_call!(MatCreate(comm_world(), &mut raw))?;
+            let m = Matrix { raw, owned: true };
+            petsc_call!(MatSetSizes(
+                raw,
+                n,
+                n,
+                sys::PETSC_DETERMINE,
+                sys::PETSC_DETERMINE
+            ))?;
+            petsc_call!(MatSetBlockSize(raw, to_petsc_int(self.block_size)?))?;
+            petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
+            petsc_call!(MatPreallocatorPreallocate(
+                self.raw,
+                sys::PetscBool_PETSC_TRUE,
+                raw
+            ))?;
+            // Inserting outside the recorded pattern is a bug, not a slowdown.
             petsc_call!(MatSetOption(
                 raw,
                 sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
                 sys::PetscBool_PETSC_TRUE
             ))?;
-            // Zeroed rows (Dirichlet) keep their entries, so the pattern, and
-            // the preconditioner's symbolic set-up, survive from one Newton
-            // iteration to the next.
+            // Zeroed rows (Dirichlet) keep their entries, so the pattern, and the
+            // preconditioner's symbolic set-up, survive across Newton iterations.
             petsc_call!(MatSetOption(
                 raw,
                 sys::MatOption_MAT_KEEP_NONZERO_PATTERN,
                 sys::PetscBool_PETSC_TRUE
             ))?;
+            Ok(m)
         }
-        Ok(Matrix { raw, owned: true })
     }
+}
 
+impl BlockSink for PatternBuilder {
+    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
+        // SAFETY: values has rows*cols entries (caller's contract, checked in debug).
+        debug_assert_eq!(rows.len() * cols.len(), values.len());
+        unsafe {
+            petsc_call!(MatSetValues(
+                self.raw,
+                rows.len() as PetscInt,
+                rows.as_ptr(),
+                cols.len() as PetscInt,
+                cols.as_ptr(),
+                values.as_ptr(),
+                sys::InsertMode_INSERT_VALUES
+            ))
+        }
+    }
+}
+
+impl Drop for PatternBuilder {
+    fn drop(&mut self) {
+        // SAFETY: owned and destroyed once.
+        unsafe {
+            sys::MatDestroy(&mut self.raw);
+        }
+    }
+}
+
+pub struct Matrix {
+    raw: sys::Mat,
+    owned: bool,
+}
+
+impl Matrix {
     /// # Safety
     /// `raw` must be valid for the lifetime of the returned value.
     pub(crate) unsafe fn borrowed(raw: sys::Mat) -> Self {
@@ -185,6 +265,12 @@ impl Matrix {
             ))?
         };
         Ok(info.nz_used)
+    }
+}
+
+impl BlockSink for Matrix {
+    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
+        Matrix::add_block(self, rows, cols, values)
     }
 }
 

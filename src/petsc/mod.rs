@@ -10,7 +10,7 @@ pub mod sys;
 pub mod vector;
 
 pub use log::LogStage;
-pub use matrix::{Matrix, Preallocation};
+pub use matrix::{BlockSink, Matrix, PatternBuilder};
 pub use scatter::Scatter;
 pub use snes::{NonlinearProblem, Snes, SnesOutcome};
 pub use vector::{GhostedVector, Vector};

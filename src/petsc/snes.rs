@@ -70,6 +70,20 @@ impl Snes {
         }
     }
 
+    /// How often the preconditioner is rebuilt within this and later solves:
+    /// 1 every Newton iteration, -1 never (reuse the last one). The Jacobian
+    /// itself is still evaluated every iteration.
+    pub fn set_lag_preconditioner(&mut self, lag: i32) -> Result<()> {
+        // SAFETY: valid snes.
+        unsafe {
+            petsc_call!(SNESSetLagPreconditionerPersists(
+                self.raw,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+            petsc_call!(SNESSetLagPreconditioner(self.raw, lag))
+        }
+    }
+
     /// Applies the options database (after the program's defaults are set).
     pub fn set_from_options(&mut self) -> Result<()> {
         // SAFETY: valid snes.

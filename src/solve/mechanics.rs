@@ -1,18 +1,22 @@
-//! The discrete equilibrium R(u) = f_int(u) − f_ext(u) = 0 that SNES solves at
-//! one load factor, with Dirichlet rows replaced by u − ū.
+//! The discrete equilibrium R(u) = f_int(u) − f_ext(u) + r_contact(u; λ) = 0
+//! that SNES solves at one load factor with the contact multipliers λ fixed,
+//! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
+use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::petsc::snes::CallbackError;
-use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Preallocation, Vector};
+use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, PatternBuilder, Vector};
 
 /// Everything the residual and Jacobian need, plus the work vectors that hold
 /// the ghosted state between callbacks.
 pub struct Mechanics<'a> {
+    pub dofs: &'a DofMap,
     pub bulk: &'a BulkAssembler,
     pub loads: &'a SurfaceLoads,
     pub dirichlet: &'a Dirichlet,
+    pub contact: &'a mut [ContactPair],
     /// Constant body force per body (per unit reference volume) at full load.
     pub body_force: Vec<[f64; 3]>,
     /// A fixed external force (local form) at full load, e.g. a manufactured
@@ -32,21 +36,23 @@ pub struct Mechanics<'a> {
 
 impl<'a> Mechanics<'a> {
     pub fn new(
-        dofs: &DofMap,
+        dofs: &'a DofMap,
         bulk: &'a BulkAssembler,
         loads: &'a SurfaceLoads,
         dirichlet: &'a Dirichlet,
+        contact: &'a mut [ContactPair],
         body_force: Vec<[f64; 3]>,
-        prealloc: &Preallocation,
     ) -> Result<Self> {
         let ghosts = dofs.ghost_dofs();
         let u = GhostedVector::new(dofs.num_owned_dofs(), &ghosts)?;
         let r = GhostedVector::new(dofs.num_owned_dofs(), &ghosts)?;
         let work = u.global().duplicate()?;
         let mut me = Mechanics {
+            dofs,
             bulk,
             loads,
             dirichlet,
+            contact,
             body_force,
             fixed_external: None,
             factor: 0.0,
@@ -59,8 +65,10 @@ impl<'a> Mechanics<'a> {
             bulk_tangent_assemblies: 0,
         };
         if bulk.is_linear() {
-            let mut k = Matrix::new_aij(dofs.num_owned_dofs(), prealloc, DIM)?;
-            let zero = vec![0.0; me.u.with_local(|l| l.len())?];
+            let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
+            bulk.add_pattern(&mut pattern)?;
+            let mut k = pattern.build()?;
+            let zero = vec![0.0; DIM * dofs.num_local_nodes()];
             bulk.add_tangent(&zero, &mut k)?;
             k.assemble()?;
             me.bulk_tangent_assemblies += 1;
@@ -75,22 +83,39 @@ impl<'a> Mechanics<'a> {
         Ok(())
     }
 
-    /// f_int − f_ext at `x`, without the Dirichlet replacement (its constrained
-    /// entries are the reactions).
+    /// Runs `f` on the ghosted local form of `x` (owned + ghost displacements)
+    /// and the contact pairs: searches, Uzawa updates and output use it.
+    pub fn with_state<T>(
+        &mut self,
+        x: &Vector,
+        f: impl FnOnce(&[f64], &mut [ContactPair]) -> Result<T>,
+    ) -> Result<T> {
+        self.load_state(x)?;
+        let contact = &mut *self.contact;
+        self.u.with_local(|u| f(u, contact))?
+    }
+
+    /// f_int − f_ext + r_contact at `x`, without the Dirichlet replacement
+    /// (its constrained entries are the reactions).
     pub fn raw_residual(&mut self, x: &Vector, out: &mut Vector) -> Result<()> {
         self.load_state(x)?;
-        let (bulk, loads, factor) = (self.bulk, self.loads, self.factor);
+        let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         let linear = self.linear_k.is_some();
         let body_force = &self.body_force;
         let fixed = self.fixed_external.as_deref();
+        let contact = &mut *self.contact;
         let u = &self.u;
-        let status: Result<()> = self.r.with_local_mut(|r_local| {
+        self.r.with_local_mut(|r_local| -> Result<()> {
             r_local.fill(0.0);
             u.with_local(|u_local| -> Result<()> {
                 if !linear {
                     bulk.add_internal_force(u_local, r_local)?;
                 }
-                loads.add_external_force(u_local, -factor, r_local)
+                loads.add_external_force(u_local, -factor, r_local)?;
+                for pair in contact.iter_mut() {
+                    pair.add_residual(dofs, u_local, factor, r_local)?;
+                }
+                Ok(())
             })??;
             bulk.add_body_force(body_force, -factor, r_local)?;
             if let Some(f) = fixed {
@@ -99,8 +124,7 @@ impl<'a> Mechanics<'a> {
                 }
             }
             Ok(())
-        })?;
-        status?;
+        })??;
         self.r.accumulate_ghosts()?;
         out.copy_from(self.r.global())?;
         if let Some(k) = &self.linear_k {
@@ -108,6 +132,12 @@ impl<'a> Mechanics<'a> {
             out.axpy(1.0, &self.work)?;
         }
         Ok(())
+    }
+
+    /// ‖R(x)‖ with the Dirichlet rows replaced, as SNES sees it.
+    pub fn residual_norm(&mut self, x: &Vector, work: &mut Vector) -> Result<f64> {
+        self.residual_impl(x, work)?;
+        Ok(work.norm2()?)
     }
 
     fn residual_impl(&mut self, x: &Vector, r: &mut Vector) -> Result<()> {
@@ -123,7 +153,7 @@ impl<'a> Mechanics<'a> {
         self.jacobian_evaluations += 1;
         self.load_state(x)?;
         j.zero_entries()?;
-        let (bulk, loads, factor) = (self.bulk, self.loads, self.factor);
+        let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         match &self.linear_k {
             Some(k) => j.add_scaled_subset(1.0, k)?,
             None => {
@@ -132,10 +162,16 @@ impl<'a> Mechanics<'a> {
                 self.bulk_tangent_assemblies += 1;
             }
         }
-        if loads.has_follower() {
-            self.u
-                .with_local(|u_local| loads.add_tangent(u_local, factor, j))??;
-        }
+        let contact = &mut *self.contact;
+        self.u.with_local(|u_local| -> Result<()> {
+            if loads.has_follower() {
+                loads.add_tangent(u_local, factor, j)?;
+            }
+            for pair in contact.iter_mut() {
+                pair.add_tangent(dofs, u_local, factor, j)?;
+            }
+            Ok(())
+        })??;
         j.assemble()?;
         j.zero_rows_columns_identity(&self.dirichlet.global_rows())?;
         Ok(())

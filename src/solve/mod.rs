@@ -1,8 +1,10 @@
-//! The solution procedure: load steps, each solved by Newton (PETSc SNES),
-//! cut back when Newton fails; converged steps go to the output file.
+//! The solution procedure: load steps; in each, the contact search, then the
+//! Uzawa loop around Newton (PETSc SNES) with the multipliers fixed during
+//! Newton; a step whose Newton or Uzawa loop fails is cut back and retried;
+//! converged steps go to the output.
 //!
-//! This module sits above `assembly` (and later `contact`): they know nothing
-//! of SNES, and only this module calls the solver.
+//! This module sits above `assembly` and `contact`: they know nothing of
+//! SNES, and only this module calls the solver.
 pub mod boundary;
 pub mod mechanics;
 pub mod natural;
@@ -12,11 +14,12 @@ pub use mechanics::Mechanics;
 pub use natural::NaturalOrder;
 
 use crate::assembly::{BulkAssembler, FacetLoad, SurfaceLoads};
+use crate::contact::{ContactPair, MasterSpec, PairSpec, UzawaStats};
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
-use crate::petsc::{self, LogStage, Matrix, Preallocation, Snes, Vector};
+use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, Vector};
 use crate::runtime::Runtime;
 use mpi::collective::SystemOperation;
 use mpi::traits::*;
@@ -27,8 +30,14 @@ use std::time::Instant;
 pub struct SolverSettings {
     pub max_newton: usize,
     pub rtol: f64,
-    /// Absolute residual tolerance; None: 1e-10 × a force scale of the model.
+    /// Absolute residual tolerance; None: rtol × the residual at the start of
+    /// each load step (the step's own force scale), so small loads and large
+    /// ones converge alike, and Uzawa's follow-up solves stay as tight.
     pub atol: Option<f64>,
+    /// Models with at most this many DOFs default to a parallel direct solver
+    /// (MUMPS LU), robust for stiff contact penalties; larger ones to
+    /// Krylov + algebraic multigrid.
+    pub direct_max_dofs: usize,
     pub max_cutbacks: usize,
     /// PETSc options (defaults that the command line and PETSC_OPTIONS override).
     pub petsc_options: String,
@@ -40,6 +49,7 @@ impl Default for SolverSettings {
             max_newton: 30,
             rtol: 1e-9,
             atol: None,
+            direct_max_dofs: 150_000,
             max_cutbacks: 8,
             petsc_options: String::new(),
         }
@@ -49,7 +59,7 @@ impl Default for SolverSettings {
 /// A vector field of the reference position, b(X).
 pub type VectorField = Box<dyn Fn([f64; 3]) -> [f64; 3]>;
 
-/// A fully resolved problem: mesh, materials per body, conditions, steps.
+/// A fully resolved problem: mesh, materials per body, conditions, contact, steps.
 pub struct Model {
     pub name: String,
     pub mesh: Mesh,
@@ -62,8 +72,22 @@ pub struct Model {
     pub body_force: Vec<[f64; 3]>,
     /// A spatially varying body force b(X) at full load (manufactured solutions).
     pub body_force_fn: Option<VectorField>,
+    pub contact: Vec<PairSpec>,
+    /// Compare a pair against Hertz after each step.
+    pub hertz: Option<crate::verify::HertzCheck>,
     pub steps: usize,
     pub solver: SolverSettings,
+}
+
+/// What a contact pair did in one converged step (figures over all ranks).
+#[derive(Debug, Clone)]
+pub struct ContactReport {
+    pub name: String,
+    /// Total contact force on the slave surface.
+    pub force: [f64; 3],
+    pub max_penetration: f64,
+    pub active_points: usize,
+    pub penalty: f64,
 }
 
 /// What one converged load increment did.
@@ -72,13 +96,16 @@ pub struct StepReport {
     pub index: usize,
     pub load_factor: f64,
     pub newton_iterations: usize,
+    pub uzawa_iterations: usize,
     pub linear_iterations: usize,
     pub residual_norm: f64,
+    /// Residual norms of every Newton iteration of the step's last solve.
     pub residual_history: Vec<f64>,
     pub cutbacks: usize,
     pub wall_seconds: f64,
     /// Total reaction force of each Dirichlet set (summed over ranks).
     pub reactions: Vec<(String, [f64; 3])>,
+    pub contact: Vec<ContactReport>,
 }
 
 /// The result of a run: per-step reports and the final displacement.
@@ -89,17 +116,39 @@ pub struct RunReport {
     /// Final displacement in natural node order, on every rank (N×3 flat).
     pub displacement: Vec<f64>,
     pub bulk_tangent_assemblies: usize,
+    pub pattern_builds: usize,
+}
+
+/// This rank's contact values of one pair at a converged step, for output.
+pub struct PairFields<'a> {
+    pub pair: &'a ContactPair,
+    pub values: crate::contact::links::PointValues,
 }
 
 /// Receives every converged step (the output file, a progress printer, ...).
 pub trait StepSink {
-    fn step(&mut self, report: &StepReport, displacement: &Vector, reaction: &Vector)
-        -> Result<()>;
+    fn step(
+        &mut self,
+        report: &StepReport,
+        displacement: &Vector,
+        reaction: &Vector,
+        contact: &[PairFields],
+        nodal_pressure: &[f64],
+    ) -> Result<()>;
 }
 
 /// Sets the program's PETSc defaults; the user's options win.
-fn set_solver_defaults(settings: &SolverSettings, symmetric: bool) -> Result<()> {
+fn set_solver_defaults(settings: &SolverSettings, symmetric: bool, dofs: usize) -> Result<()> {
     petsc::options::insert_string_defaults(&settings.petsc_options)?;
+    if dofs <= settings.direct_max_dofs {
+        // GMRES around the LU factors: one iteration with fresh factors, a
+        // few with the factors an earlier Uzawa iteration left behind.
+        petsc::options::set_default("-ksp_type", "gmres")?;
+        petsc::options::set_default("-ksp_rtol", "1e-10")?;
+        petsc::options::set_default("-pc_type", "lu")?;
+        petsc::options::set_default("-pc_factor_mat_solver_type", "mumps")?;
+        return Ok(());
+    }
     petsc::options::set_default("-ksp_type", if symmetric { "cg" } else { "gmres" })?;
     petsc::options::set_default("-pc_type", "gamg")?;
     petsc::options::set_default("-ksp_rtol", "1e-10")?;
@@ -107,8 +156,8 @@ fn set_solver_defaults(settings: &SolverSettings, symmetric: bool) -> Result<()>
     Ok(())
 }
 
-/// A model set up on this rank: partition, numbering, element data, Jacobian
-/// storage. Built collectively by every rank.
+/// A model set up on this rank: partition, numbering, element data, contact
+/// pairs, Jacobian storage. Built collectively by every rank.
 pub struct Simulation<'m> {
     model: &'m Model,
     partition: Vec<i32>,
@@ -116,14 +165,23 @@ pub struct Simulation<'m> {
     bulk: BulkAssembler,
     loads: SurfaceLoads,
     dirichlet: Dirichlet,
-    prealloc: Preallocation,
+    contact: Vec<ContactPair>,
     jac: Matrix,
+}
+
+/// Why a load increment failed.
+enum StepFailure {
+    Newton(SnesOutcome),
+    Uzawa {
+        iterations: usize,
+        stats: UzawaStats,
+    },
 }
 
 impl<'m> Simulation<'m> {
     /// Partitions (METIS on rank 0, broadcast), numbers the DOFs, precomputes
-    /// element data and allocates the Jacobian. Collective; fails on every rank
-    /// if it fails on one.
+    /// element data, resolves contact pairs and allocates the Jacobian.
+    /// Collective; fails on every rank if it fails on one.
     pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
         let stage = LogStage::register("Setup")?;
         stage.scope(|| setup(rt, model))
@@ -142,22 +200,36 @@ impl<'m> Simulation<'m> {
         self.model
     }
 
+    pub fn contact(&self) -> &[ContactPair] {
+        &self.contact
+    }
+
     /// Runs all load steps, calling `sink` after every converged one.
     pub fn run(&mut self, rt: &Runtime, sink: &mut dyn StepSink, echo: bool) -> Result<RunReport> {
         let started = Instant::now();
         let world = rt.world();
         let model = self.model;
         let stage_solve = LogStage::register("Solve")?;
-        let symmetric = !self.loads.has_follower();
-        set_solver_defaults(&model.solver, symmetric)?;
-        let (dofs, bulk, loads, dirichlet) = (&self.dofs, &self.bulk, &self.loads, &self.dirichlet);
+        let stage_search = LogStage::register("Contact search")?;
+        let symmetric = !self.loads.has_follower() && self.contact.is_empty();
+        set_solver_defaults(&model.solver, symmetric, DIM * self.dofs.num_global_nodes())?;
+        let Simulation {
+            dofs,
+            bulk,
+            loads,
+            dirichlet,
+            contact,
+            jac,
+            ..
+        } = self;
+        let (dofs, bulk, loads, dirichlet) = (&*dofs, &*bulk, &*loads, &*dirichlet);
         let mut mech = Mechanics::new(
             dofs,
             bulk,
             loads,
             dirichlet,
+            contact,
             model.body_force.clone(),
-            &self.prealloc,
         )?;
         if let Some(b) = &model.body_force_fn {
             let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
@@ -176,14 +248,18 @@ impl<'m> Simulation<'m> {
         let mut x_prev = x.duplicate()?;
         let mut reaction = x.duplicate()?;
         let mut snes = Snes::new()?;
-        let atol = model
-            .solver
-            .atol
-            .unwrap_or_else(|| 1e-10 * force_scale(model));
-        snes.set_tolerances(atol, model.solver.rtol, 0.0, model.solver.max_newton)?;
+        let user_atol = petsc::options::has("-snes_atol")?;
+        let atol_floor = 1e-14 * force_scale(model);
+        snes.set_tolerances(
+            model.solver.atol.unwrap_or(atol_floor),
+            model.solver.rtol,
+            0.0,
+            model.solver.max_newton,
+        )?;
         snes.set_from_options()?;
 
         let mut steps = Vec::new();
+        let mut pattern_builds = 0usize;
         let base = 1.0 / model.steps.max(1) as f64;
         let mut done = 0.0f64;
         let mut increment = base;
@@ -192,59 +268,104 @@ impl<'m> Simulation<'m> {
             let target = (done + increment).min(1.0);
             let t0 = Instant::now();
             x_prev.copy_from(&x)?;
+            let lambda_prev: Vec<Vec<f64>> = mech
+                .contact
+                .iter()
+                .map(|p| p.multipliers.lambda.clone())
+                .collect();
             mech.factor = target;
             x.with_array_mut(|xa| dirichlet.apply(xa, target))?;
-            let jac = &mut self.jac;
-            let outcome = stage_solve.scope(|| snes.solve(&mut mech, &mut x, &mut r, jac))?;
-            if !outcome.converged {
-                x.copy_from(&x_prev)?;
-                cutbacks_here += 1;
-                let why = match &outcome.domain_error {
-                    Some(d) => format!("{} ({d})", outcome.reason_text),
-                    None => format!(
-                        "{} after {} iterations, |R| = {:.3e}",
-                        outcome.reason_text, outcome.iterations, outcome.residual_norm
-                    ),
-                };
-                if cutbacks_here > model.solver.max_cutbacks {
-                    return Err(Error::NoConvergence {
-                        step: steps.len() + 1,
-                        load_factor: target,
-                        cutbacks: cutbacks_here - 1,
-                        reason: why,
-                    });
+            if !mech.contact.is_empty() {
+                let changed = stage_search.scope(|| {
+                    mech.with_state(&x, |u, pairs| {
+                        Ok(pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c))
+                    })
+                })?;
+                if any_rank(&world, changed) || pattern_builds == 0 {
+                    *jac = build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)?;
+                    pattern_builds += 1;
                 }
-                increment *= 0.5;
-                if echo && rt.rank() == 0 {
-                    println!("  cutback: load factor {target:.6} failed ({why}); retrying with increment {increment:.3e}");
-                }
-                continue;
             }
+            if model.solver.atol.is_none() && !user_atol {
+                // The step's own force scale: the residual once the new loads
+                // and prescribed displacements are in place.
+                let r0 = mech.residual_norm(&x, &mut r)?;
+                snes.set_tolerances(
+                    (model.solver.rtol * r0).max(atol_floor),
+                    model.solver.rtol,
+                    0.0,
+                    model.solver.max_newton,
+                )?;
+            }
+            let attempt = stage_solve
+                .scope(|| uzawa_loop(&world, &mut snes, &mut mech, &mut x, &mut r, jac, target));
+            let (outcome, uzawa_iterations, stats) = match attempt? {
+                Ok(done_step) => done_step,
+                Err(failure) => {
+                    x.copy_from(&x_prev)?;
+                    for (p, l) in mech.contact.iter_mut().zip(lambda_prev) {
+                        p.multipliers.lambda = l;
+                        p.multipliers.exchange()?;
+                    }
+                    cutbacks_here += 1;
+                    let why = failure_text(&failure);
+                    if cutbacks_here > model.solver.max_cutbacks {
+                        return Err(Error::NoConvergence {
+                            step: steps.len() + 1,
+                            load_factor: target,
+                            cutbacks: cutbacks_here - 1,
+                            reason: why,
+                        });
+                    }
+                    increment *= 0.5;
+                    if echo && rt.rank() == 0 {
+                        println!("  cutback: load factor {target:.6} failed ({why}); retrying with increment {increment:.3e}");
+                    }
+                    continue;
+                }
+            };
             done = target;
             mech.raw_residual(&x, &mut reaction)?;
             let reactions = reaction_totals(&world, dirichlet, &reaction, dofs.owned_dof_start())?;
             zero_unconstrained(&mut reaction, dirichlet)?;
+            let (fields, forces) = mech.with_state(&x, |u, pairs| {
+                let values = pairs
+                    .iter_mut()
+                    .map(|p| p.point_values(u, target))
+                    .collect::<Result<Vec<_>>>()?;
+                Ok(values.into_iter().unzip::<_, [f64; 3], Vec<_>, Vec<_>>())
+            })?;
+            let contact_reports = contact_reports(&world, mech.contact, &forces, &stats);
+            let nodal_pressure = nodal_pressure(dofs, mech.contact)?;
             let report = StepReport {
                 index: steps.len() + 1,
                 load_factor: done,
                 newton_iterations: outcome.iterations,
+                uzawa_iterations,
                 linear_iterations: outcome.linear_iterations,
                 residual_norm: outcome.residual_norm,
                 residual_history: outcome.history.clone(),
                 cutbacks: cutbacks_here,
                 wall_seconds: t0.elapsed().as_secs_f64(),
                 reactions,
+                contact: contact_reports,
             };
             if echo && rt.rank() == 0 {
                 print_step(&report);
             }
-            sink.step(&report, &x, &reaction)?;
+            let pair_fields: Vec<PairFields> = mech
+                .contact
+                .iter()
+                .zip(fields)
+                .map(|(pair, values)| PairFields { pair, values })
+                .collect();
+            sink.step(&report, &x, &reaction, &pair_fields, &nodal_pressure)?;
             steps.push(report);
             cutbacks_here = 0;
             // Grow back towards the scene's increment after a successful cut step.
             increment = (increment * 2.0).min(base);
         }
-        let mut natural = NaturalOrder::new(dofs)?;
+        let mut natural = NaturalOrder::nodal(dofs)?;
         let displacement = natural.gather_all(&x)?;
         Ok(RunReport {
             steps,
@@ -252,17 +373,213 @@ impl<'m> Simulation<'m> {
             wall_seconds: started.elapsed().as_secs_f64(),
             displacement,
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
+            pattern_builds,
         })
     }
 }
 
-/// Partition, number, precompute element data and allocate the Jacobian.
+type StepResult = std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), StepFailure>;
+
+/// The seed's Uzawa loop for one load step: Newton with λ fixed, then
+/// λ ← ⟨λ − εN gN⟩ at every link, until the penetration and the multiplier
+/// change meet the tolerances on every rank (or there is no contact).
+/// Newton iterations are summed over the Uzawa iterations.
+fn uzawa_loop(
+    world: &impl Communicator,
+    snes: &mut Snes,
+    mech: &mut Mechanics,
+    x: &mut Vector,
+    r: &mut Vector,
+    jac: &mut Matrix,
+    factor: f64,
+) -> Result<StepResult> {
+    let max_uzawa = mech
+        .contact
+        .iter()
+        .map(|p| p.spec.max_uzawa)
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    let mut newton = 0usize;
+    let mut linear = 0usize;
+    let mut history = Vec::new();
+    let mut k = 0;
+    loop {
+        k += 1;
+        // Between Uzawa iterations only λ changes, so the tangent barely
+        // does: keep the preconditioner (the LU factors) of the first solve.
+        snes.set_lag_preconditioner(if k == 1 || mech.contact.is_empty() {
+            1
+        } else {
+            -1
+        })?;
+        let mut outcome = snes.solve(mech, x, r, jac)?;
+        newton += outcome.iterations;
+        linear += outcome.linear_iterations;
+        history.extend_from_slice(&outcome.history);
+        if !outcome.converged {
+            return Ok(Err(StepFailure::Newton(outcome)));
+        }
+        if mech.contact.is_empty() {
+            return Ok(Ok((outcome, 0, Vec::new())));
+        }
+        let local: Vec<UzawaStats> = mech.with_state(x, |u, pairs| {
+            pairs
+                .iter_mut()
+                .map(|p| p.uzawa_update(u, factor))
+                .collect()
+        })?;
+        let stats = reduce_stats(world, &local);
+        let converged = mech.contact.iter().zip(&stats).all(|(p, s)| {
+            s.max_penetration <= p.spec.penetration_tol
+                && s.max_change <= p.spec.multiplier_tol * s.max_force.max(f64::MIN_POSITIVE)
+        });
+        if converged {
+            outcome.iterations = newton;
+            outcome.linear_iterations = linear;
+            outcome.history = history;
+            return Ok(Ok((outcome, k, stats)));
+        }
+        if k >= max_uzawa {
+            let worst = stats
+                .iter()
+                .copied()
+                .fold(UzawaStats::default(), |a, s| UzawaStats {
+                    max_penetration: a.max_penetration.max(s.max_penetration),
+                    max_change: a.max_change.max(s.max_change),
+                    max_force: a.max_force.max(s.max_force),
+                    max_multiplier: a.max_multiplier.max(s.max_multiplier),
+                    active: a.active + s.active,
+                });
+            return Ok(Err(StepFailure::Uzawa {
+                iterations: k,
+                stats: worst,
+            }));
+        }
+    }
+}
+
+fn failure_text(f: &StepFailure) -> String {
+    match f {
+        StepFailure::Newton(o) => match &o.domain_error {
+            Some(d) => format!("{} ({d})", o.reason_text),
+            None => format!("{} after {} iterations, |R| = {:.3e}", o.reason_text, o.iterations, o.residual_norm),
+        },
+        StepFailure::Uzawa { iterations, stats } => format!(
+            "Uzawa loop did not converge in {iterations} iterations (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
+            stats.max_penetration, stats.max_change, stats.max_force
+        ),
+    }
+}
+
+/// True on every rank if `flag` is true on any.
+fn any_rank(world: &impl Communicator, flag: bool) -> bool {
+    let mine = i32::from(flag);
+    let mut any = 0;
+    world.all_reduce_into(&mine, &mut any, SystemOperation::max());
+    any == 1
+}
+
+fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaStats> {
+    local
+        .iter()
+        .map(|s| {
+            let maxes = [
+                s.max_penetration,
+                s.max_change,
+                s.max_force,
+                s.max_multiplier,
+            ];
+            let mut g = [0.0; 4];
+            world.all_reduce_into(&maxes[..], &mut g[..], SystemOperation::max());
+            let mut active = 0u64;
+            world.all_reduce_into(&(s.active as u64), &mut active, SystemOperation::sum());
+            UzawaStats {
+                max_penetration: g[0],
+                max_change: g[1],
+                max_force: g[2],
+                max_multiplier: g[3],
+                active: active as usize,
+            }
+        })
+        .collect()
+}
+
+fn contact_reports(
+    world: &impl Communicator,
+    pairs: &[ContactPair],
+    forces: &[[f64; 3]],
+    stats: &[UzawaStats],
+) -> Vec<ContactReport> {
+    pairs
+        .iter()
+        .zip(forces)
+        .enumerate()
+        .map(|(i, (p, f))| {
+            let mut total = [0.0; 3];
+            world.all_reduce_into(&f[..], &mut total[..], SystemOperation::sum());
+            let s = stats.get(i).copied().unwrap_or_default();
+            ContactReport {
+                name: p.spec.name.clone(),
+                force: total,
+                max_penetration: s.max_penetration,
+                active_points: s.active,
+                penalty: p.penalty,
+            }
+        })
+        .collect()
+}
+
+/// Nodal contact pressure of the owned nodes (all pairs), PETSc node order.
+fn nodal_pressure(dofs: &DofMap, pairs: &[ContactPair]) -> Result<Vec<f64>> {
+    let n = dofs.num_owned_nodes();
+    let (mut num, mut den) = (vec![0.0; n], vec![0.0; n]);
+    for p in pairs {
+        p.multipliers.add_nodal_pressure(&mut num, &mut den)?;
+    }
+    Ok(num
+        .iter()
+        .zip(&den)
+        .map(|(a, b)| if *b > 0.0 { a / b } else { 0.0 })
+        .collect())
+}
+
+/// The Jacobian's storage for the current contact couplings: bulk cells,
+/// follower loads and every link's candidate master patch.
+fn build_jacobian(
+    dofs: &DofMap,
+    bulk: &BulkAssembler,
+    loads: &SurfaceLoads,
+    contact: &[ContactPair],
+    mesh: &Mesh,
+) -> Result<Matrix> {
+    let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
+    bulk.add_pattern(&mut pattern)?;
+    loads.add_pattern(&mut pattern)?;
+    for pair in contact {
+        pair.add_pattern(dofs, &mut pattern)?;
+    }
+    let mut jac = pattern.build()?;
+    let coords = owned_coordinates(mesh, dofs)?;
+    jac.set_rigid_body_near_null_space(&coords)?;
+    Ok(jac)
+}
+
+/// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
 fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
     let world = rt.world();
     let (rank, size) = (rt.rank(), rt.size());
     let mesh = &model.mesh;
     let partition = broadcast_partition(&world, mesh, rank, size)?;
-    let dofs = DofMap::new(mesh, &partition, rank, size);
+    let mut master_nodes = Vec::new();
+    for pair in &model.contact {
+        if let MasterSpec::Surface { set } = &pair.master {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh, set,
+            )?);
+        }
+    }
+    let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
     let bulk = collective(
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
@@ -279,13 +596,20 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
     }
     let loads = SurfaceLoads::new(mesh, &dofs, &facet_loads)?;
     let dirichlet = collective(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
-    let prealloc = dofs.bulk_preallocation(mesh, &[]);
-    let mut jac = Matrix::new_aij(dofs.num_owned_dofs(), &prealloc, DIM)?;
-    bulk.add_pattern(&mut jac)?;
-    loads.add_pattern(&mut jac)?;
-    jac.assemble()?;
-    let coords = owned_coordinates(mesh, &dofs)?;
-    jac.set_rigid_body_near_null_space(&coords)?;
+    let softest = model
+        .materials
+        .iter()
+        .map(Material::youngs)
+        .fold(f64::INFINITY, f64::min);
+    let contact = collective(
+        &world,
+        model
+            .contact
+            .iter()
+            .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest))
+            .collect::<Result<Vec<_>>>(),
+    )?;
+    let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
     Ok(Simulation {
         model,
         partition,
@@ -293,7 +617,7 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         bulk,
         loads,
         dirichlet,
-        prealloc,
+        contact,
         jac,
     })
 }
@@ -411,13 +735,20 @@ fn print_step(s: &StepReport) {
         .map(|r| format!("{r:.2e}"))
         .collect();
     println!(
-        "step {:4}  load {:.4}  newton {:2}  ksp {:4}  |R| {:.3e}  {:.2}s  [{}]",
+        "step {:4}  load {:.4}  newton {:2}  uzawa {:2}  ksp {:4}  |R| {:.3e}  {:.2}s  [{}]",
         s.index,
         s.load_factor,
         s.newton_iterations,
+        s.uzawa_iterations,
         s.linear_iterations,
         s.residual_norm,
         s.wall_seconds,
         hist.join(" ")
     );
+    for c in &s.contact {
+        println!(
+            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], {} active points, max penetration {:.3e} h, penalty {:.3e}",
+            c.name, c.force[0], c.force[1], c.force[2], c.active_points, c.max_penetration, c.penalty
+        );
+    }
 }

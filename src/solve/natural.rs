@@ -1,41 +1,86 @@
-//! Moving nodal fields from PETSc's DOF order to the input (natural) order the
-//! output file uses, so files from any rank count compare row by row.
-use crate::dofs::{DofMap, NaturalNode, DIM};
+//! Moving fields from PETSc's (rank-contiguous) order to the input (natural)
+//! order the output file uses, so files from any rank count compare row by row.
+use crate::dofs::{even_block, DofMap, NaturalNode, DIM};
 use crate::error::Result;
 use crate::petsc::{PetscInt, Scatter, Vector};
 
-/// A scatter from a PETSc-ordered nodal vector into a vector whose rank r
-/// holds a contiguous block of natural node ids.
+/// A scatter from a field stored in PETSc row order (rows owned contiguously
+/// per rank, `cols` values per row) into a vector whose rank r holds a
+/// contiguous block of natural rows.
 pub struct NaturalOrder {
     scatter: Scatter,
+    source: Vector,
     target: Vector,
     block: std::ops::Range<usize>,
 }
 
 impl NaturalOrder {
-    pub fn new(dofs: &DofMap) -> Result<Self> {
-        let block = dofs.output_node_block();
-        let target = Vector::new_mpi(DIM * block.len())?;
-        let template = Vector::new_mpi(dofs.num_owned_dofs())?;
-        let mut from = Vec::with_capacity(DIM * block.len());
-        let mut to = Vec::with_capacity(DIM * block.len());
+    /// `owned_rows`: rows this rank owns in PETSc order; `petsc_row(i)`: the
+    /// PETSc row of natural row i (any i in 0..global_rows). Collective.
+    pub fn new(
+        global_rows: usize,
+        cols: usize,
+        owned_rows: usize,
+        petsc_row: impl Fn(usize) -> usize,
+        rank: usize,
+        nranks: usize,
+    ) -> Result<Self> {
+        let block = even_block(global_rows, rank, nranks);
+        let source = Vector::new_mpi(cols * owned_rows)?;
+        let target = Vector::new_mpi(cols * block.len())?;
+        let mut from = Vec::with_capacity(cols * block.len());
+        let mut to = Vec::with_capacity(cols * block.len());
         for nat in block.clone() {
-            for c in 0..DIM {
-                from.push(dofs.dof_of_natural(NaturalNode(nat), c).0);
-                to.push((DIM * nat + c) as PetscInt);
+            let p = petsc_row(nat);
+            for c in 0..cols {
+                from.push((cols * p + c) as PetscInt);
+                to.push((cols * nat + c) as PetscInt);
             }
         }
-        let scatter = Scatter::new(&template, &from, &target, &to)?;
+        let scatter = Scatter::new(&source, &from, &target, &to)?;
         Ok(NaturalOrder {
             scatter,
+            source,
             target,
             block,
         })
     }
 
-    /// This rank's natural-order block of `v`: (first natural node, N_block×3 values).
+    /// Nodal vector fields (3 per node) in the DOF layout.
+    pub fn nodal(dofs: &DofMap) -> Result<Self> {
+        Self::new(
+            dofs.num_global_nodes(),
+            DIM,
+            dofs.num_owned_nodes(),
+            |n| dofs.petsc_node(NaturalNode(n)),
+            dofs.rank,
+            dofs.nranks,
+        )
+    }
+
+    /// Nodal scalar fields (one value per owned node, PETSc node order).
+    pub fn nodal_scalar(dofs: &DofMap) -> Result<Self> {
+        Self::new(
+            dofs.num_global_nodes(),
+            1,
+            dofs.num_owned_nodes(),
+            |n| dofs.petsc_node(NaturalNode(n)),
+            dofs.rank,
+            dofs.nranks,
+        )
+    }
+
+    /// This rank's natural-order block of `v`: (first natural row, rows × cols values).
     pub fn block_of(&mut self, v: &Vector) -> Result<(usize, Vec<f64>)> {
         self.scatter.forward(v, &mut self.target)?;
+        let data = self.target.with_array(|a| a.to_vec())?;
+        Ok((self.block.start, data))
+    }
+
+    /// As `block_of`, from this rank's owned rows given as a slice.
+    pub fn block_of_owned(&mut self, owned: &[f64]) -> Result<(usize, Vec<f64>)> {
+        self.source.with_array_mut(|a| a.copy_from_slice(owned))?;
+        self.scatter.forward(&self.source, &mut self.target)?;
         let data = self.target.with_array(|a| a.to_vec())?;
         Ok((self.block.start, data))
     }

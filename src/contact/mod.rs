@@ -1,0 +1,23 @@
+//! Contact: the ContactLink3D condition (DESIGN.md §2–§3).
+//!
+//! - `pair`: what a scene says about a pair;
+//! - `surfaces`: the slave and master sides as one rank sees them;
+//! - `search`: spatial index, outer and inner search;
+//! - `projection`: closest-point projection onto a master facet;
+//! - `link`: the kernel of one link: gap, normal, contact pressure
+//!   pN = ⟨λN − εN gN⟩, residual and consistent tangent;
+//! - `multipliers`: λN at the slave points, the Uzawa update rule, halo exchange;
+//! - `links`: a pair at run time (search per step, assembly, Uzawa update).
+//!
+//! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
+pub mod dual;
+pub mod link;
+pub mod links;
+pub mod multipliers;
+pub mod pair;
+pub mod projection;
+pub mod search;
+pub mod surfaces;
+
+pub use links::{ContactPair, UzawaStats};
+pub use pair::{MasterSpec, PairSpec, SlaveQuadrature};

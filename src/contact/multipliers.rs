@@ -1,0 +1,240 @@
+//! The Uzawa multipliers λN at the slave quadrature points, and their update
+//! rule λN ← ⟨λN − εN gN⟩.
+//!
+//! A slave quadrature point belongs to the rank that owns its facet's cell.
+//! The multipliers live in an owned + ghost layout (a PETSc ghosted vector in a
+//! quadrature-point numbering that is contiguous per rank): ghosts are the
+//! points of other ranks' slave facets that touch a node this rank owns, so
+//! nodal quantities (the nodal contact pressure) need no further messages.
+//! The ghosts are refreshed by a halo exchange after every Uzawa update.
+use super::link::reference_weights;
+use super::surfaces::SlaveSurface;
+use crate::dofs::{DofMap, LocalNode, NaturalNode};
+use crate::error::{Error, Result};
+use crate::fem::{shape::facet_shape, QuadRule};
+use crate::mesh::Mesh;
+use crate::petsc::{GhostedVector, PetscInt};
+
+/// The Uzawa update of one multiplier: the contact pressure of the converged
+/// Newton solution, pN = ⟨λN − εN gN⟩ (never negative: contact cannot pull).
+pub fn updated_multiplier(lambda: f64, penalty: f64, gap: f64) -> f64 {
+    (lambda - penalty * gap).max(0.0)
+}
+
+/// A quadrature point contribution to a node this rank owns: the point's slot
+/// in the local (owned + ghost) layout and its weight N_a(ζ) w.
+#[derive(Debug, Clone, Copy)]
+struct NodalWeight {
+    owned_node: u32,
+    /// Position of the node in `owned_nodes`.
+    owned_slot: u32,
+    slot: u32,
+    weight: f64,
+}
+
+pub struct Multipliers {
+    /// λN of the owned points (same order as the slave surface's points).
+    pub lambda: Vec<f64>,
+    halo: GhostedVector,
+    n_owned: usize,
+    n_ghost: usize,
+    /// For the nodal pressure: contributions of owned and ghost points to owned nodes.
+    nodal: Vec<NodalWeight>,
+    /// PETSc number of every slave facet of the set (by set index).
+    petsc_facet: Vec<usize>,
+    /// Owned slave nodes: local index and reference position.
+    owned_nodes: Vec<(u32, [f64; 3])>,
+}
+
+impl Multipliers {
+    pub fn new(
+        mesh: &Mesh,
+        dofs: &DofMap,
+        partition: &[i32],
+        set: &str,
+        slave: &SlaveSurface,
+        rule: &QuadRule,
+    ) -> Result<Self> {
+        let facets = mesh
+            .facet_sets
+            .get(set)
+            .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
+        let nqp = slave.nqp;
+        let owner: Vec<usize> = facets.iter().map(|f| partition[f.cell] as usize).collect();
+        let petsc_facet = contiguous_numbering(&owner, dofs.nranks);
+        let rank = dofs.rank;
+        let owned_node = |nat: usize| dofs.local(NaturalNode(nat)).filter(|&l| dofs.is_owned(l));
+        // Ghost facets: other ranks' facets with a node this rank owns.
+        let mut ghost_facets = Vec::new();
+        for (i, f) in facets.iter().enumerate() {
+            if owner[i] != rank
+                && mesh
+                    .facet_nodes(f)?
+                    .into_iter()
+                    .any(|v| owned_node(v).is_some())
+            {
+                ghost_facets.push(i);
+            }
+        }
+        let ghosts: Vec<PetscInt> = ghost_facets
+            .iter()
+            .flat_map(|&i| {
+                let first = petsc_facet[i] * nqp;
+                (0..nqp).map(move |q| (first + q) as PetscInt)
+            })
+            .collect();
+        let n_owned = slave.num_qps();
+        let halo = GhostedVector::new(n_owned, &ghosts)?;
+        let mut nodal = Vec::new();
+        let mut owned_nodes: Vec<(u32, [f64; 3])> = Vec::new();
+        let mut slot_of: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
+        let mut add_facet = |set_index: usize, first_slot: usize| -> Result<()> {
+            let natural = mesh.facet_nodes(&facets[set_index])?;
+            let x_ref: Vec<[f64; 3]> = natural.iter().map(|&v| mesh.nodes[v]).collect();
+            let points = reference_weights(slave.facet_type, &x_ref, rule);
+            for (q, (zeta, w)) in points.iter().enumerate() {
+                let s = facet_shape(slave.facet_type, *zeta);
+                for (a, &v) in natural.iter().enumerate() {
+                    if let Some(LocalNode(l)) = owned_node(v) {
+                        let owned_slot = *slot_of.entry(l as u32).or_insert_with(|| {
+                            owned_nodes.push((l as u32, mesh.nodes[v]));
+                            (owned_nodes.len() - 1) as u32
+                        });
+                        nodal.push(NodalWeight {
+                            owned_node: l as u32,
+                            owned_slot,
+                            slot: (first_slot + q) as u32,
+                            weight: s.n[a] * w,
+                        });
+                    }
+                }
+            }
+            Ok(())
+        };
+        for (k, f) in slave.facets.iter().enumerate() {
+            add_facet(f.set_index, k * nqp)?;
+        }
+        for (k, &i) in ghost_facets.iter().enumerate() {
+            add_facet(i, n_owned + k * nqp)?;
+        }
+        Ok(Multipliers {
+            lambda: vec![0.0; n_owned],
+            halo,
+            n_owned,
+            n_ghost: ghosts.len(),
+            nodal,
+            petsc_facet,
+            owned_nodes,
+        })
+    }
+
+    /// Halo exchange: ghost copies take their owners' current multipliers.
+    pub fn exchange(&mut self) -> Result<()> {
+        let lambda = &self.lambda;
+        self.halo
+            .global_mut()
+            .with_array_mut(|a| a.copy_from_slice(lambda))?;
+        self.halo.update_ghosts()?;
+        Ok(())
+    }
+
+    /// Normal contact force carried by each owned slave node: Σ N_a(ζ) w λN
+    /// over every slave point around it (on any rank, through the halo).
+    /// Multipliers that change without changing these forces (possible where
+    /// a facet's points over-constrain the surface) do not move the solution.
+    pub fn nodal_forces(&self) -> Result<Vec<f64>> {
+        let mut forces = vec![0.0; self.owned_nodes.len()];
+        self.halo.with_local(|all| {
+            for w in &self.nodal {
+                forces[w.owned_slot as usize] += w.weight * all[w.slot as usize];
+            }
+        })?;
+        Ok(forces)
+    }
+
+    /// Nodal contact pressure of each owned slave node: its normal force over
+    /// its share of the slave area, Σ N_a w λN / Σ N_a w. Unlike the point
+    /// multipliers it is unique, and it is what the Hertz checks compare.
+    pub fn nodal_pressures(&self) -> Result<Vec<f64>> {
+        let forces = self.nodal_forces()?;
+        let mut area = vec![0.0; forces.len()];
+        for w in &self.nodal {
+            area[w.owned_slot as usize] += w.weight;
+        }
+        Ok(forces
+            .iter()
+            .zip(&area)
+            .map(|(f, a)| if *a > 0.0 { f / a } else { 0.0 })
+            .collect())
+    }
+
+    /// Owned slave nodes (local index, reference position), in the order of
+    /// `nodal_forces`.
+    pub fn owned_nodes(&self) -> &[(u32, [f64; 3])] {
+        &self.owned_nodes
+    }
+
+    /// Nodal contact pressure of the owned nodes (area-weighted average of the
+    /// multipliers of every slave point around the node, on any rank), added
+    /// into `numerator` and `denominator` (indexed by owned local node).
+    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) -> Result<()> {
+        self.halo.with_local(|all| {
+            debug_assert_eq!(all.len(), self.n_owned + self.n_ghost);
+            for w in &self.nodal {
+                numerator[w.owned_node as usize] += w.weight * all[w.slot as usize];
+                denominator[w.owned_node as usize] += w.weight;
+            }
+        })?;
+        Ok(())
+    }
+
+    /// PETSc number of a slave point of this rank, for redistribution to output order.
+    pub fn petsc_point(&self, set_index: usize, q: usize, nqp: usize) -> usize {
+        self.petsc_facet[set_index] * nqp + q
+    }
+}
+
+/// Numbers items rank by rank (each rank's in their given order), the same
+/// way `DofMap` numbers nodes.
+fn contiguous_numbering(owner: &[usize], nranks: usize) -> Vec<usize> {
+    let mut count = vec![0usize; nranks];
+    for &o in owner {
+        count[o] += 1;
+    }
+    let mut next: Vec<usize> = count
+        .iter()
+        .scan(0, |acc, &c| {
+            let start = *acc;
+            *acc += c;
+            Some(start)
+        })
+        .collect();
+    owner
+        .iter()
+        .map(|&o| {
+            let n = next[o];
+            next[o] += 1;
+            n
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn update_rule_is_the_positive_part() {
+        assert_eq!(updated_multiplier(1.0, 10.0, 0.05), 0.5);
+        assert_eq!(updated_multiplier(1.0, 10.0, -0.1), 2.0);
+        assert_eq!(updated_multiplier(1.0, 10.0, 0.2), 0.0);
+    }
+
+    #[test]
+    fn numbering_is_contiguous_per_rank() {
+        assert_eq!(
+            contiguous_numbering(&[1, 0, 1, 0, 2], 3),
+            vec![2, 0, 3, 1, 4]
+        );
+    }
+}

@@ -1,0 +1,743 @@
+//! Closest-point projection of a point onto a quad4 / tri3 master facet.
+//!
+//! The facet is the fem module's isoparametric surface `x²(ξ) = Σ N_b(ξ) x_b`
+//! (node order and reference coordinates of [`FacetType`]), extended beyond
+//! the reference facet by the same polynomial so a point just past an edge
+//! still gets a smooth projection (the contact search decides from
+//! [`Projection::outside`] whether to keep it).
+//!
+//! The projection minimises `φ(ξ) = ½ |x − x²(ξ)|²`. Its stationarity
+//! conditions are `F_α = (x − x²)·τ_α = 0` with `τ_α = ∂x²/∂ξ_α`, and its
+//! Hessian is `H_αβ = τ_α·τ_β − (x − x²)·∂τ_α/∂ξ_β`. Newton with the full
+//! Hessian converges quadratically also on warped quads, where the second
+//! term is non-zero. Safeguards so it never diverges: when `H` is not
+//! positive definite the metric `τ_α·τ_β` (Gauss–Newton) or the gradient is
+//! used instead, steps are limited in length, large steps must decrease `φ`
+//! (backtracking), and `ξ` is kept in a box around the reference facet. A
+//! minimiser that would lie outside that box ends as a clamped answer with
+//! `converged = false`.
+
+use crate::fem::shape::{facet_shape, QUAD4_REF_NODES};
+use crate::fem::{FacetType, MAX_FACET_NODES};
+
+/// Result of [`project`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// Facet coordinates of the closest point (possibly outside the
+    /// reference facet, see `outside`).
+    pub xi: [f64; 2],
+    /// The closest point `x²(ξ)`.
+    pub point: [f64; 3],
+    /// Unit outward normal `τ₁×τ₂/|τ₁×τ₂|` at `xi`; all zeros when the facet
+    /// has no normal there (degenerate facet).
+    pub normal: [f64; 3],
+    /// `(x − point)·normal`: `> 0` apart, `< 0` penetration.
+    /// `f64::INFINITY` when the projection is unusable (bad input or no
+    /// normal), so a caller that ignores `converged` still sees no contact.
+    pub gap: f64,
+    /// Newton met its tolerance at an unconstrained stationary point.
+    pub converged: bool,
+    /// How far `xi` lies outside the reference facet, in reference units: the
+    /// largest violation of its inequalities (quad `|ξ_α| ≤ 1`; tri
+    /// `ξ₁ ≥ 0, ξ₂ ≥ 0, ξ₁ + ξ₂ ≤ 1`); 0 inside. `f64::INFINITY` on bad input.
+    pub outside: f64,
+}
+
+/// Relative Newton tolerance on the step in reference coordinates.
+const TOL: f64 = 1e-13;
+/// Longest step in reference units: the facet spans 1–2 units, so a longer
+/// step only jumps over the local geometry.
+const MAX_STEP: f64 = 0.5;
+/// Steps shorter than this are taken without the decrease test, because
+/// near the solution `φ` changes by less than its round-off and a decrease
+/// test would reject the steps that give quadratic convergence.
+const SMALL_STEP: f64 = 1e-4;
+const MAX_ITER: usize = 60;
+const MAX_HALVINGS: usize = 40;
+/// Relative threshold below which a 2×2 matrix counts as singular.
+const SINGULAR: f64 = 1e-12;
+
+/// Closest-point projection of `x` onto the facet through `master` (current
+/// nodal positions, fem node order), started from `start` (typically the
+/// last `ξ̄`) or the facet centre. Never panics and never returns NaN: bad
+/// input gives `converged = false`, `gap = ∞`.
+pub fn project(
+    facet: FacetType,
+    master: &[[f64; 3]],
+    x: [f64; 3],
+    start: Option<[f64; 2]>,
+) -> Projection {
+    project_counted(facet, master, x, start).0
+}
+
+/// Reference coordinates of the facet centre (the default Newton start).
+pub fn reference_centre(facet: FacetType) -> [f64; 2] {
+    match facet {
+        FacetType::Quad4 => [0.0, 0.0],
+        FacetType::Tri3 => [1.0 / 3.0, 1.0 / 3.0],
+    }
+}
+
+/// Largest violation of the reference facet's inequalities at `xi`.
+pub fn outside_distance(facet: FacetType, xi: [f64; 2]) -> f64 {
+    let violation = match facet {
+        FacetType::Quad4 => (xi[0].abs() - 1.0).max(xi[1].abs() - 1.0),
+        FacetType::Tri3 => (-xi[0]).max(-xi[1]).max(xi[0] + xi[1] - 1.0),
+    };
+    violation.max(0.0)
+}
+
+/// `∂²N_b/∂ξ₁∂ξ₂`, the only non-zero second derivative of the facet shape
+/// functions (bilinear quad: `¼ ξ_b η_b`; linear tri: 0). With it the
+/// second-order Taylor expansion of `N_b` about any point is exact, which
+/// the link kernel uses to evaluate at a dual-valued `ξ`.
+pub fn mixed_second_derivative(facet: FacetType) -> [f64; MAX_FACET_NODES] {
+    let mut m = [0.0; MAX_FACET_NODES];
+    if facet == FacetType::Quad4 {
+        for (mb, node) in m.iter_mut().zip(QUAD4_REF_NODES) {
+            *mb = 0.25 * node[0] * node[1];
+        }
+    }
+    m
+}
+
+/// Box that keeps `ξ` near the reference facet: one facet width beyond each
+/// edge (quad `[-2, 2]²`, tri `[-1, 2]²`). A projection further out belongs
+/// to another facet, and the bilinear extension may fold there.
+fn search_box(facet: FacetType) -> (f64, f64) {
+    match facet {
+        FacetType::Quad4 => (-2.0, 2.0),
+        FacetType::Tri3 => (-1.0, 2.0),
+    }
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm3(a: [f64; 3]) -> f64 {
+    dot3(a, a).sqrt()
+}
+
+/// The facet translated so its node centroid is the origin. Working relative
+/// to the centroid keeps round-off proportional to the facet size rather
+/// than to the distance from the global origin.
+struct Frame {
+    facet: FacetType,
+    nodes: [[f64; 3]; MAX_FACET_NODES],
+    centre: [f64; 3],
+    /// Largest node distance from the centroid: the length scale.
+    size: f64,
+    mixed: [f64; MAX_FACET_NODES],
+}
+
+impl Frame {
+    fn new(facet: FacetType, master: &[[f64; 3]]) -> Option<Self> {
+        let n = facet.nodes();
+        if master.len() != n || !master.iter().flatten().all(|v| v.is_finite()) {
+            return None;
+        }
+        let mut centre = [0.0; 3];
+        for p in master {
+            centre = add3(centre, p.map(|c| c / n as f64));
+        }
+        let mut nodes = [[0.0; 3]; MAX_FACET_NODES];
+        let mut size = 0.0f64;
+        for (local, p) in nodes.iter_mut().zip(master) {
+            *local = sub3(*p, centre);
+            size = size.max(norm3(*local));
+        }
+        if !(size > 0.0 && size.is_finite()) {
+            return None;
+        }
+        Some(Frame {
+            facet,
+            nodes,
+            centre,
+            size,
+            mixed: mixed_second_derivative(facet),
+        })
+    }
+
+    fn count(&self) -> usize {
+        self.facet.nodes()
+    }
+
+    fn surface(&self, xi: [f64; 2]) -> Surface {
+        let s = facet_shape(self.facet, xi);
+        let mut out = Surface::default();
+        for b in 0..self.count() {
+            let xb = self.nodes[b];
+            out.x = add3(out.x, xb.map(|c| s.n[b] * c));
+            out.t1 = add3(out.t1, xb.map(|c| s.dn[b][0] * c));
+            out.t2 = add3(out.t2, xb.map(|c| s.dn[b][1] * c));
+            out.t12 = add3(out.t12, xb.map(|c| self.mixed[b] * c));
+        }
+        out
+    }
+}
+
+/// Position, tangents and mixed second derivative of the surface at one `ξ`
+/// (centroid-relative).
+#[derive(Default)]
+struct Surface {
+    x: [f64; 3],
+    t1: [f64; 3],
+    t2: [f64; 3],
+    t12: [f64; 3],
+}
+
+impl Surface {
+    /// `τ_α·τ_β`.
+    fn metric(&self) -> Sym2 {
+        Sym2 {
+            a: dot3(self.t1, self.t1),
+            b: dot3(self.t1, self.t2),
+            c: dot3(self.t2, self.t2),
+        }
+    }
+
+    /// Hessian of `φ` with `d = x − x²`; `∂τ₁/∂ξ₁ = ∂τ₂/∂ξ₂ = 0` for
+    /// both facet types, so only the off-diagonal gets a curvature term.
+    fn hessian(&self, d: [f64; 3]) -> Sym2 {
+        let m = self.metric();
+        Sym2 {
+            b: m.b - dot3(d, self.t12),
+            ..m
+        }
+    }
+}
+
+/// Symmetric 2×2 matrix `[[a, b], [b, c]]`.
+#[derive(Clone, Copy)]
+struct Sym2 {
+    a: f64,
+    b: f64,
+    c: f64,
+}
+
+impl Sym2 {
+    fn positive_definite(&self) -> bool {
+        let det = self.a * self.c - self.b * self.b;
+        self.a > 0.0 && self.c > 0.0 && det > SINGULAR * self.a * self.c
+    }
+
+    /// Solve restricted to the free components (the others stay zero), or
+    /// `None` if the restricted matrix is not positive definite.
+    fn solve_free(&self, f: [f64; 2], free: [bool; 2]) -> Option<[f64; 2]> {
+        match free {
+            [true, true] => {
+                if !self.positive_definite() {
+                    return None;
+                }
+                let det = self.a * self.c - self.b * self.b;
+                Some([
+                    (self.c * f[0] - self.b * f[1]) / det,
+                    (self.a * f[1] - self.b * f[0]) / det,
+                ])
+            }
+            [true, false] => (self.a > 0.0).then(|| [f[0] / self.a, 0.0]),
+            [false, true] => (self.c > 0.0).then(|| [0.0, f[1] / self.c]),
+            [false, false] => None,
+        }
+    }
+}
+
+/// Descent direction for `φ` at one iterate: Newton with the full Hessian if
+/// that is positive definite, else Gauss–Newton with the metric, else a
+/// scaled gradient step. `f = −∇φ`.
+fn direction(s: &Surface, d: [f64; 3], f: [f64; 2], free: [bool; 2]) -> Option<[f64; 2]> {
+    let metric = s.metric();
+    let hessian = s.hessian(d);
+    let gradient = || {
+        let scale = metric.a + metric.c;
+        (scale > 0.0).then(|| {
+            let keep = free.map(|fr| if fr { 1.0 } else { 0.0 });
+            [keep[0] * f[0] / scale, keep[1] * f[1] / scale]
+        })
+    };
+    let dir = hessian
+        .solve_free(f, free)
+        .or_else(|| metric.solve_free(f, free))
+        .or_else(gradient)?;
+    dir.iter().all(|v| v.is_finite()).then_some(dir)
+}
+
+fn clamp_box(xi: [f64; 2], (lo, hi): (f64, f64)) -> [f64; 2] {
+    xi.map(|v| v.clamp(lo, hi))
+}
+
+/// Components pinned at the search box: at a bound with the descent
+/// direction `f` pointing out of the box.
+fn free_components(xi: [f64; 2], f: [f64; 2], (lo, hi): (f64, f64)) -> [bool; 2] {
+    [0, 1].map(|i| !((xi[i] <= lo && f[i] < 0.0) || (xi[i] >= hi && f[i] > 0.0)))
+}
+
+fn objective(frame: &Frame, y: [f64; 3], xi: [f64; 2]) -> f64 {
+    let d = sub3(y, frame.surface(xi).x);
+    0.5 * dot3(d, d)
+}
+
+/// Shortens `dir` to at most `MAX_STEP` in the max norm.
+fn limit_step(dir: [f64; 2]) -> [f64; 2] {
+    let len = dir[0].abs().max(dir[1].abs());
+    if len > MAX_STEP {
+        dir.map(|v| v * MAX_STEP / len)
+    } else {
+        dir
+    }
+}
+
+/// Backtracking along `dir` (projected onto the box) until `φ` decreases.
+fn line_search(frame: &Frame, y: [f64; 3], xi: [f64; 2], dir: [f64; 2]) -> Option<[f64; 2]> {
+    let bounds = search_box(frame.facet);
+    let phi = objective(frame, y, xi);
+    let mut alpha = 1.0;
+    for _ in 0..MAX_HALVINGS {
+        let trial = clamp_box([xi[0] + alpha * dir[0], xi[1] + alpha * dir[1]], bounds);
+        if trial == xi {
+            return None;
+        }
+        if objective(frame, y, trial) < phi {
+            return Some(trial);
+        }
+        alpha *= 0.5;
+    }
+    None
+}
+
+/// Starting point: `start` if usable, else the facet centre; inside the box.
+fn initial_xi(facet: FacetType, start: Option<[f64; 2]>) -> [f64; 2] {
+    match start {
+        Some(s) if s.iter().all(|v| v.is_finite()) => clamp_box(s, search_box(facet)),
+        _ => reference_centre(facet),
+    }
+}
+
+/// Newton iteration; returns the final `ξ`, whether it converged, and the
+/// number of iterations (for tests of the convergence rate).
+fn newton(frame: &Frame, y: [f64; 3], mut xi: [f64; 2]) -> ([f64; 2], bool, usize) {
+    let bounds = search_box(frame.facet);
+    // Round-off in F grows with the distance of x from the facet, so the
+    // attainable accuracy of ξ does too.
+    let tol = TOL * (1.0 + norm3(y) / frame.size);
+    for it in 0..MAX_ITER {
+        let s = frame.surface(xi);
+        let d = sub3(y, s.x);
+        let f = [dot3(d, s.t1), dot3(d, s.t2)];
+        let free = free_components(xi, f, bounds);
+        let Some(dir) = direction(&s, d, f, free) else {
+            return (xi, false, it);
+        };
+        let len = dir[0].abs().max(dir[1].abs());
+        let constrained = free != [true, true];
+        if len <= tol {
+            let next = clamp_box([xi[0] + dir[0], xi[1] + dir[1]], bounds);
+            let converged = !constrained && next == [xi[0] + dir[0], xi[1] + dir[1]];
+            return (next, converged, it + 1);
+        }
+        let next = if len <= SMALL_STEP {
+            Some(clamp_box([xi[0] + dir[0], xi[1] + dir[1]], bounds))
+        } else {
+            line_search(frame, y, xi, limit_step(dir))
+        };
+        match next {
+            Some(n) if n != xi => xi = n,
+            // No progress possible: a clamped minimiser on the box boundary
+            // or a degenerate neighbourhood.
+            _ => return (xi, false, it + 1),
+        }
+    }
+    (xi, false, MAX_ITER)
+}
+
+fn failed(xi: [f64; 2]) -> Projection {
+    Projection {
+        xi,
+        point: [0.0; 3],
+        normal: [0.0; 3],
+        gap: f64::INFINITY,
+        converged: false,
+        outside: f64::INFINITY,
+    }
+}
+
+/// [`project`] plus the Newton iteration count.
+pub(crate) fn project_counted(
+    facet: FacetType,
+    master: &[[f64; 3]],
+    x: [f64; 3],
+    start: Option<[f64; 2]>,
+) -> (Projection, usize) {
+    let xi0 = initial_xi(facet, start);
+    let Some(frame) = Frame::new(facet, master) else {
+        return (failed(xi0), 0);
+    };
+    if !x.iter().all(|v| v.is_finite()) {
+        return (failed(xi0), 0);
+    }
+    let y = sub3(x, frame.centre);
+    let (xi, converged, iterations) = newton(&frame, y, xi0);
+    (finish(&frame, y, xi, converged), iterations)
+}
+
+/// Point, normal and gap at the final `ξ`.
+fn finish(frame: &Frame, y: [f64; 3], xi: [f64; 2], converged: bool) -> Projection {
+    let s = frame.surface(xi);
+    let n = cross3(s.t1, s.t2);
+    let area = norm3(n);
+    let point = add3(s.x, frame.centre);
+    let outside = outside_distance(frame.facet, xi);
+    // A facet collapsed at ξ has no normal, so no gap: report "no contact".
+    if !(area > SINGULAR * norm3(s.t1) * norm3(s.t2) && area > 0.0) {
+        return Projection {
+            xi,
+            point,
+            normal: [0.0; 3],
+            gap: f64::INFINITY,
+            converged: false,
+            outside,
+        };
+    }
+    let normal = n.map(|v| v / area);
+    let d = sub3(y, s.x);
+    // A stationary point that is not a local minimum (reachable through the
+    // Gauss–Newton fallback) is not a closest point, and the link tangent
+    // needs an invertible Hessian there.
+    let minimum = s.hessian(d).positive_definite();
+    Projection {
+        xi,
+        point,
+        normal,
+        gap: dot3(d, normal),
+        converged: converged && minimum,
+        outside,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::test_util::Lcg;
+
+    fn flat_quad() -> [[f64; 3]; 4] {
+        // A parallelogram in z = 0.3 (affine map, so ξ is known in closed
+        // form): x = c + ξ₁ a + ξ₂ b.
+        [
+            [-1.0 - 0.2, -0.5, 0.3],
+            [1.0 - 0.2, -0.5, 0.3],
+            [1.0 + 0.2, 0.5, 0.3],
+            [-1.0 + 0.2, 0.5, 0.3],
+        ]
+    }
+
+    fn warped_quad() -> [[f64; 3]; 4] {
+        [
+            [-1.0, -1.0, 0.25],
+            [1.1, -0.9, -0.2],
+            [0.9, 1.2, 0.3],
+            [-1.05, 0.95, -0.25],
+        ]
+    }
+
+    fn tri() -> [[f64; 3]; 3] {
+        [[0.1, 0.2, 0.5], [2.1, 0.4, 0.7], [0.3, 1.9, 0.2]]
+    }
+
+    fn surface_point(facet: FacetType, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
+        let s = facet_shape(facet, xi);
+        let mut p = [0.0; 3];
+        for (b, xb) in x.iter().enumerate() {
+            for i in 0..3 {
+                p[i] += s.n[b] * xb[i];
+            }
+        }
+        p
+    }
+
+    fn assert_finite(p: &Projection) {
+        let vals = p.xi.iter().chain(&p.point).chain(&p.normal);
+        assert!(vals.clone().all(|v| v.is_finite()), "{p:?}");
+        assert!(!p.gap.is_nan() && !p.outside.is_nan(), "{p:?}");
+    }
+
+    #[test]
+    fn point_above_flat_quad_interior_is_exact() {
+        let m = flat_quad();
+        // x = c + 0.3 a + (−0.6) b + 0.7 ẑ with a = (1, 0, 0), b = (0.2, 0.5, 0).
+        let xi_exact = [0.3, -0.6];
+        let on = surface_point(FacetType::Quad4, &m, xi_exact);
+        let x = [on[0], on[1], on[2] + 0.7];
+        let p = project(FacetType::Quad4, &m, x, None);
+        assert!(p.converged);
+        assert!((p.xi[0] - 0.3).abs() < 1e-14 && (p.xi[1] + 0.6).abs() < 1e-14);
+        assert!((p.gap - 0.7).abs() < 1e-14);
+        assert!((p.normal[2] - 1.0).abs() < 1e-15);
+        assert_eq!(p.outside, 0.0);
+        // Below the facet: penetration.
+        let below = project(FacetType::Quad4, &m, [on[0], on[1], on[2] - 0.2], None);
+        assert!((below.gap + 0.2).abs() < 1e-14);
+    }
+
+    #[test]
+    fn tri_exact_and_oriented() {
+        let m = tri();
+        let xi_exact = [0.2, 0.5];
+        let on = surface_point(FacetType::Tri3, &m, xi_exact);
+        let n = {
+            let v = cross3(sub3(m[1], m[0]), sub3(m[2], m[0]));
+            v.map(|c| c / norm3(v))
+        };
+        let x = add3(on, n.map(|c| -0.4 * c));
+        let (p, its) = project_counted(FacetType::Tri3, &m, x, None);
+        assert!(p.converged);
+        assert!((p.xi[0] - 0.2).abs() < 1e-13 && (p.xi[1] - 0.5).abs() < 1e-13);
+        assert!((p.gap + 0.4).abs() < 1e-13);
+        assert!(dot3(p.normal, n) > 1.0 - 1e-14);
+        // A plane: Newton is exact after one step, the second confirms it.
+        assert!(its <= 2, "{its} iterations");
+    }
+
+    #[test]
+    fn warped_quad_satisfies_orthogonality_and_converges_quadratically() {
+        let m = warped_quad();
+        let mut rng = Lcg::new(11);
+        for _ in 0..50 {
+            let xi = [0.8 * rng.next(), 0.8 * rng.next()];
+            let on = surface_point(FacetType::Quad4, &m, xi);
+            let x = add3(on, rng.vec3(0.4));
+            let (p, its) = project_counted(FacetType::Quad4, &m, x, None);
+            assert!(p.converged, "{p:?}");
+            // Gauss–Newton (no curvature term) needs far more iterations here.
+            assert!(its <= 7, "{its} iterations");
+            let s = facet_shape(FacetType::Quad4, p.xi);
+            let d = sub3(x, p.point);
+            for alpha in 0..2 {
+                let mut t = [0.0; 3];
+                for (b, xb) in m.iter().enumerate() {
+                    for i in 0..3 {
+                        t[i] += s.dn[b][alpha] * xb[i];
+                    }
+                }
+                assert!(dot3(d, t).abs() < 1e-13, "F_{alpha} = {}", dot3(d, t));
+            }
+            // x − x² is along the normal at the closest point.
+            assert!((p.gap.abs() - norm3(d)).abs() < 1e-13);
+        }
+    }
+
+    /// Dense sampling over the reference square, refined around the best
+    /// sample, as an independent minimiser of |x − x²(ξ)|.
+    fn brute_force(m: &[[f64; 3]], x: [f64; 3]) -> ([f64; 2], f64) {
+        let dist = |xi: [f64; 2]| norm3(sub3(x, surface_point(FacetType::Quad4, m, xi)));
+        let mut best = ([0.0, 0.0], f64::INFINITY);
+        let n = 200;
+        for i in 0..=n {
+            for j in 0..=n {
+                let xi = [
+                    -1.0 + 2.0 * i as f64 / n as f64,
+                    -1.0 + 2.0 * j as f64 / n as f64,
+                ];
+                let d = dist(xi);
+                if d < best.1 {
+                    best = (xi, d);
+                }
+            }
+        }
+        let mut h = 2.0 / n as f64;
+        for _ in 0..30 {
+            let c = best.0;
+            for i in -4..=4 {
+                for j in -4..=4 {
+                    let xi = [c[0] + h * i as f64 / 4.0, c[1] + h * j as f64 / 4.0];
+                    let d = dist(xi);
+                    if d < best.1 {
+                        best = (xi, d);
+                    }
+                }
+            }
+            h *= 0.5;
+        }
+        best
+    }
+
+    #[test]
+    fn random_points_match_brute_force_minimum() {
+        let m = warped_quad();
+        let mut rng = Lcg::new(5);
+        let mut checked = 0;
+        for _ in 0..40 {
+            let x = add3([1.2 * rng.next(), 1.2 * rng.next(), 0.0], rng.vec3(0.6));
+            let (xi_b, d_b) = brute_force(&m, x);
+            if xi_b.iter().any(|v| v.abs() > 0.98) {
+                continue; // minimiser on the boundary of the sampled square
+            }
+            let p = project(FacetType::Quad4, &m, x, None);
+            assert!(p.converged);
+            assert!(
+                (p.gap.abs() - d_b).abs() < 1e-10,
+                "{} vs {d_b}",
+                p.gap.abs()
+            );
+            assert!((p.xi[0] - xi_b[0]).abs() < 1e-6 && (p.xi[1] - xi_b[1]).abs() < 1e-6);
+            checked += 1;
+        }
+        assert!(checked >= 20, "only {checked} interior cases");
+    }
+
+    #[test]
+    fn off_edge_and_corner_report_outside() {
+        let m = flat_quad();
+        // Beyond the edge ξ₁ = 1 by 0.3 in ξ₁, inside in ξ₂.
+        let on = surface_point(FacetType::Quad4, &m, [1.3, 0.2]);
+        let p = project(FacetType::Quad4, &m, [on[0], on[1], on[2] + 0.1], None);
+        assert!(p.converged);
+        assert!((p.outside - 0.3).abs() < 1e-13, "{}", p.outside);
+        // Off the corner (1, 1).
+        let on = surface_point(FacetType::Quad4, &m, [1.2, 1.5]);
+        let p = project(FacetType::Quad4, &m, [on[0], on[1], on[2] - 0.1], None);
+        assert!(p.converged);
+        assert!((p.outside - 0.5).abs() < 1e-13);
+        assert!((p.gap + 0.1).abs() < 1e-13);
+        // Tri: beyond the hypotenuse.
+        let t = tri();
+        let on = surface_point(FacetType::Tri3, &t, [0.7, 0.6]);
+        let p = project(FacetType::Tri3, &t, on, Some([0.0, 0.0]));
+        assert!(p.converged);
+        assert!((p.outside - 0.3).abs() < 1e-12);
+        // Off the tri corner at node 0.
+        let on = surface_point(FacetType::Tri3, &t, [-0.2, -0.4]);
+        let p = project(FacetType::Tri3, &t, on, None);
+        assert!((p.outside - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn far_points_are_clamped_not_divergent() {
+        let mut rng = Lcg::new(9);
+        for facet_x in [warped_quad().to_vec(), flat_quad().to_vec()] {
+            for scale in [10.0, 1e3, 1e6] {
+                for _ in 0..20 {
+                    let x = rng.vec3(scale);
+                    let start = [3.0 * rng.next(), 3.0 * rng.next()];
+                    let p = project(FacetType::Quad4, &facet_x, x, Some(start));
+                    assert_finite(&p);
+                    let bounds = search_box(FacetType::Quad4);
+                    assert!(p.xi.iter().all(|v| (bounds.0..=bounds.1).contains(v)));
+                    // Descent: never further away than the (clamped) start.
+                    let d = norm3(sub3(x, p.point));
+                    let s0 = clamp_box(start, bounds);
+                    let d0 = norm3(sub3(x, surface_point(FacetType::Quad4, &facet_x, s0)));
+                    assert!(d <= d0 * (1.0 + 1e-9), "{d} > {d0}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn far_above_flat_facet_still_converges() {
+        let m = flat_quad();
+        let on = surface_point(FacetType::Quad4, &m, [0.4, 0.1]);
+        let p = project(FacetType::Quad4, &m, [on[0], on[1], on[2] + 1e4], None);
+        assert!(p.converged);
+        assert!((p.xi[0] - 0.4).abs() < 1e-12 && (p.xi[1] - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_facets_do_not_panic() {
+        let collapsed = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let p = project(FacetType::Quad4, &collapsed, [0.5, 0.3, 0.2], None);
+        assert_finite(&p);
+        // Triangle-shaped quad still has a normal away from the collapsed edge.
+        assert!(p.converged && (p.gap - 0.2).abs() < 1e-12, "{p:?}");
+
+        let point = [[1.0, 2.0, 3.0]; 4];
+        let p = project(FacetType::Quad4, &point, [0.0, 0.0, 0.0], None);
+        assert_finite(&p);
+        assert!(!p.converged && p.gap == f64::INFINITY);
+
+        let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let p = project(FacetType::Tri3, &line, [0.5, 1.0, 0.0], None);
+        assert_finite(&p);
+        assert!(!p.converged);
+
+        let sliver = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1e-9, 0.0]];
+        let p = project(FacetType::Tri3, &sliver, [0.5, 0.0, 0.3], None);
+        assert_finite(&p);
+
+        let nan = [[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let p = project(FacetType::Tri3, &nan, [0.0; 3], None);
+        assert!(!p.converged && p.gap == f64::INFINITY);
+        let p = project(FacetType::Tri3, &tri(), [f64::INFINITY, 0.0, 0.0], None);
+        assert!(!p.converged);
+        let p = project(FacetType::Quad4, &tri(), [0.0; 3], None);
+        assert!(!p.converged, "wrong node count must be rejected");
+        // Overflow-sized coordinates: no NaN anywhere.
+        for x in [[1e200, -1e200, 3e199], [1e-300, 0.0, 1e-310]] {
+            assert_finite(&project(FacetType::Quad4, &warped_quad(), x, None));
+        }
+        let huge = warped_quad().map(|p| p.map(|c| c * 1e300));
+        assert_finite(&project(FacetType::Quad4, &huge, [1.0, 2.0, 3.0], None));
+        let tiny = warped_quad().map(|p| p.map(|c| c * 1e-300));
+        assert_finite(&project(
+            FacetType::Quad4,
+            &tiny,
+            [1e-300, 0.0, 2e-300],
+            None,
+        ));
+        let p = project(
+            FacetType::Tri3,
+            &tri(),
+            [0.3, 0.3, 1.0],
+            Some([f64::NAN, 0.0]),
+        );
+        assert!(p.converged, "a NaN start falls back to the centre");
+    }
+
+    #[test]
+    fn start_value_is_used() {
+        let m = warped_quad();
+        let on = surface_point(FacetType::Quad4, &m, [0.9, -0.9]);
+        let x = add3(on, [0.0, 0.0, 0.05]);
+        let (far, n_far) = project_counted(FacetType::Quad4, &m, x, None);
+        let (near, n_near) = project_counted(FacetType::Quad4, &m, x, Some(far.xi));
+        assert!(far.converged && near.converged);
+        assert!(n_near < n_far, "{n_near} vs {n_far}");
+        assert!((near.xi[0] - far.xi[0]).abs() < 1e-13);
+    }
+
+    #[test]
+    fn mixed_derivative_matches_shape_gradients() {
+        // ∂/∂ξ₂ of ∂N/∂ξ₁ by differences (exact: linear in ξ₂).
+        for facet in [FacetType::Quad4, FacetType::Tri3] {
+            let m = mixed_second_derivative(facet);
+            let (a, b) = (
+                facet_shape(facet, [0.3, 0.1]),
+                facet_shape(facet, [0.3, 0.6]),
+            );
+            for (i, mi) in m.iter().enumerate().take(facet.nodes()) {
+                assert!(((b.dn[i][0] - a.dn[i][0]) / 0.5 - mi).abs() < 1e-14);
+            }
+        }
+    }
+}

@@ -1,0 +1,249 @@
+//! The two sides of a contact pair as one rank sees them.
+//!
+//! Slave facets belong to the rank that owns their cell; that rank evaluates
+//! their links. Master facets (of a deformable master) are known to every rank:
+//! their nodes are ghosted on every rank (the master halo), so each rank
+//! searches and evaluates its own slave points without further messages.
+use super::link::reference_weights;
+use crate::dofs::{DofMap, LocalNode, NaturalNode, DIM};
+use crate::error::{Error, Result};
+use crate::fem::{shape::facet_shape, FacetType, QuadRule};
+use crate::mesh::{FacetRef, Mesh};
+use crate::petsc::PetscInt;
+
+/// A slave facet this rank evaluates.
+#[derive(Debug, Clone)]
+pub struct SlaveFacet {
+    /// Position in the slave facet set: output rows are ordered by it.
+    pub set_index: usize,
+    pub nodes: Vec<u32>,
+    pub x_ref: Vec<[f64; 3]>,
+    pub dofs: Vec<PetscInt>,
+    /// Shortest edge: the local element size for the penalty and tolerance.
+    pub h: f64,
+}
+
+/// The slave side: this rank's facets and their quadrature points.
+#[derive(Debug, Clone)]
+pub struct SlaveSurface {
+    pub facet_type: FacetType,
+    pub facets: Vec<SlaveFacet>,
+    /// Quadrature points per facet (same rule on every facet).
+    pub nqp: usize,
+    /// Per local quadrature point (facet-major): facet coordinates and
+    /// reference area weight.
+    pub qp_zeta: Vec<[f64; 2]>,
+    pub qp_weight: Vec<f64>,
+    /// Facets in the whole set (all ranks).
+    pub global_facets: usize,
+    /// Mean shortest edge of the set's facets (identical on every rank): the
+    /// element size the penalty and the penetration tolerance scale with.
+    /// The shortest edge, not √area, so one-cell-thick plane-strain slabs
+    /// get their in-plane size.
+    pub h: f64,
+}
+
+impl SlaveSurface {
+    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, rule: &QuadRule) -> Result<Self> {
+        let facet_refs = facet_set(mesh, set)?;
+        let facet_type = mesh.cell_type.facet_type();
+        let mut local_cell = vec![false; mesh.num_cells()];
+        for &c in &dofs.local_cells {
+            local_cell[c] = true;
+        }
+        let mut edge_sum = 0.0;
+        let mut facets = Vec::new();
+        let (mut qp_zeta, mut qp_weight) = (Vec::new(), Vec::new());
+        for (set_index, f) in facet_refs.iter().enumerate() {
+            let natural = mesh.facet_nodes(f)?;
+            let x_ref: Vec<[f64; 3]> = natural.iter().map(|&v| mesh.nodes[v]).collect();
+            let weights = reference_weights(facet_type, &x_ref, rule);
+            if weights.is_empty() {
+                return Err(Error::scene(
+                    "contact",
+                    format!(
+                        "slave facet {set_index} of '{set}' (cell {}) is degenerate",
+                        f.cell
+                    ),
+                ));
+            }
+            edge_sum += shortest_edge(&x_ref);
+            if !local_cell[f.cell] {
+                continue;
+            }
+            for (zeta, w) in &weights {
+                qp_zeta.push(*zeta);
+                qp_weight.push(*w);
+            }
+            let nodes: Vec<u32> = natural
+                .iter()
+                .map(|&v| local_node(dofs, v))
+                .collect::<Result<_>>()?;
+            let facet_dofs = nodes
+                .iter()
+                .flat_map(|&l| (0..DIM).map(move |c| (l, c)))
+                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c).0)
+                .collect();
+            facets.push(SlaveFacet {
+                set_index,
+                nodes,
+                h: shortest_edge(&x_ref),
+                x_ref,
+                dofs: facet_dofs,
+            });
+        }
+        let global_facets = facet_refs.len();
+        Ok(SlaveSurface {
+            facet_type,
+            facets,
+            nqp: rule.len(),
+            qp_zeta,
+            qp_weight,
+            global_facets,
+            h: edge_sum / global_facets.max(1) as f64,
+        })
+    }
+
+    pub fn num_qps(&self) -> usize {
+        self.qp_weight.len()
+    }
+
+    /// Current position of local quadrature point `q`.
+    pub fn qp_position(&self, q: usize, u_local: &[f64]) -> [f64; 3] {
+        let facet = &self.facets[q / self.nqp];
+        let s = facet_shape(self.facet_type, self.qp_zeta[q]);
+        let mut x = [0.0; 3];
+        for (a, (&l, xr)) in facet.nodes.iter().zip(&facet.x_ref).enumerate() {
+            for c in 0..DIM {
+                x[c] += s.n[a] * (xr[c] + u_local[DIM * l as usize + c]);
+            }
+        }
+        x
+    }
+
+    /// Current nodal positions of a facet.
+    pub fn facet_positions(&self, facet: usize, u_local: &[f64], out: &mut [[f64; 3]]) {
+        current_positions(
+            &self.facets[facet].nodes,
+            &self.facets[facet].x_ref,
+            u_local,
+            out,
+        );
+    }
+}
+
+/// The master side of a deformable pair: every facet of the set, with its
+/// nodes numbered compactly (0..n) for the search, and their local indices.
+#[derive(Debug, Clone)]
+pub struct MasterSurface {
+    pub facet_type: FacetType,
+    /// Local node index (owned or ghost) of each master node.
+    pub node_local: Vec<u32>,
+    pub x_ref: Vec<[f64; 3]>,
+    /// Facets as indices into the master node arrays (tri3 uses 3).
+    pub facets: Vec<[u32; 4]>,
+}
+
+impl MasterSurface {
+    /// The natural ids of the master nodes, which every rank must ghost.
+    pub fn natural_nodes(mesh: &Mesh, set: &str) -> Result<Vec<usize>> {
+        let mut nodes: Vec<usize> = Vec::new();
+        for f in facet_set(mesh, set)? {
+            nodes.extend(mesh.facet_nodes(f)?);
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        Ok(nodes)
+    }
+
+    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str) -> Result<Self> {
+        let natural = Self::natural_nodes(mesh, set)?;
+        let node_local = natural
+            .iter()
+            .map(|&v| local_node(dofs, v))
+            .collect::<Result<Vec<_>>>()?;
+        let x_ref = natural.iter().map(|&v| mesh.nodes[v]).collect();
+        let mut facets = Vec::new();
+        for f in facet_set(mesh, set)? {
+            let mut ids = [0u32; 4];
+            for (slot, v) in ids.iter_mut().zip(mesh.facet_nodes(f)?) {
+                // `natural` is sorted, so the compact index is a binary search away.
+                *slot = natural
+                    .binary_search(&v)
+                    .map_err(|_| Error::Partition(format!("master node {v} missing")))?
+                    as u32;
+            }
+            facets.push(ids);
+        }
+        Ok(MasterSurface {
+            facet_type: mesh.cell_type.facet_type(),
+            node_local,
+            x_ref,
+            facets,
+        })
+    }
+
+    /// Current positions of all master nodes.
+    pub fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
+        let mut out = vec![[0.0; 3]; self.x_ref.len()];
+        current_positions(&self.node_local, &self.x_ref, u_local, &mut out);
+        out
+    }
+
+    pub fn facet_nodes(&self, facet: u32) -> &[u32] {
+        &self.facets[facet as usize][..self.facet_type.nodes()]
+    }
+
+    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<PetscInt>) {
+        for &m in self.facet_nodes(facet) {
+            let l = LocalNode(self.node_local[m as usize] as usize);
+            for c in 0..DIM {
+                out.push(dofs.dof(l, c).0);
+            }
+        }
+    }
+}
+
+fn shortest_edge(x: &[[f64; 3]]) -> f64 {
+    (0..x.len())
+        .map(|i| {
+            let (a, b) = (x[i], x[(i + 1) % x.len()]);
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn current_positions(nodes: &[u32], x_ref: &[[f64; 3]], u_local: &[f64], out: &mut [[f64; 3]]) {
+    for ((o, &l), xr) in out.iter_mut().zip(nodes).zip(x_ref) {
+        let b = DIM * l as usize;
+        *o = [
+            xr[0] + u_local[b],
+            xr[1] + u_local[b + 1],
+            xr[2] + u_local[b + 2],
+        ];
+    }
+}
+
+fn facet_set<'m>(mesh: &'m Mesh, set: &str) -> Result<&'m [FacetRef]> {
+    mesh.facet_sets.get(set).map(Vec::as_slice).ok_or_else(|| {
+        let known: Vec<&str> = mesh.facet_sets.keys().map(String::as_str).collect();
+        Error::scene(
+            "contact",
+            format!(
+                "facet set '{set}' does not exist (facet sets: {})",
+                known.join(", ")
+            ),
+        )
+    })
+}
+
+fn local_node(dofs: &DofMap, natural: usize) -> Result<u32> {
+    dofs.local(NaturalNode(natural))
+        .map(|l| l.0 as u32)
+        .ok_or_else(|| {
+            Error::Partition(format!(
+                "node {natural} is not visible on rank {}",
+                dofs.rank
+            ))
+        })
+}
