@@ -10,7 +10,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-serial test-mpi bench scaling lint fmt clean
+.PHONY: deps build demo test test-mpi bench hertz-study lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -46,6 +46,17 @@ bench: deps
 	for n in 1 2; do \
 	  echo "assembly benchmark on $$n rank(s)"; \
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/assembly-$$n.csv || exit 1; \
+	done
+
+# Hertz verification under refinement (figures in the README).
+hertz-study: build
+	@for args in "--set mesh.fine_size=0.2" "" "--set mesh.level=1 --set solver.direct_max_dofs=200000"; do \
+	  echo "== hertz-cylinder $$args"; \
+	  $(MPIRUN) -n 2 target/release/contactlink run hertz-cylinder -q $$args | grep -E "Hertz|done" ; \
+	done
+	@for args in "--set mesh.fine_size=0.5" ""; do \
+	  echo "== hertz-sphere $$args"; \
+	  $(MPIRUN) -n 2 target/release/contactlink run hertz-sphere -q $$args | grep -E "Hertz|done" ; \
 	done
 
 lint:

@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   petsc-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
-  libclang-dev clang pkg-config hdf5-tools
+  libclang-dev clang pkg-config hdf5-tools libopenblas0-serial
 )
 missing=()
 for p in "${packages[@]}"; do

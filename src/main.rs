@@ -145,6 +145,12 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
+            for p in &model.contact {
+                println!(
+                    "  contact {}: slave {} master {:?}",
+                    p.name, p.slave, p.master
+                );
+            }
             println!(
                 "  steps {}, output {}",
                 model.steps,
@@ -171,7 +177,8 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     let result = pipeline::run_scene(&rt, scene, &cli.run);
     let code = match result {
         Ok(summary) => {
-            if rank == 0 && cli.run.echo {
+            // -q quiets the per-step lines; the summary always prints.
+            if rank == 0 {
                 let r = &summary.report;
                 let newton: usize = r.steps.iter().map(|s| s.newton_iterations).sum();
                 println!(

@@ -163,3 +163,79 @@ fn newton_failure_is_reported_after_cutbacks() {
         "the output file is not readable"
     );
 }
+
+const CONTACT: &str = r#"
+[[contact]]
+name = "c"
+slave = "lower.top"
+master = "upper.bottom"
+"#;
+
+fn stacked(extra: &str) -> String {
+    format!(
+        r#"
+[mesh]
+generator = "stacked-blocks"
+
+[[body]]
+name = "lower"
+material = "linear-elastic"
+youngs = 100.0
+poisson = 0.3
+
+[[body]]
+name = "upper"
+material = "linear-elastic"
+youngs = 100.0
+poisson = 0.3
+
+[[dirichlet]]
+set = "lower.bottom"
+{extra}
+"#
+    )
+}
+
+#[test]
+fn contact_pair_on_missing_surface_is_named() {
+    check_fails(
+        "contact-missing",
+        &stacked(&CONTACT.replace("upper.bottom", "upper.floor")),
+        &["upper.floor", "master"],
+    );
+}
+
+#[test]
+fn contact_slave_equal_to_master_is_rejected() {
+    check_fails(
+        "contact-self",
+        &stacked(&CONTACT.replace("upper.bottom", "lower.top")),
+        &["same facet set", "lower.top"],
+    );
+}
+
+#[test]
+fn non_positive_penalty_is_rejected() {
+    check_fails(
+        "contact-penalty",
+        &stacked(&format!("{CONTACT}penalty = -3.0")),
+        &["penalty", "-3"],
+    );
+}
+
+#[test]
+fn rigid_and_master_together_are_rejected() {
+    check_fails(
+        "contact-both",
+        &stacked(&format!("{CONTACT}rigid = {{ kind = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }}")),
+        &["not both"],
+    );
+}
+
+#[test]
+fn good_contact_scene_passes_check() {
+    let dir = scratch("contact-good");
+    let path = write(&dir, "scene.toml", &stacked(CONTACT));
+    let o = run(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+}

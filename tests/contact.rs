@@ -20,13 +20,6 @@ fn dataset(path: &Path, step: usize, rel: &str) -> Vec<f64> {
         .0
 }
 
-fn points(path: &Path, step: usize, pair: &str) -> Vec<[f64; 3]> {
-    dataset(path, step, &format!("contact/{pair}/points"))
-        .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect()
-}
-
 fn run_scene(ranks: usize, scene: &str, out: &Path, extra: &[&str]) -> String {
     let mut args = vec!["run", scene, "-o", out.to_str().unwrap()];
     args.extend_from_slice(extra);
@@ -248,4 +241,51 @@ fn contact_scenes_same_on_1_2_3_ranks() {
             );
         }
     }
+}
+
+#[test]
+fn hertz_sphere_on_a_coarse_mesh_is_close_to_closed_form() {
+    // Two elements per contact radius (fine_size 0.5): a smoke test of point
+    // contact in 3D, with tolerances for that resolution; the default mesh's
+    // figures are in the README.
+    let dir = scratch("contact-hertz-sphere");
+    let out = dir.join("out.h5");
+    run_scene(
+        2,
+        "hertz-sphere",
+        &out,
+        &["--set", "mesh.fine_size=0.5", "--set", "steps.count=1"],
+    );
+    assert_balance(&out, "hertz", "sphere.curved");
+    let step = last_step(&out);
+    let nodal: Vec<([f64; 3], f64)> = nodal_pressure_on(&out, step, "sphere.curved")
+        .into_iter()
+        .filter(|(_, p)| *p > 0.0)
+        .collect();
+    let pts: Vec<[f64; 3]> = nodal.iter().map(|(x, _)| *x).collect();
+    let p: Vec<f64> = nodal.iter().map(|(_, p)| *p).collect();
+    let f = dataset(&out, step, "contact/hertz/force");
+    let check = HertzCheck {
+        kind: HertzKind::Point,
+        pair: "hertz".into(),
+        radius: 10.0,
+        effective_modulus: verify::effective_modulus(1000.0, 0.3, 1000.0, 0.3),
+    };
+    let c = verify::compare(&check, &pts, &p, [f[0], f[1], f[2]]).expect("a pressure profile");
+    println!(
+        "sphere: F = {:.5}, p0 {:.5} vs {:.5} ({:+.3} %), a {:.5} vs {:.5} ({:+.3} %)",
+        c.load,
+        c.p0,
+        c.p0_exact,
+        100.0 * c.p0_error(),
+        c.width,
+        c.width_exact,
+        100.0 * c.width_error()
+    );
+    assert!(
+        c.p0_error().abs() < 0.05 && c.width_error().abs() < 0.03,
+        "sphere errors too large: p0 {:.2} %, a {:.2} %",
+        100.0 * c.p0_error(),
+        100.0 * c.width_error()
+    );
 }

@@ -49,7 +49,7 @@ impl Default for SolverSettings {
             max_newton: 30,
             rtol: 1e-9,
             atol: None,
-            direct_max_dofs: 150_000,
+            direct_max_dofs: 50_000,
             max_cutbacks: 8,
             petsc_options: String::new(),
         }
