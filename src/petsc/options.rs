@@ -11,12 +11,33 @@ fn c_string(s: &str) -> Result<CString> {
     })
 }
 
-/// Sets `name` (with its leading dash) to `value` unless the user already set it.
+/// Options this program set as defaults (not the user): a later run in the
+/// same process may set them differently (e.g. direct solver for a small
+/// model, multigrid for a large one), while the user's own options stay.
+static PROGRAM_SET: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// Sets `name` (with its leading dash) to `value` unless the user set it.
 pub fn set_default(name: &str, value: &str) -> Result<()> {
-    if has(name)? {
+    let mut ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
+    let is_ours = ours.iter().any(|n| n == name);
+    if !is_ours && has(name)? {
         return Ok(());
     }
+    if !is_ours {
+        ours.push(name.to_owned());
+    }
     set(name, value)
+}
+
+/// Removes every default this program set, before a new run sets its own.
+pub fn clear_defaults() -> Result<()> {
+    let mut ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
+    for name in ours.drain(..) {
+        let n = c_string(&name)?;
+        // SAFETY: valid C string; clearing an absent option is not an error.
+        unsafe { petsc_call!(PetscOptionsClearValue(std::ptr::null_mut(), n.as_ptr()))? };
+    }
+    Ok(())
 }
 
 /// Sets `name` to `value` unconditionally.

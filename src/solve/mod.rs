@@ -49,7 +49,7 @@ impl Default for SolverSettings {
             max_newton: 30,
             rtol: 1e-9,
             atol: None,
-            direct_max_dofs: 50_000,
+            direct_max_dofs: 20_000,
             max_cutbacks: 8,
             petsc_options: String::new(),
         }
@@ -139,6 +139,7 @@ pub trait StepSink {
 
 /// Sets the program's PETSc defaults; the user's options win.
 fn set_solver_defaults(settings: &SolverSettings, symmetric: bool, dofs: usize) -> Result<()> {
+    petsc::options::clear_defaults()?;
     petsc::options::insert_string_defaults(&settings.petsc_options)?;
     if dofs <= settings.direct_max_dofs {
         // GMRES around the LU factors: one iteration with fresh factors, a
