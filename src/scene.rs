@@ -5,7 +5,7 @@
 //! output path. Built-in scenes live in `scenes/` and are compiled in.
 //! Every error names the key (and, for syntax errors, the line).
 use crate::assembly::FacetLoad;
-use crate::contact::{MasterSpec, PairSpec, SlaveQuadrature};
+use crate::contact::{MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
 use crate::error::{Error, Result};
 use crate::fem::{CellType, Material};
 use crate::mesh::generate::{
@@ -258,7 +258,7 @@ pub struct ContactSection {
     pub name: Option<String>,
     pub slave: String,
     pub master: Option<String>,
-    pub rigid: Option<RigidSection>,
+    pub rigid: Option<RigidSurface>,
     /// Translation of the rigid surface at full load.
     pub motion: Option<[f64; 3]>,
     pub penalty: Option<f64>,
@@ -268,24 +268,6 @@ pub struct ContactSection {
     pub search_distance: Option<f64>,
     /// "gauss" (default) or "nodal": where the slave links sit.
     pub quadrature: Option<String>,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy)]
-#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
-pub enum RigidSection {
-    Plane {
-        point: [f64; 3],
-        normal: [f64; 3],
-    },
-    Sphere {
-        centre: [f64; 3],
-        radius: f64,
-    },
-    Cylinder {
-        point: [f64; 3],
-        axis: [f64; 3],
-        radius: f64,
-    },
 }
 
 #[derive(Debug, Deserialize)]
@@ -708,7 +690,10 @@ fn contact_spec(
             }
             MasterSpec::Surface { set: m.clone() }
         }
-        (None, Some(r)) => rigid_spec(r, &at)?,
+        (None, Some(r)) => {
+            r.validate().map_err(|e| format!("{at}: {e}"))?;
+            MasterSpec::Rigid(*r)
+        }
         (Some(_), Some(_)) => {
             return Err(format!(
                 "{at}: give either master (a facet set) or rigid (an analytic surface), not both"
@@ -756,47 +741,6 @@ fn contact_spec(
         return Err(format!("{at}: max_uzawa must be at least 1"));
     }
     Ok(spec)
-}
-
-fn rigid_spec(r: &RigidSection, at: &str) -> std::result::Result<MasterSpec, String> {
-    let nonzero = |v: [f64; 3], key: &str| {
-        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if n > 0.0 && n.is_finite() {
-            Ok(v)
-        } else {
-            Err(format!("{at}: rigid {key} must be a non-zero vector"))
-        }
-    };
-    Ok(match *r {
-        RigidSection::Plane { point, normal } => MasterSpec::Plane {
-            point,
-            normal: nonzero(normal, "normal")?,
-        },
-        RigidSection::Sphere { centre, radius } => {
-            if radius.is_nan() || radius <= 0.0 {
-                return Err(format!(
-                    "{at}: rigid sphere radius must be positive (got {radius})"
-                ));
-            }
-            MasterSpec::Sphere { centre, radius }
-        }
-        RigidSection::Cylinder {
-            point,
-            axis,
-            radius,
-        } => {
-            if radius.is_nan() || radius <= 0.0 {
-                return Err(format!(
-                    "{at}: rigid cylinder radius must be positive (got {radius})"
-                ));
-            }
-            MasterSpec::Cylinder {
-                point,
-                axis: nonzero(axis, "axis")?,
-                radius,
-            }
-        }
-    })
 }
 
 /// The body a facet set lies on (its first facet's cell).

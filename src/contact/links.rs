@@ -3,7 +3,7 @@
 //! residual and tangent, and the Uzawa update of their multipliers.
 use super::link::{self, LinkInput, LinkState, Master};
 use super::multipliers::{updated_multiplier, Multipliers};
-use super::pair::{MasterSpec, PairSpec};
+use super::pair::{MasterSpec, PairSpec, RigidSurface};
 use super::search::{self, SearchIndex};
 use super::surfaces::{MasterSurface, SlaveSurface};
 use crate::dofs::{DofMap, DIM};
@@ -29,7 +29,7 @@ pub struct Link {
 /// The master side at run time.
 pub enum MasterSide {
     Deformable(MasterSurface),
-    Rigid(MasterSpec),
+    Rigid(RigidSurface),
 }
 
 /// What an Uzawa update found on this rank (reduced over ranks by the caller).
@@ -90,7 +90,7 @@ impl ContactPair {
             MasterSpec::Surface { set } => {
                 MasterSide::Deformable(MasterSurface::new(mesh, dofs, set)?)
             }
-            rigid => MasterSide::Rigid(rigid.clone()),
+            MasterSpec::Rigid(r) => MasterSide::Rigid(*r),
         };
         let multipliers = Multipliers::new(mesh, dofs, partition, &spec.slave, &slave, &rule)?;
         let penalty = spec.penalty.unwrap_or(10.0 * softest_youngs / slave.h);
@@ -186,9 +186,9 @@ impl ContactPair {
                 }
             }
             MasterSide::Rigid(spec) => {
-                let geometry = rigid_at(spec, &self.spec.motion, factor);
+                let geometry = spec.moved(self.spec.motion, factor);
                 for (q, x) in points.iter().enumerate() {
-                    if rigid_distance(&geometry, *x) <= self.search_distance {
+                    if geometry.distance(*x) <= self.search_distance {
                         self.links.push(Link {
                             qp: q as u32,
                             facet: 0,
@@ -319,7 +319,7 @@ impl ContactPair {
                         x: &xm[..fnodes.len()],
                     }
                 }
-                MasterSide::Rigid(spec) => rigid_at(spec, &self.spec.motion, factor).as_master(),
+                MasterSide::Rigid(spec) => spec.moved(self.spec.motion, factor).as_master(),
             };
             let input = LinkInput {
                 slave_facet: self.slave.facet_type,
@@ -446,7 +446,7 @@ impl ContactPair {
                         x: &xm[..fnodes.len()],
                     }
                 }
-                MasterSide::Rigid(spec) => rigid_at(spec, &self.spec.motion, factor).as_master(),
+                MasterSide::Rigid(spec) => spec.moved(self.spec.motion, factor).as_master(),
             };
             out.push(link::evaluate(&LinkInput {
                 slave_facet: self.slave.facet_type,
@@ -533,107 +533,12 @@ fn still_inside(
     (p.converged && p.outside <= STICKY).then_some(p)
 }
 
-/// A rigid master placed at load factor `factor`.
-#[derive(Debug, Clone, Copy)]
-pub enum RigidGeometry {
-    Plane {
-        point: [f64; 3],
-        normal: [f64; 3],
-    },
-    Sphere {
-        centre: [f64; 3],
-        radius: f64,
-    },
-    Cylinder {
-        point: [f64; 3],
-        axis: [f64; 3],
-        radius: f64,
-    },
-}
-
-impl RigidGeometry {
-    fn as_master(&self) -> Master<'static> {
-        match *self {
-            RigidGeometry::Plane { point, normal } => Master::Plane { point, normal },
-            RigidGeometry::Sphere { centre, radius } => Master::Sphere { centre, radius },
-            RigidGeometry::Cylinder {
-                point,
-                axis,
-                radius,
-            } => Master::Cylinder {
-                point,
-                axis,
-                radius,
-            },
-        }
-    }
-}
-
-fn shifted(p: [f64; 3], motion: &[f64; 3], factor: f64) -> [f64; 3] {
-    [
-        p[0] + factor * motion[0],
-        p[1] + factor * motion[1],
-        p[2] + factor * motion[2],
-    ]
-}
-
-fn rigid_at(spec: &MasterSpec, motion: &[f64; 3], factor: f64) -> RigidGeometry {
-    match *spec {
-        MasterSpec::Plane { point, normal } => RigidGeometry::Plane {
-            point: shifted(point, motion, factor),
-            normal: unit(normal),
-        },
-        MasterSpec::Sphere { centre, radius } => RigidGeometry::Sphere {
-            centre: shifted(centre, motion, factor),
-            radius,
-        },
-        MasterSpec::Cylinder {
-            point,
-            axis,
-            radius,
-        } => RigidGeometry::Cylinder {
-            point: shifted(point, motion, factor),
-            axis: unit(axis),
-            radius,
-        },
-        MasterSpec::Surface { .. } => RigidGeometry::Plane {
-            point: [0.0; 3],
-            normal: [0.0, 0.0, 1.0],
-        },
-    }
-}
-
-fn unit(v: [f64; 3]) -> [f64; 3] {
-    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / n, v[1] / n, v[2] / n]
-}
-
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Distance of a point from a rigid surface (negative inside).
-fn rigid_distance(g: &RigidGeometry, x: [f64; 3]) -> f64 {
-    match *g {
-        RigidGeometry::Plane { point, normal } => dot(sub(x, point), normal),
-        RigidGeometry::Sphere { centre, radius } => {
-            dot(sub(x, centre), sub(x, centre)).sqrt() - radius
-        }
-        RigidGeometry::Cylinder {
-            point,
-            axis,
-            radius,
-        } => {
-            let d = sub(x, point);
-            let along = dot(d, axis);
-            let radial = sub(d, [along * axis[0], along * axis[1], along * axis[2]]);
-            dot(radial, radial).sqrt() - radius
-        }
-    }
 }
 
 /// Default search distance: generous enough that bodies approaching within a

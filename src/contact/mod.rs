@@ -20,4 +20,4 @@ pub mod search;
 pub mod surfaces;
 
 pub use links::{ContactPair, UzawaStats};
-pub use pair::{MasterSpec, PairSpec, SlaveQuadrature};
+pub use pair::{MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

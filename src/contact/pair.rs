@@ -1,23 +1,15 @@
 //! Contact pairs as a scene states them: which surfaces meet, the penalty, and
 //! the Uzawa tolerances.
+use super::link::Master;
 
-/// The master side of a pair: a facet set of a deformable body, or a rigid
-/// analytic surface (no DOFs) that moves by a prescribed translation.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MasterSpec {
-    Surface {
-        set: String,
-    },
+/// A rigid analytic master surface (no DOFs), as given at load factor 0.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum RigidSurface {
     /// Half-space below `point` with outward `normal` (the slave stays on the normal side).
-    Plane {
-        point: [f64; 3],
-        normal: [f64; 3],
-    },
+    Plane { point: [f64; 3], normal: [f64; 3] },
     /// Rigid ball; the slave stays outside.
-    Sphere {
-        centre: [f64; 3],
-        radius: f64,
-    },
+    Sphere { centre: [f64; 3], radius: f64 },
     /// Rigid infinite cylinder; the slave stays outside.
     Cylinder {
         point: [f64; 3],
@@ -26,9 +18,127 @@ pub enum MasterSpec {
     },
 }
 
+impl RigidSurface {
+    /// Why the surface is unusable, if it is.
+    pub fn validate(&self) -> Result<(), String> {
+        let nonzero = |v: [f64; 3], key: &str| {
+            let n = norm(v);
+            if n > 0.0 && n.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("rigid {key} must be a non-zero vector"))
+            }
+        };
+        let positive = |r: f64| {
+            if r > 0.0 && r.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("rigid radius must be positive (got {r})"))
+            }
+        };
+        match *self {
+            RigidSurface::Plane { normal, .. } => nonzero(normal, "normal"),
+            RigidSurface::Sphere { radius, .. } => positive(radius),
+            RigidSurface::Cylinder { axis, radius, .. } => {
+                nonzero(axis, "axis").and(positive(radius))
+            }
+        }
+    }
+
+    /// The surface translated by `factor · motion`, with unit normal or axis.
+    pub fn moved(&self, motion: [f64; 3], factor: f64) -> Self {
+        let shift = |p: [f64; 3]| {
+            [
+                p[0] + factor * motion[0],
+                p[1] + factor * motion[1],
+                p[2] + factor * motion[2],
+            ]
+        };
+        match *self {
+            RigidSurface::Plane { point, normal } => RigidSurface::Plane {
+                point: shift(point),
+                normal: unit(normal),
+            },
+            RigidSurface::Sphere { centre, radius } => RigidSurface::Sphere {
+                centre: shift(centre),
+                radius,
+            },
+            RigidSurface::Cylinder {
+                point,
+                axis,
+                radius,
+            } => RigidSurface::Cylinder {
+                point: shift(point),
+                axis: unit(axis),
+                radius,
+            },
+        }
+    }
+
+    /// The link kernel's view of the surface.
+    pub fn as_master(&self) -> Master<'static> {
+        match *self {
+            RigidSurface::Plane { point, normal } => Master::Plane { point, normal },
+            RigidSurface::Sphere { centre, radius } => Master::Sphere { centre, radius },
+            RigidSurface::Cylinder {
+                point,
+                axis,
+                radius,
+            } => Master::Cylinder {
+                point,
+                axis,
+                radius,
+            },
+        }
+    }
+
+    /// Signed distance of `x` from the surface (negative inside the rigid body),
+    /// for a surface placed by `moved`.
+    pub fn distance(&self, x: [f64; 3]) -> f64 {
+        match *self {
+            RigidSurface::Plane { point, normal } => dot(sub(x, point), normal),
+            RigidSurface::Sphere { centre, radius } => norm(sub(x, centre)) - radius,
+            RigidSurface::Cylinder {
+                point,
+                axis,
+                radius,
+            } => {
+                let d = sub(x, point);
+                let along = dot(d, axis);
+                norm(sub(d, [along * axis[0], along * axis[1], along * axis[2]])) - radius
+            }
+        }
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = norm(v);
+    [v[0] / n, v[1] / n, v[2] / n]
+}
+
+/// The master side of a pair: a facet set of a deformable body, or a rigid
+/// analytic surface that moves by a prescribed translation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MasterSpec {
+    Surface { set: String },
+    Rigid(RigidSurface),
+}
+
 impl MasterSpec {
     pub fn is_rigid(&self) -> bool {
-        !matches!(self, MasterSpec::Surface { .. })
+        matches!(self, MasterSpec::Rigid(_))
     }
 }
 

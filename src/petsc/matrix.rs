@@ -109,19 +109,7 @@ impl PatternBuilder {
 
 impl BlockSink for PatternBuilder {
     fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
-        // SAFETY: values has rows*cols entries (caller's contract, checked in debug).
-        debug_assert_eq!(rows.len() * cols.len(), values.len());
-        unsafe {
-            petsc_call!(MatSetValues(
-                self.raw,
-                rows.len() as PetscInt,
-                rows.as_ptr(),
-                cols.len() as PetscInt,
-                cols.as_ptr(),
-                values.as_ptr(),
-                sys::InsertMode_INSERT_VALUES
-            ))
-        }
+        set_values(self.raw, rows, cols, values, sys::InsertMode_INSERT_VALUES)
     }
 }
 
@@ -163,19 +151,7 @@ impl Matrix {
         cols: &[PetscInt],
         values: &[f64],
     ) -> Result<()> {
-        debug_assert_eq!(rows.len() * cols.len(), values.len());
-        // SAFETY: values has rows*cols entries in row-major order as MatSetValues expects.
-        unsafe {
-            petsc_call!(MatSetValues(
-                self.raw,
-                rows.len() as PetscInt,
-                rows.as_ptr(),
-                cols.len() as PetscInt,
-                cols.as_ptr(),
-                values.as_ptr(),
-                sys::InsertMode_ADD_VALUES
-            ))
-        }
+        set_values(self.raw, rows, cols, values, sys::InsertMode_ADD_VALUES)
     }
 
     pub fn assemble(&mut self) -> Result<()> {
@@ -297,5 +273,40 @@ impl Matrix {
                 sys::MatStructure_SUBSET_NONZERO_PATTERN
             ))
         }
+    }
+}
+
+/// MatSetValues for a dense row-major block.
+fn set_values(
+    raw: sys::Mat,
+    rows: &[PetscInt],
+    cols: &[PetscInt],
+    values: &[f64],
+    mode: sys::InsertMode,
+) -> Result<()> {
+    if rows.len() * cols.len() != values.len() {
+        return Err(super::PetscError {
+            call: "MatSetValues",
+            code: -1,
+            message: format!(
+                "{} values for a {}×{} block",
+                values.len(),
+                rows.len(),
+                cols.len()
+            ),
+        });
+    }
+    // SAFETY: `raw` is a valid matrix owned by the caller; values holds
+    // rows × cols entries in row-major order, as MatSetValues reads them.
+    unsafe {
+        petsc_call!(MatSetValues(
+            raw,
+            rows.len() as PetscInt,
+            rows.as_ptr(),
+            cols.len() as PetscInt,
+            cols.as_ptr(),
+            values.as_ptr(),
+            mode
+        ))
     }
 }
