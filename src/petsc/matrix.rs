@@ -65,14 +65,7 @@ impl PatternBuilder {
         // SAFETY: the preallocator is assembled before use; the new matrix has the
         // same sizes; out-pointer valid.
         unsafe {
-            petsc_call!(MatAssemblyBegin(
-                self.raw,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(
-                self.raw,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
+            final_assembly(self.raw)?;
             petsc_call!(MatCreate(comm_world(), &mut raw))?;
             let m = Matrix { raw, owned: true };
             petsc_call!(MatSetSizes(
@@ -155,17 +148,7 @@ impl Matrix {
     }
 
     pub fn assemble(&mut self) -> Result<()> {
-        // SAFETY: valid mat; begin/end paired.
-        unsafe {
-            petsc_call!(MatAssemblyBegin(
-                self.raw,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(
-                self.raw,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))
-        }
+        final_assembly(self.raw)
     }
 
     /// Replaces rows and columns of constrained DOFs by the identity, keeping
@@ -308,5 +291,17 @@ fn set_values(
             values.as_ptr(),
             mode
         ))
+    }
+}
+
+/// MatAssemblyBegin/End, final assembly.
+fn final_assembly(raw: sys::Mat) -> Result<()> {
+    // SAFETY: `raw` is a valid matrix owned by the caller; begin/end are paired.
+    unsafe {
+        petsc_call!(MatAssemblyBegin(
+            raw,
+            sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+        ))?;
+        petsc_call!(MatAssemblyEnd(raw, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY))
     }
 }
