@@ -23,9 +23,21 @@
 //!   derivative of ξ̄. Gap, normal and forces are then evaluated in duals, so
 //!   the change of ξ̄ and ν (curvature terms) is included.
 //!
-//! Friction (DESIGN.md §4) will add a tangential traction to the same force
-//! loop (`normal_forces` is the only place forces are formed) and needs the
-//! dual-valued ξ and tangents that `facet_kinematics` already computes.
+//! Coulomb friction (DESIGN.md §4), when the input carries a [`Friction`]:
+//! - slip increment ΔgT in the master's convected frame: `(ξ̄ − ξ̄ₙ)^α τ_α`
+//!   on a facet, the tangential move of the contact point on a rigid master,
+//!   or `Δt · vT` (relative tangential velocity) in dynamics;
+//! - λT held fixed during Newton (covariant components `λ_α = λT·τ_α` on a
+//!   facet, so a rigid rotation of the master carries it along), trial
+//!   `tT* = λT + εT ΔgT`, stick if `|tT*| ≤ μ pN`, else the return map
+//!   `tT = μ pN tT*/|tT*|`;
+//! - virtual work `∫ tT·τ_α δξ̄^α w` (the master point's convected
+//!   variation), `r_slave = N¹_a τ_β c^β w`, `r_master = (−N²_b τ_β +
+//!   (x¹ − x²) N²_b,β) c^β w` with `c = H⁻¹ [tT·τ_α]`, written explicitly in
+//!   the scalar type so the dual pass differentiates it exactly: the slip
+//!   branch, the coupling to pN and (in dynamics) the damping term
+//!   `∂r/∂v · ∂v/∂x` all land in `k`, which is then non-symmetric.
+//! `r` and `k` include the friction only when the link is closed.
 
 use thiserror::Error;
 
@@ -52,6 +64,58 @@ pub enum Master<'a> {
     },
 }
 
+/// Where slip is measured from, and the tangential multiplier λT (held
+/// fixed during Newton). The variant must match the master kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SlipHistory {
+    /// Deformable master: `ξ̄ₙ` on the link's facet (the master point of the
+    /// last converged step) and λT's covariant components `λT·τ_α` there.
+    Convected { xi_n: [f64; 2], lambda: [f64; 2] },
+    /// Rigid master: the last converged contact point, moved with the
+    /// master to its current placement, and λT as a vector (a rigid master
+    /// only translates, so a fixed frame is its convected frame).
+    Spatial { point_n: [f64; 3], lambda: [f64; 3] },
+}
+
+/// Nodal velocities for the dynamic slip rate `ΔgT = Δt · vT`. The time
+/// integrator makes the velocity affine in the displacement, `v = v̄ +
+/// dv_dx · (x − x̄)` about the current state, which is how the damping
+/// contribution `∂r/∂v` enters the tangent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlipRate<'a> {
+    pub slave_v: &'a [[f64; 3]],
+    /// Master facet node velocities (one per master node), or one entry: the
+    /// velocity of a rigid master.
+    pub master_v: &'a [[f64; 3]],
+    pub dt: f64,
+    /// `∂v/∂u` of the integrator (`γ/(βΔt)` for Newmark).
+    pub dv_dx: f64,
+}
+
+/// Coulomb friction of one link.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Friction<'a> {
+    pub mu: f64,
+    /// Tangential penalty εT > 0.
+    pub penalty: f64,
+    pub history: SlipHistory,
+    /// Dynamics: slip from the relative velocity instead of `ξ̄ − ξ̄ₙ`.
+    pub rate: Option<SlipRate<'a>>,
+}
+
+/// Friction values of a closed link (f64).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionState {
+    /// Tangential traction on the slave per reference area (`−tT`).
+    pub traction: [f64; 3],
+    /// Slip increment ΔgT of the step (slave relative to master, in space).
+    pub slip: [f64; 3],
+    pub sliding: bool,
+    /// What the Uzawa update stores: λT ← tT (same variant as the input)
+    /// with the current master point as the next `ξ̄ₙ` / `point_n`.
+    pub updated: SlipHistory,
+}
+
 /// Everything one link evaluation needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinkInput<'a> {
@@ -69,6 +133,8 @@ pub struct LinkInput<'a> {
     pub lambda_n: f64,
     /// Penalty εN > 0.
     pub penalty: f64,
+    /// Coulomb friction; `None` is frictionless (no tangential work at all).
+    pub friction: Option<Friction<'a>>,
 }
 
 /// What a link evaluation reports (f64 values, no derivatives).
@@ -92,6 +158,8 @@ pub struct LinkState {
     /// How far ξ̄ lies outside the master facet (see
     /// [`projection::Projection::outside`]); 0 for rigid masters.
     pub outside: f64,
+    /// Present when the input has friction and the link is closed.
+    pub friction: Option<FrictionState>,
 }
 
 impl LinkState {
@@ -107,6 +175,7 @@ impl LinkState {
             master_point: [0.0; 3],
             projection_converged: false,
             outside: f64::INFINITY,
+            friction: None,
         }
     }
 }
@@ -193,6 +262,9 @@ pub fn check_input(input: &LinkInput) -> Result<(), LinkError> {
     non_negative("weight", input.weight, false)?;
     non_negative("lambda_n", input.lambda_n, false)?;
     non_negative("penalty", input.penalty, true)?;
+    if let Some(f) = &input.friction {
+        check_friction(input, f)?;
+    }
     match input.master {
         Master::Facet { facet, x } => facet_nodes("master x", facet, x),
         Master::Plane { point, normal } => {
@@ -213,6 +285,48 @@ pub fn check_input(input: &LinkInput) -> Result<(), LinkError> {
             non_negative("cylinder radius", radius, true)
         }
     }
+}
+
+fn check_friction(input: &LinkInput, f: &Friction) -> Result<(), LinkError> {
+    non_negative("friction coefficient", f.mu, false)?;
+    non_negative("tangential penalty", f.penalty, true)?;
+    let rigid = !matches!(input.master, Master::Facet { .. });
+    match f.history {
+        SlipHistory::Convected { xi_n, lambda } if !rigid => {
+            finite("xi_n", &xi_n)?;
+            finite("lambda_t", &lambda)?;
+        }
+        SlipHistory::Spatial { point_n, lambda } if rigid => {
+            finite("point_n", &point_n)?;
+            finite("lambda_t", &lambda)?;
+        }
+        _ => {
+            return Err(LinkError::OutOfRange {
+                what: "slip history",
+                value: f64::NAN,
+                must: "convected for facet masters, spatial for rigid ones",
+            })
+        }
+    }
+    if let Some(rate) = &f.rate {
+        non_negative("time step", rate.dt, true)?;
+        non_negative("dv_dx", rate.dv_dx, false)?;
+        let expected_master = if rigid { 1 } else { master_nodes(&input.master) };
+        for (what, v, n) in [
+            ("slave velocities", rate.slave_v, input.slave_facet.nodes()),
+            ("master velocities", rate.master_v, expected_master),
+        ] {
+            if v.len() != n {
+                return Err(LinkError::NodeCount {
+                    what,
+                    expected: n,
+                    got: v.len(),
+                });
+            }
+            finite(what, v.as_flattened())?;
+        }
+    }
+    Ok(())
 }
 
 /// Checks the lengths of the output buffers of [`residual_tangent`].
@@ -274,14 +388,33 @@ fn slave_point<T: Scalar>(facet: FacetType, zeta: [f64; 2], x: &[Vec3<T>]) -> Ve
     p
 }
 
-/// Normal gap, normal and master shape values at the closest point, in
-/// scalar type `T` (f64 or dual).
+/// Gap, normal, master shape values and the convected frame at the closest
+/// point, in scalar type `T` (f64 or dual).
 struct Kinematics<T> {
+    /// `x¹ − x²(ξ̄)` (= gN ν at the closest point).
+    separation: Vec3<T>,
     gap: T,
     normal: Vec3<T>,
     master_point: Vec3<T>,
     /// `N²_b(ξ̄)` for a facet master (first `n_m` entries).
     master_n: [T; MAX_FACET_NODES],
+    frame: Frame<T>,
+}
+
+/// How the master point moves along the surface (what friction needs).
+enum Frame<T> {
+    /// Master facet: ξ̄ (dual-valued, so it carries ∂ξ̄/∂u), tangents τ_α,
+    /// the projection Hessian `H = [h11, h12, h22]` and `N²_b,α(ξ̄)`.
+    Facet {
+        xi: [T; 2],
+        tangents: [Vec3<T>; 2],
+        hessian: [T; 3],
+        master_dn: [[T; 2]; MAX_FACET_NODES],
+    },
+    /// Rigid master: the contact point's derivative with respect to x¹ is
+    /// `J = a⊗a + s (I − a⊗a − ν⊗ν)` (plane: s = 1 and no axis; sphere:
+    /// s = R/|x¹ − c|; cylinder: s = R/(distance to the axis), a the axis).
+    Rigid { scale: T, axis: Option<[f64; 3]> },
 }
 
 /// Relative threshold for a singular projection Hessian or a vanishing
@@ -329,18 +462,34 @@ fn facet_kinematics<T: Scalar>(
     let t1 = dual::add(&t1, &dual::scale(&t12, d2));
     let t2 = dual::add(&t2, &dual::scale(&t12, d1));
     let mut master_n = [T::from_f64(0.0); MAX_FACET_NODES];
-    for (b, nb) in master_n.iter_mut().enumerate().take(xm.len()) {
-        *nb = d1 * s.dn[b][0] + d2 * s.dn[b][1] + d12 * m[b] + s.n[b];
+    let mut master_dn = [[T::from_f64(0.0); 2]; MAX_FACET_NODES];
+    for b in 0..xm.len() {
+        master_n[b] = d1 * s.dn[b][0] + d2 * s.dn[b][1] + d12 * m[b] + s.n[b];
+        master_dn[b] = [d2 * m[b] + s.dn[b][0], d1 * m[b] + s.dn[b][1]];
     }
     let normal = unit(
         &dual::cross(&t1, &t2),
         dual::norm(&t1).re() * dual::norm(&t2).re(),
     )?;
+    let separation = dual::sub(x1, &x2);
+    // The Hessian at ξ̄ + Δ (not ξ̄), so its derivative includes the move of ξ̄.
+    let hessian = [
+        dual::dot(&t1, &t1),
+        dual::dot(&t1, &t2) - dual::dot(&separation, &t12),
+        dual::dot(&t2, &t2),
+    ];
     Some(Kinematics {
-        gap: dual::dot(&dual::sub(x1, &x2), &normal),
+        gap: dual::dot(&separation, &normal),
+        separation,
         normal,
         master_point: x2,
         master_n,
+        frame: Frame::Facet {
+            xi: [d1 + xi_bar[0], d2 + xi_bar[1]],
+            tangents: [t1, t2],
+            hessian,
+            master_dn,
+        },
     })
 }
 
@@ -359,39 +508,45 @@ fn unit_f64(v: [f64; 3]) -> [f64; 3] {
 /// undefined (slave point at the sphere centre / on the cylinder axis).
 fn rigid_kinematics<T: Scalar>(x1: &Vec3<T>, master: &Master) -> Option<Kinematics<T>> {
     let no_nodes = [T::from_f64(0.0); MAX_FACET_NODES];
-    let (normal, gap, master_point) = match *master {
+    let one = T::from_f64(1.0);
+    let (normal, gap, master_point, scale, axis) = match *master {
         Master::Plane { point, normal } => {
             let n = dual::constant3::<T>(unit_f64(normal));
             let gap = dual::dot(&dual::sub(x1, &dual::constant3(point)), &n);
             let foot = dual::sub(x1, &dual::scale(&n, gap));
-            (n, gap, foot)
+            (n, gap, foot, one, None)
         }
         Master::Sphere { centre, radius } => {
             let c = dual::constant3::<T>(centre);
             let n = unit(&dual::sub(x1, &c), radius)?;
-            let gap = dual::dot(&dual::sub(x1, &c), &n) - radius;
-            (n, gap, dual::add(&c, &dual::scale_f64(&n, radius)))
+            let dist = dual::dot(&dual::sub(x1, &c), &n);
+            let foot = dual::add(&c, &dual::scale_f64(&n, radius));
+            (n, dist - radius, foot, dist.recip() * radius, None)
         }
         Master::Cylinder {
             point,
             axis,
             radius,
         } => {
-            let a = dual::constant3::<T>(unit_f64(axis));
+            let a_f = unit_f64(axis);
+            let a = dual::constant3::<T>(a_f);
             let d = dual::sub(x1, &dual::constant3(point));
             let along = dual::scale(&a, dual::dot(&d, &a));
             let n = unit(&dual::sub(&d, &along), radius)?;
-            let gap = dual::dot(&dual::sub(&d, &along), &n) - radius;
+            let dist = dual::dot(&dual::sub(&d, &along), &n);
             let base = dual::add(&dual::constant3(point), &along);
-            (n, gap, dual::add(&base, &dual::scale_f64(&n, radius)))
+            let foot = dual::add(&base, &dual::scale_f64(&n, radius));
+            (n, dist - radius, foot, dist.recip() * radius, Some(a_f))
         }
         Master::Facet { .. } => return None,
     };
     Some(Kinematics {
+        separation: dual::sub(x1, &master_point),
         gap,
         normal,
         master_point,
         master_n: no_nodes,
+        frame: Frame::Rigid { scale, axis },
     })
 }
 
@@ -401,27 +556,178 @@ fn closed_pressure<T: Scalar>(input: &LinkInput, gap: T) -> T {
     -(gap * input.penalty) + input.lambda_n
 }
 
-/// The normal contact forces `r = −pN ∂gN/∂u · w`, handed to `emit(dof,
-/// value)`: slave `−pN N¹_a ν w`, master `+pN N²_b ν w`.
-fn normal_forces<T: Scalar>(
+/// `v − ν (ν·v)`.
+fn tangential<T: Scalar>(v: &Vec3<T>, normal: &Vec3<T>) -> Vec3<T> {
+    dual::sub(v, &dual::scale(normal, dual::dot(normal, v)))
+}
+
+/// `Σ N_a (v̄_a + dv_dx (x_a − x̄_a))`: the integrator's velocity, affine in
+/// the positions, interpolated with shape values `n`.
+fn interpolated_velocity<T: Scalar>(n: &[T], x: &[Vec3<T>], v: &[[f64; 3]], dv_dx: f64) -> Vec3<T> {
+    let mut out = dual::constant3::<T>([0.0; 3]);
+    for ((na, xa), va) in n.iter().zip(x).zip(v) {
+        for i in 0..3 {
+            out[i] = out[i] + *na * ((xa[i] - xa[i].re()) * dv_dx + va[i]);
+        }
+    }
+    out
+}
+
+/// Slip increment ΔgT of the slave relative to the master.
+fn slip_increment<T: Scalar>(
+    input: &LinkInput,
+    friction: &Friction,
+    kin: &Kinematics<T>,
+    slave: &[Vec3<T>],
+    master: &[Vec3<T>],
+) -> Vec3<T> {
+    if let Some(rate) = &friction.rate {
+        let s = facet_shape(input.slave_facet, input.zeta);
+        let n_slave = s.n.map(T::from_f64);
+        let v1 = interpolated_velocity(&n_slave[..slave.len()], slave, rate.slave_v, rate.dv_dx);
+        let v2 = match kin.frame {
+            Frame::Facet { .. } => interpolated_velocity(
+                &kin.master_n[..master.len()],
+                master,
+                rate.master_v,
+                rate.dv_dx,
+            ),
+            Frame::Rigid { .. } => dual::constant3(rate.master_v[0]),
+        };
+        return dual::scale_f64(&tangential(&dual::sub(&v1, &v2), &kin.normal), rate.dt);
+    }
+    match (&kin.frame, friction.history) {
+        (Frame::Facet { xi, tangents, .. }, SlipHistory::Convected { xi_n, .. }) => dual::add(
+            &dual::scale(&tangents[0], xi[0] - xi_n[0]),
+            &dual::scale(&tangents[1], xi[1] - xi_n[1]),
+        ),
+        (Frame::Rigid { .. }, SlipHistory::Spatial { point_n, .. }) => tangential(
+            &dual::sub(&kin.master_point, &dual::constant3(point_n)),
+            &kin.normal,
+        ),
+        // `check_input` rejects a history that does not match the master.
+        _ => dual::constant3([0.0; 3]),
+    }
+}
+
+/// λT as a vector in the current tangent plane.
+fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Vec3<T> {
+    match (&kin.frame, history) {
+        (Frame::Facet { tangents: [t1, t2], .. }, SlipHistory::Convected { lambda, .. }) => {
+            // Contravariant basis m^α = M^{αβ} τ_β, so that λT·τ_α = λ_α.
+            let (m11, m12, m22) = (dual::dot(t1, t1), dual::dot(t1, t2), dual::dot(t2, t2));
+            let det = m11 * m22 - m12 * m12;
+            let c1 = (m22 * lambda[0] - m12 * lambda[1]) / det;
+            let c2 = (m11 * lambda[1] - m12 * lambda[0]) / det;
+            dual::add(&dual::scale(t1, c1), &dual::scale(t2, c2))
+        }
+        (_, SlipHistory::Spatial { lambda, .. }) => {
+            tangential(&dual::constant3(lambda), &kin.normal)
+        }
+        _ => dual::constant3([0.0; 3]),
+    }
+}
+
+/// The friction law at one link: trial, stick/slip decision (on the f64
+/// value) and return map. Returns `tT` (the traction resisting the slip).
+fn friction_traction<T: Scalar>(
+    friction: &Friction,
+    kin: &Kinematics<T>,
+    pressure: T,
+    slip: &Vec3<T>,
+) -> (Vec3<T>, bool) {
+    let lambda = multiplier_vector(friction.history, kin);
+    let trial = dual::add(&lambda, &dual::scale_f64(slip, friction.penalty));
+    let size = dual::norm(&trial);
+    let limit = pressure * friction.mu;
+    if size.re() > limit.re() && size.re() > 0.0 {
+        (dual::scale(&trial, limit / size), true)
+    } else {
+        (trial, false)
+    }
+}
+
+/// The contact forces of one link (normal, plus friction when the input has
+/// it), handed to `emit(dof, value)` once per DOF. Slave node `a` gets
+/// `N¹_a (g − pN ν) w`; master node `b` gets `(pN ν − g) N²_b w + (x¹ − x²)
+/// c^α N²_b,α w`, where `g = τ_α c^α` (facet) or `Jᵀ tT` (rigid) is the
+/// friction's generalized force and `c = H⁻¹ [tT·τ_α]`.
+fn link_forces<T: Scalar>(
     input: &LinkInput,
     kin: &Kinematics<T>,
-    n_master: usize,
+    slave: &[Vec3<T>],
+    master: &[Vec3<T>],
     mut emit: impl FnMut(usize, T),
-) {
+) -> Option<FrictionState> {
     let s = facet_shape(input.slave_facet, input.zeta);
     let ns = input.slave_facet.nodes();
-    let force = dual::scale(&kin.normal, closed_pressure(input, kin.gap) * input.weight);
+    let n_master = master.len();
+    let pressure = closed_pressure(input, kin.gap);
+    let mut common = dual::scale(&kin.normal, -pressure);
+    let mut master_extra = [T::from_f64(0.0); MAX_FACET_NODES];
+    let mut state = None;
+    if let Some(friction) = &input.friction {
+        let slip = slip_increment(input, friction, kin, slave, master);
+        let (traction, sliding) = friction_traction(friction, kin, pressure, &slip);
+        let (g, updated) = match &kin.frame {
+            Frame::Facet {
+                xi,
+                tangents: [t1, t2],
+                hessian: [h11, h12, h22],
+                master_dn,
+            } => {
+                let t = [dual::dot(&traction, t1), dual::dot(&traction, t2)];
+                let det = *h11 * *h22 - *h12 * *h12;
+                let c1 = (*h22 * t[0] - *h12 * t[1]) / det;
+                let c2 = (*h11 * t[1] - *h12 * t[0]) / det;
+                for (extra, dn) in master_extra.iter_mut().zip(master_dn).take(n_master) {
+                    *extra = c1 * dn[0] + c2 * dn[1];
+                }
+                let g = dual::add(&dual::scale(t1, c1), &dual::scale(t2, c2));
+                let updated = SlipHistory::Convected {
+                    xi_n: [xi[0].re(), xi[1].re()],
+                    lambda: [t[0].re(), t[1].re()],
+                };
+                (g, updated)
+            }
+            Frame::Rigid { scale, axis } => {
+                let along = match axis {
+                    Some(a) => {
+                        let a = dual::constant3::<T>(*a);
+                        dual::scale(&a, dual::dot(&a, &traction))
+                    }
+                    None => dual::constant3([0.0; 3]),
+                };
+                let across = tangential(&dual::sub(&traction, &along), &kin.normal);
+                let g = dual::add(&along, &dual::scale(&across, *scale));
+                let updated = SlipHistory::Spatial {
+                    point_n: dual::re3(&kin.master_point),
+                    lambda: dual::re3(&traction),
+                };
+                (g, updated)
+            }
+        };
+        common = dual::add(&common, &g);
+        state = Some(FrictionState {
+            traction: dual::re3(&traction).map(|v| -v),
+            slip: dual::re3(&slip),
+            sliding,
+            updated,
+        });
+    }
+    let common = dual::scale_f64(&common, input.weight);
     for a in 0..ns {
-        for (i, fi) in force.iter().enumerate() {
-            emit(3 * a + i, -(*fi * s.n[a]));
+        for (i, ci) in common.iter().enumerate() {
+            emit(3 * a + i, *ci * s.n[a]);
         }
     }
     for b in 0..n_master {
-        for (i, fi) in force.iter().enumerate() {
-            emit(3 * (ns + b) + i, *fi * kin.master_n[b]);
+        for i in 0..3 {
+            let extra = kin.separation[i] * master_extra[b] * input.weight;
+            emit(3 * (ns + b) + i, extra - common[i] * kin.master_n[b]);
         }
     }
+    state
 }
 
 /// Kinematics for either master kind, with slave and master nodal
@@ -466,20 +772,18 @@ fn master_x<'a>(input: &LinkInput<'a>) -> &'a [[f64; 3]] {
 }
 
 /// Residual only (f64 path; the Newton step is then a harmless polish).
-fn residual_f64(input: &LinkInput, xi_bar: [f64; 2], r: &mut [f64]) -> bool {
+/// `None` where the kernel has no usable closest point.
+fn residual_f64(input: &LinkInput, xi_bar: [f64; 2], r: &mut [f64]) -> Option<Option<FrictionState>> {
     let ns = input.slave_facet.nodes();
     let xm = master_x(input);
     let slave = nodes_as::<f64>(input.slave_x);
     let master = nodes_as::<f64>(xm);
-    let Some(kin) = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar) else {
-        return false;
-    };
-    normal_forces(input, &kin, xm.len(), |dof, v| {
+    let kin = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
+    Some(link_forces(input, &kin, &slave[..ns], &master[..xm.len()], |dof, v| {
         if let Some(ri) = r.get_mut(dof) {
             *ri = v;
         }
-    });
-    true
+    }))
 }
 
 /// Residual and tangent with `N` = number of link DOFs.
@@ -488,25 +792,27 @@ fn residual_dual<const N: usize>(
     xi_bar: [f64; 2],
     r: &mut [f64],
     k: &mut [f64],
-) -> bool {
+) -> Option<Option<FrictionState>> {
     let ns = input.slave_facet.nodes();
     let xm = master_x(input);
     let slave = seed::<N>(input.slave_x, 0);
     let master = seed::<N>(xm, 3 * ns);
-    let Some(kin) = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar) else {
-        return false;
-    };
-    normal_forces(input, &kin, xm.len(), |dof, v: Dual<N>| {
-        if let Some(ri) = r.get_mut(dof) {
-            *ri = v.re;
-        }
-        if let Some(row) = k.get_mut(dof * N..(dof + 1) * N) {
-            row.copy_from_slice(&v.eps);
-        }
-    });
-    true
+    let kin = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
+    Some(link_forces(
+        input,
+        &kin,
+        &slave[..ns],
+        &master[..xm.len()],
+        |dof, v: Dual<N>| {
+            if let Some(ri) = r.get_mut(dof) {
+                *ri = v.re;
+            }
+            if let Some(row) = k.get_mut(dof * N..(dof + 1) * N) {
+                row.copy_from_slice(&v.eps);
+            }
+        },
+    ))
 }
-
 /// Monomorphised for the possible link sizes so the dual arrays are exactly
 /// as long as needed: quad–quad 24, quad–tri 21, tri–tri 18, rigid 12 / 9.
 fn residual_tangent_sized(
@@ -514,14 +820,14 @@ fn residual_tangent_sized(
     xi_bar: [f64; 2],
     r: &mut [f64],
     k: &mut [f64],
-) -> bool {
+) -> Option<Option<FrictionState>> {
     match dof_count(input) {
         24 => residual_dual::<24>(input, xi_bar, r, k),
         21 => residual_dual::<21>(input, xi_bar, r, k),
         18 => residual_dual::<18>(input, xi_bar, r, k),
         12 => residual_dual::<12>(input, xi_bar, r, k),
         9 => residual_dual::<9>(input, xi_bar, r, k),
-        _ => false,
+        _ => None,
     }
 }
 
@@ -550,6 +856,7 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
                 master_point: p.point,
                 projection_converged: p.converged,
                 outside: p.outside,
+                friction: None,
             }
         }
         _ => match rigid_kinematics::<f64>(&x1, &input.master) {
@@ -562,6 +869,7 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
                 master_point: kin.master_point,
                 projection_converged: true,
                 outside: 0.0,
+                friction: None,
             },
             None => LinkState {
                 slave_point: x1,
@@ -571,6 +879,17 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
     };
     if state.projection_converged {
         state.pressure = (input.lambda_n - input.penalty * state.gap).max(0.0);
+    }
+    if state.pressure > 0.0 && input.friction.is_some() {
+        // The friction state comes from the kernel's own kinematics, so the
+        // stick/slip decision here is the one the residual makes.
+        match residual_f64(input, state.xi, &mut []) {
+            Some(friction) => state.friction = friction,
+            None => {
+                state.projection_converged = false;
+                state.pressure = 0.0;
+            }
+        }
     }
     state
 }
@@ -608,7 +927,7 @@ pub fn residual_tangent(input: &LinkInput, r: &mut [f64], mut k: Option<&mut [f6
         Some(k) => residual_tangent_sized(input, state.xi, r, k),
         None => residual_f64(input, state.xi, r),
     };
-    if !ok {
+    if ok.is_none() {
         // The closest point has no usable Hessian or normal in the kernel's
         // own evaluation: drop the link rather than return a wrong tangent.
         r.fill(0.0);
@@ -645,6 +964,16 @@ mod tests {
         master: OwnedMaster,
         lambda_n: f64,
         penalty: f64,
+        friction: Option<CaseFriction>,
+    }
+
+    /// Owned counterpart of [`Friction`]; `rate` = (slave v, master v, Δt, dv/dx).
+    #[derive(Clone)]
+    struct CaseFriction {
+        mu: f64,
+        penalty: f64,
+        history: SlipHistory,
+        rate: Option<(Vec<[f64; 3]>, Vec<[f64; 3]>, f64, f64)>,
     }
 
     impl Case {
@@ -666,6 +995,17 @@ mod tests {
                 xi_start,
                 lambda_n: self.lambda_n,
                 penalty: self.penalty,
+                friction: self.friction.as_ref().map(|f| Friction {
+                    mu: f.mu,
+                    penalty: f.penalty,
+                    history: f.history,
+                    rate: f.rate.as_ref().map(|(vs, vm, dt, c)| SlipRate {
+                        slave_v: vs,
+                        master_v: vm,
+                        dt: *dt,
+                        dv_dx: *c,
+                    }),
+                }),
             }
         }
 
@@ -690,6 +1030,16 @@ mod tests {
                 c.slave_x[node][i] += h;
             } else if let OwnedMaster::Facet(_, x) = &mut c.master {
                 x[node - ns][i] += h;
+            }
+            // The integrator's velocity moves with the position.
+            if let Some((vs, vm, _, dv_dx)) = c.friction.as_mut().and_then(|f| f.rate.as_mut()) {
+                if node < ns {
+                    vs[node][i] += *dv_dx * h;
+                } else if let Some(v) = vm.get_mut(node - ns) {
+                    if matches!(self.master, OwnedMaster::Facet(..)) {
+                        v[i] += *dv_dx * h;
+                    }
+                }
             }
             c
         }
@@ -836,6 +1186,7 @@ mod tests {
                 master,
                 lambda_n: 0.5 * (rng.next() + 1.0),
                 penalty: 20.0,
+                friction: None,
             };
             let s = evaluate(&case.input());
             if s.projection_converged && s.pressure > 0.05 && s.outside < 0.5 {
@@ -1019,6 +1370,7 @@ mod tests {
             master: OwnedMaster::Facet(FacetType::Quad4, master),
             lambda_n: 1.0,
             penalty: 10.0,
+            friction: None,
         };
         let (r, _, s) = case.residual_and_tangent();
         assert!((s.gap - 0.02).abs() < 1e-15);
@@ -1047,6 +1399,7 @@ mod tests {
                 xi_start: [0.0; 2],
                 lambda_n: 0.7,
                 penalty: 50.0,
+                friction: None,
             };
             let mut r = vec![0.0; dof_count(&input)];
             let s = residual_tangent(&input, &mut r, None);
@@ -1239,6 +1592,7 @@ mod tests {
                 master: OwnedMaster::Rigid(m),
                 lambda_n: 1.0,
                 penalty: 1.0,
+                friction: None,
             };
             let s = run(&c, 12, 144);
             assert!(!s.projection_converged && s.pressure == 0.0, "{m:?}");
@@ -1261,12 +1615,325 @@ mod tests {
             xi_start: [0.0; 2],
             lambda_n: 0.0,
             penalty: 10.0,
+            friction: None,
         };
         let s = evaluate(&input);
         assert!((s.gap + 0.1).abs() < 1e-15);
         assert!((s.pressure - 1.0).abs() < 1e-14);
         assert_eq!(s.master_point, [0.0, 0.0, 1.0]);
         assert!((potential(&input) - 1.0 / 20.0 * 2.0).abs() < 1e-15);
+    }
+
+    /// Adds friction to a closed case: a slip history a little away from the
+    /// current master point, a λT, and μ chosen so that `|tT*| = ratio · μ pN`
+    /// (ratio < 1 sticks, > 1 slips; far from the kink either way).
+    fn with_friction(case: &Case, ratio: f64, dynamic: bool, rng: &mut Lcg) -> Case {
+        let mut c = case.clone();
+        let s = evaluate(&c.input());
+        let history = match &c.master {
+            OwnedMaster::Facet(..) => SlipHistory::Convected {
+                xi_n: [s.xi[0] - 0.05 * rng.next(), s.xi[1] + 0.05 * rng.next()],
+                lambda: [0.1 * rng.next(), 0.1 * rng.next()],
+            },
+            OwnedMaster::Rigid(_) => SlipHistory::Spatial {
+                point_n: dual::add(&s.master_point, &rng.vec3(0.05)),
+                lambda: rng.vec3(0.1),
+            },
+        };
+        let rate = dynamic.then(|| {
+            let nm = match &c.master {
+                OwnedMaster::Facet(_, x) => x.len(),
+                OwnedMaster::Rigid(_) => 1,
+            };
+            (
+                (0..c.slave_x.len()).map(|_| rng.vec3(0.5)).collect(),
+                (0..nm).map(|_| rng.vec3(0.5)).collect(),
+                0.1,
+                3.0,
+            )
+        });
+        c.friction = Some(CaseFriction {
+            mu: 1e6,
+            penalty: 15.0,
+            history,
+            rate,
+        });
+        // With μ huge the link sticks and |traction| = |tT*|.
+        let trial = dual::norm(&evaluate(&c.input()).friction.unwrap().traction);
+        if let Some(f) = &mut c.friction {
+            f.mu = trial / (ratio * s.pressure);
+        }
+        c
+    }
+
+    /// Every pairing with friction: stick and slip, static and dynamic.
+    fn friction_cases() -> Vec<(String, Case)> {
+        let mut rng = Lcg::new(7);
+        let mut out = Vec::new();
+        for (name, case) in all_cases() {
+            for (ratio, branch) in [(0.5, "stick"), (2.0, "slip")] {
+                for dynamic in [false, true] {
+                    let c = with_friction(&case, ratio, dynamic, &mut rng);
+                    let kind = if dynamic { "dyn" } else { "static" };
+                    out.push((format!("{name} {branch} {kind}"), c));
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn friction_cases_stick_and_slip_as_intended() {
+        for (name, case) in friction_cases() {
+            let s = evaluate(&case.input());
+            let f = s.friction.expect("closed link with friction");
+            assert_eq!(f.sliding, name.contains("slip"), "{name}");
+            let limit = case.friction.as_ref().unwrap().mu * s.pressure;
+            let t = dual::norm(&f.traction);
+            if f.sliding {
+                assert!((t - limit).abs() < 1e-12 * limit, "{name}: {t} vs {limit}");
+            } else {
+                assert!(t < limit, "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn friction_tangent_matches_finite_differences() {
+        let mut worst = std::collections::BTreeMap::<String, f64>::new();
+        for (name, case) in friction_cases() {
+            let (_, k, _) = case.residual_and_tangent();
+            let err = rel_err(&k, &fd_tangent(&case));
+            assert!(err < 1e-6, "{name}: {err:e}");
+            let key = name.split(' ').skip(1).collect::<Vec<_>>().join(" ");
+            let w = worst.entry(key).or_insert(0.0);
+            *w = w.max(err);
+        }
+        for (branch, err) in worst {
+            println!("friction k vs FD(r) {branch:>12}: {err:.1e}");
+        }
+    }
+
+    #[test]
+    fn friction_residual_only_path_matches_dual_path() {
+        for (name, case) in friction_cases() {
+            let (r, _, _) = case.residual_and_tangent();
+            assert!(rel_err(&case.residual(), &r) < 1e-14, "{name}");
+        }
+    }
+
+    #[test]
+    fn damping_matrix_is_the_velocity_derivative() {
+        // k(dv/dx = c) − k(dv/dx = 0) = c ∂r/∂v: the seed's damping matrix
+        // enters through the integrator's coefficient and nothing else.
+        const HV: f64 = 1e-6;
+        for (name, case) in friction_cases() {
+            if !name.ends_with("dyn") {
+                continue;
+            }
+            let n = case.n();
+            let c = case.friction.as_ref().unwrap().rate.as_ref().unwrap().3;
+            let (_, k, _) = case.residual_and_tangent();
+            let mut still = case.clone();
+            still.friction.as_mut().unwrap().rate.as_mut().unwrap().3 = 0.0;
+            let (_, k0, _) = still.residual_and_tangent();
+            let ns = case.slave_x.len();
+            let facet_master = matches!(case.master, OwnedMaster::Facet(..));
+            let mut damping = vec![0.0; n * n];
+            for j in 0..n {
+                let (node, i) = (j / 3, j % 3);
+                if node >= ns && !facet_master {
+                    continue;
+                }
+                let shifted = |h: f64| {
+                    let mut s = still.clone();
+                    let rate = s.friction.as_mut().unwrap().rate.as_mut().unwrap();
+                    if node < ns {
+                        rate.0[node][i] += h;
+                    } else {
+                        rate.1[node - ns][i] += h;
+                    }
+                    s.residual()
+                };
+                let (p, m) = (shifted(HV), shifted(-HV));
+                for row in 0..n {
+                    damping[row * n + j] = c * (p[row] - m[row]) / (2.0 * HV);
+                }
+            }
+            let diff: Vec<f64> = k.iter().zip(&k0).map(|(a, b)| a - b).collect();
+            let err = rel_err(&diff, &damping);
+            assert!(err < 1e-6, "{name}: {err:e}");
+        }
+    }
+
+    #[test]
+    fn friction_forces_balance_for_facet_masters() {
+        for (name, case) in friction_cases() {
+            if matches!(case.master, OwnedMaster::Rigid(_)) {
+                continue;
+            }
+            let (r, k, _) = case.residual_and_tangent();
+            let n = case.n();
+            let scale = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let force = r
+                .chunks_exact(3)
+                .fold([0.0; 3], |f, v| dual::add(&f, &[v[0], v[1], v[2]]));
+            assert!(dual::norm(&force) < 1e-13 * scale, "{name}: {force:?}");
+            let kscale = k.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for i in 0..3 {
+                for col in 0..n {
+                    let sum: f64 = (0..n / 3).map(|a| k[(3 * a + i) * n + col]).sum();
+                    assert!(sum.abs() < 1e-12 * kscale, "{name}: row sum {sum:e}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn zero_friction_coefficient_is_frictionless() {
+        for (name, case) in friction_cases() {
+            let mut c = case.clone();
+            c.friction.as_mut().unwrap().mu = 0.0;
+            let mut plain = case.clone();
+            plain.friction = None;
+            let (r, k, _) = c.residual_and_tangent();
+            let (r0, k0, _) = plain.residual_and_tangent();
+            assert!(rel_err(&r, &r0) < 1e-14 && rel_err(&k, &k0) < 1e-14, "{name}");
+        }
+    }
+
+    #[test]
+    fn convected_multiplier_turns_with_the_master() {
+        // Rotate the whole link: the covariant λT, the slip and the forces
+        // rotate with it (frame indifference).
+        let (c, s) = (0.6f64, 0.8f64);
+        let rot = |p: &[f64; 3]| [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]];
+        for (name, case) in friction_cases() {
+            let OwnedMaster::Facet(facet, x) = &case.master else {
+                continue;
+            };
+            if name.ends_with("dyn") {
+                continue;
+            }
+            let mut turned = case.clone();
+            turned.slave_x = case.slave_x.iter().map(rot).collect();
+            turned.master = OwnedMaster::Facet(*facet, x.iter().map(rot).collect());
+            let (r, _, st) = case.residual_and_tangent();
+            let (r2, _, st2) = turned.residual_and_tangent();
+            let r_rot: Vec<f64> = r
+                .chunks_exact(3)
+                .flat_map(|f| rot(&[f[0], f[1], f[2]]))
+                .collect();
+            assert!(rel_err(&r2, &r_rot) < 1e-11, "{name}");
+            let (f, f2) = (st.friction.unwrap(), st2.friction.unwrap());
+            assert!(rel_err(&f2.traction, &rot(&f.traction)) < 1e-11, "{name}");
+        }
+    }
+
+    #[test]
+    fn sliding_block_transmits_mu_times_pressure() {
+        // A flat slave facet pressed into a flat master, then moved +x: the
+        // traction on the slave is exactly −μ pN x̂ once sliding, and
+        // λT + εT·slip opposing the slip while sticking.
+        let master_x = [
+            [-5.0, -5.0, 0.0],
+            [5.0, -5.0, 0.0],
+            [5.0, 5.0, 0.0],
+            [-5.0, 5.0, 0.0],
+        ];
+        let slave_x = [
+            [0.3, 0.0, -0.01],
+            [0.3, 1.0, -0.01],
+            [1.3, 1.0, -0.01],
+            [1.3, 0.0, -0.01],
+        ];
+        let masters = [
+            (
+                Master::Facet {
+                    facet: FacetType::Quad4,
+                    x: &master_x,
+                },
+                SlipHistory::Convected {
+                    // Master point before the move: (0.5, 0.5), ξ = x/5.
+                    xi_n: [0.1, 0.1],
+                    lambda: [0.0, 0.0],
+                },
+            ),
+            (
+                Master::Plane {
+                    point: [0.0; 3],
+                    normal: [0.0, 0.0, 1.0],
+                },
+                SlipHistory::Spatial {
+                    point_n: [0.5, 0.5, 0.0],
+                    lambda: [0.0; 3],
+                },
+            ),
+        ];
+        let p_n = 2.0 + 100.0 * 0.01;
+        for (master, history) in masters {
+            for (mu, sliding) in [(0.3, true), (10.0, false)] {
+                let input = LinkInput {
+                    slave_facet: FacetType::Quad4,
+                    slave_x: &slave_x,
+                    zeta: [0.0, 0.0],
+                    weight: 1.0,
+                    master,
+                    xi_start: [0.0; 2],
+                    lambda_n: 2.0,
+                    penalty: 100.0,
+                    friction: Some(Friction {
+                        mu,
+                        penalty: 50.0,
+                        history,
+                        rate: None,
+                    }),
+                };
+                let s = evaluate(&input);
+                let f = s.friction.unwrap();
+                assert_eq!(f.sliding, sliding);
+                assert!(rel_err(&f.slip, &[0.3, 0.0, 0.0]) < 1e-12, "{:?}", f.slip);
+                let expect = if sliding { -mu * p_n } else { -50.0 * 0.3 };
+                assert!(rel_err(&f.traction, &[expect, 0.0, 0.0]) < 1e-12, "{f:?}");
+                let mut r = vec![0.0; dof_count(&input)];
+                residual_tangent(&input, &mut r, None);
+                let fx: f64 = r[..12].chunks_exact(3).map(|v| v[0]).sum();
+                assert!((fx + expect).abs() < 1e-12, "slave residual x {fx}");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_friction_input_is_rejected() {
+        let mut rng = Lcg::new(5);
+        let base = random_case(FacetType::Quad4, Some(FacetType::Quad4), 0, &mut rng);
+        let good = with_friction(&base, 0.5, true, &mut rng);
+        assert!(check_input(&good.input()).is_ok());
+        let edits: [(&str, fn(&mut CaseFriction)); 5] = [
+            ("mu < 0", |f| f.mu = -0.1),
+            ("εT = 0", |f| f.penalty = 0.0),
+            ("εT NaN", |f| f.penalty = f64::NAN),
+            ("spatial history on a facet", |f| {
+                f.history = SlipHistory::Spatial {
+                    point_n: [0.0; 3],
+                    lambda: [0.0; 3],
+                }
+            }),
+            ("dt = 0", |f| f.rate.as_mut().unwrap().2 = 0.0),
+        ];
+        for (what, edit) in edits {
+            let mut c = good.clone();
+            edit(c.friction.as_mut().unwrap());
+            assert!(check_input(&c.input()).is_err(), "{what}");
+            let s = evaluate(&c.input());
+            assert!(!s.projection_converged && s.pressure == 0.0, "{what}");
+        }
+        let mut c = good.clone();
+        c.friction.as_mut().unwrap().rate.as_mut().unwrap().1.pop();
+        assert!(matches!(
+            check_input(&c.input()),
+            Err(LinkError::NodeCount { .. })
+        ));
     }
 
     #[test]

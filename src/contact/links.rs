@@ -330,6 +330,7 @@ impl ContactPair {
                 xi_start: xi,
                 lambda_n: self.multipliers.lambda[qp],
                 penalty: self.facet_penalty[qp / self.slave.nqp],
+                friction: None,
             };
             let n = link_dofs.len();
             let state = if with_tangent {
@@ -457,6 +458,7 @@ impl ContactPair {
                 xi_start: l.xi,
                 lambda_n: self.multipliers.lambda[qp],
                 penalty: self.facet_penalty[qp / self.slave.nqp],
+                friction: None,
             }));
         }
         out
