@@ -60,7 +60,11 @@ fn model(n: usize) -> Model {
             vec![0, 1, 2],
             [0.0; 3],
         )],
-        facet_loads: vec![("block.top".into(), FacetLoad::Pressure(50.0))],
+        facet_loads: vec![(
+            "block.top".into(),
+            FacetLoad::Pressure(50.0),
+            Default::default(),
+        )],
         body_force: vec![[0.0; 3]],
         body_force_fn: None,
         contact: Vec::new(),

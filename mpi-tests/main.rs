@@ -289,6 +289,7 @@ fn bulk_patch_test(rt: &Runtime, material: Material) -> Result<(), String> {
         nodes,
         components: vec![0, 1, 2],
         values,
+        amplitude: Default::default(),
     };
     let interior_moved = mesh.nodes.clone();
     let model = model_with(mesh, material, vec![bc], 1);
@@ -407,6 +408,7 @@ fn manufactured_solution_converges(rt: &Runtime) -> Result<(), String> {
             nodes,
             components: vec![0, 1, 2],
             values,
+            amplitude: Default::default(),
         };
         let mut model = model_with(mesh, material, vec![bc], 1);
         let m = material;

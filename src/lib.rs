@@ -12,6 +12,7 @@
 //!
 //! `pipeline` strings these together for one run; `petsc` and `runtime` are
 //! the only places that touch C libraries directly.
+pub mod amplitude;
 pub mod assembly;
 pub mod contact;
 pub mod dofs;

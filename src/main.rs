@@ -141,7 +141,7 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
                 model
                     .facet_loads
                     .iter()
-                    .map(|(s, l)| format!("{s} {l:?}"))
+                    .map(|(s, l, _)| format!("{s} {l:?}"))
                     .collect::<Vec<_>>()
                     .join(", ")
             );

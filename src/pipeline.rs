@@ -236,34 +236,40 @@ impl Hdf5Sink {
         report: &StepReport,
     ) -> Result<()> {
         let name = &fields.pair.spec.name;
-        let order = &mut self.pairs[i];
         let v = &fields.values;
-        let points: Vec<f64> = v.points.iter().flatten().copied().collect();
-        let (start, data) = order.vector.block_of_owned(&points)?;
+        let flat = |a: &[[f64; 3]]| -> Vec<f64> { a.iter().flatten().copied().collect() };
+        let mut vectors = vec![("points", flat(&v.points))];
+        let mut scalars = vec![
+            ("pressure", v.pressure.clone()),
+            ("gap", v.gap.clone()),
+            ("lambda_n", v.lambda.clone()),
+        ];
+        if !v.state.is_empty() {
+            vectors.push(("traction_t", flat(&v.traction)));
+            vectors.push(("slip", flat(&v.slip)));
+            // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
+            scalars.push(("state", v.state.iter().map(|&s| f64::from(s)).collect()));
+        }
+        let order = &mut self.pairs[i];
         let rows = order.rows;
-        self.file.write_step_block(
-            step,
-            &format!("contact/{name}/points"),
-            BlockRows {
-                global_rows: rows,
-                start,
-                cols: 3,
-                data: &data,
-            },
-        )?;
-        for (label, values) in [
-            ("pressure", &v.pressure),
-            ("gap", &v.gap),
-            ("lambda_n", &v.lambda),
-        ] {
-            let (start, data) = order.scalar.block_of_owned(values)?;
+        for (cols, label, values) in vectors
+            .iter()
+            .map(|(l, d)| (3, l, d))
+            .chain(scalars.iter().map(|(l, d)| (1, l, d)))
+        {
+            let scatter = if cols == 3 {
+                &mut order.vector
+            } else {
+                &mut order.scalar
+            };
+            let (start, data) = scatter.block_of_owned(values)?;
             self.file.write_step_block(
                 step,
                 &format!("contact/{name}/{label}"),
                 BlockRows {
                     global_rows: rows,
                     start,
-                    cols: 1,
+                    cols,
                     data: &data,
                 },
             )?;

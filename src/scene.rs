@@ -40,6 +40,11 @@ pub const BUILTIN: &[(&str, &str, &str)] = &[
         include_str!("../scenes/block-on-plane.toml"),
     ),
     (
+        "block-slide",
+        "Block pressed on a rigid plane and pulled: Coulomb friction (μ = 0.3), stick then slip",
+        include_str!("../scenes/block-slide.toml"),
+    ),
+    (
         "block-compress",
         "Neo-Hookean block compressed 20 % by a follower pressure (finite strain)",
         include_str!("../scenes/block-compress.toml"),
@@ -216,6 +221,8 @@ pub struct DirichletSection {
     pub components: Option<Vec<String>>,
     /// Displacement of each listed component at full load; zero when absent.
     pub value: Option<Vec<f64>>,
+    /// Load path `[[load_factor, amplitude], ...]` (default: linear ramp).
+    pub amplitude: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -223,6 +230,7 @@ pub struct DirichletSection {
 pub struct PressureSection {
     pub set: String,
     pub value: f64,
+    pub amplitude: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -230,6 +238,7 @@ pub struct PressureSection {
 pub struct TractionSection {
     pub set: String,
     pub vector: [f64; 3],
+    pub amplitude: Option<Vec<[f64; 2]>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -261,6 +270,8 @@ pub struct ContactSection {
     pub rigid: Option<RigidSurface>,
     /// Translation of the rigid surface at full load.
     pub motion: Option<[f64; 3]>,
+    /// Load path of the motion `[[load_factor, amplitude], ...]`.
+    pub motion_amplitude: Option<Vec<[f64; 2]>>,
     pub penalty: Option<f64>,
     pub penetration_tol: Option<f64>,
     pub multiplier_tol: Option<f64>,
@@ -268,6 +279,10 @@ pub struct ContactSection {
     pub search_distance: Option<f64>,
     /// "gauss" (default) or "nodal": where the slave links sit.
     pub quadrature: Option<String>,
+    /// Coulomb friction coefficient μ (absent or 0: frictionless).
+    pub friction: Option<f64>,
+    /// Tangential penalty εT (default: the normal penalty).
+    pub tangential_penalty: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -460,7 +475,8 @@ impl Scene {
         for p in &self.pressure {
             check_facet_set(&mesh, &p.set, "[[pressure]]").map_err(&err)?;
             check_finite(p.value, "[[pressure]] value").map_err(&err)?;
-            facet_loads.push((p.set.clone(), FacetLoad::Pressure(p.value)));
+            let a = amplitude(&p.amplitude, &format!("[[pressure]] '{}'", p.set)).map_err(&err)?;
+            facet_loads.push((p.set.clone(), FacetLoad::Pressure(p.value), a));
         }
         for t in &self.traction {
             check_facet_set(&mesh, &t.set, "[[traction]]").map_err(&err)?;
@@ -468,7 +484,8 @@ impl Scene {
                 .iter()
                 .try_for_each(|&v| check_finite(v, "[[traction]] vector"))
                 .map_err(&err)?;
-            facet_loads.push((t.set.clone(), FacetLoad::Traction(t.vector)));
+            let a = amplitude(&t.amplitude, &format!("[[traction]] '{}'", t.set)).map_err(&err)?;
+            facet_loads.push((t.set.clone(), FacetLoad::Traction(t.vector), a));
         }
         let mut body_force = vec![[0.0; 3]; mesh.bodies.len()];
         for bf in &self.body_force {
@@ -671,7 +688,20 @@ fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<Diri
         check_finite(v, "[[dirichlet]] value")?;
         full[c] = v;
     }
-    Ok(DirichletSpec::uniform(&d.set, nodes, components, full))
+    let mut spec = DirichletSpec::uniform(&d.set, nodes, components, full);
+    spec.amplitude = amplitude(&d.amplitude, &format!("[[dirichlet]] set '{}'", d.set))?;
+    Ok(spec)
+}
+
+/// An optional amplitude table, checked; a linear ramp when absent.
+fn amplitude(
+    table: &Option<Vec<[f64; 2]>>,
+    at: &str,
+) -> std::result::Result<crate::amplitude::Amplitude, String> {
+    match table {
+        None => Ok(crate::amplitude::Amplitude::ramp()),
+        Some(t) => crate::amplitude::Amplitude::from_table(t).map_err(|e| format!("{at}: {e}")),
+    }
 }
 
 fn contact_spec(
@@ -706,6 +736,10 @@ fn contact_spec(
     }
     let mut spec = PairSpec::new(&name, &c.slave, master);
     spec.motion = c.motion.unwrap_or([0.0; 3]);
+    if c.motion_amplitude.is_some() && c.motion.is_none() {
+        return Err(format!("{at}: motion_amplitude is set but motion is not"));
+    }
+    spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))?;
     spec.quadrature = match c.quadrature.as_deref() {
         None | Some("gauss") => SlaveQuadrature::Gauss,
         Some("nodal") => SlaveQuadrature::Nodal,
@@ -740,6 +774,26 @@ fn contact_spec(
     if spec.max_uzawa == 0 {
         return Err(format!("{at}: max_uzawa must be at least 1"));
     }
+    if let Some(mu) = c.friction {
+        if !(mu >= 0.0 && mu.is_finite()) {
+            return Err(format!(
+                "{at}: friction (the coefficient μ) must be zero or positive (got {mu})"
+            ));
+        }
+    }
+    let tangential_penalty = c
+        .tangential_penalty
+        .map(|p| positive(p, "tangential_penalty"))
+        .transpose()?;
+    if tangential_penalty.is_some() && c.friction.is_none() {
+        return Err(format!(
+            "{at}: tangential_penalty is set but friction is not; give friction = μ"
+        ));
+    }
+    spec.friction = c.friction.map(|mu| crate::contact::pair::FrictionSpec {
+        mu,
+        penalty: tangential_penalty,
+    });
     Ok(spec)
 }
 

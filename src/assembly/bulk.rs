@@ -1,6 +1,7 @@
-//! Bulk (volume) contributions: internal force and stiffness of every local cell.
+//! Bulk (volume) contributions of every local cell: internal force, stiffness,
+//! consistent mass and stored energy.
 use super::{element_dofs, gather_nodal, scatter_add};
-use crate::dofs::DofMap;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
 use crate::mesh::Mesh;
@@ -130,6 +131,117 @@ impl BulkAssembler {
         Ok(())
     }
 
+    /// Adds the consistent mass `∫ ρ N_a N_b dV` of every local cell into `m`
+    /// (not assembled); `density[b]` is the reference density of body b, as
+    /// `materials[b]` is its material. The blocks land on the tangent's
+    /// pattern, so `m` may be a matrix built from [`Self::add_pattern`] or the
+    /// tangent itself. A body of density 0 adds nothing.
+    pub fn add_mass(&self, density: &[f64], m: &mut Matrix) -> Result<()> {
+        self.for_each_cell_mass(density, |dofs, me| Ok(m.add_block(dofs, dofs, me)?))
+    }
+
+    /// Calls `add(dofs, mass)` for every local cell of non-zero density;
+    /// split from [`Self::add_mass`] so the sums can be checked without PETSc.
+    fn for_each_cell_mass(
+        &self,
+        density: &[f64],
+        mut add: impl FnMut(&[PetscInt], &[f64]) -> Result<()>,
+    ) -> Result<()> {
+        // Checked up front rather than per cell: a rank without cells must
+        // fail as well, or the others would wait for it in assembly.
+        self.check_densities(density)?;
+        let n = self.npc();
+        let mut me = [0.0; 24 * 24];
+        for (i, geom) in self.geometry.iter().enumerate() {
+            let body = self.cell_material[i] as usize;
+            let rho = *density.get(body).ok_or_else(|| {
+                self.cell_error(
+                    i,
+                    FemError::LengthMismatch {
+                        what: "density (one per body)",
+                        expected: body + 1,
+                        got: density.len(),
+                    },
+                )
+            })?;
+            if rho == 0.0 {
+                continue;
+            }
+            fem::mass_matrix(geom, rho, &mut me[..9 * n * n]).map_err(|e| self.cell_error(i, e))?;
+            add(self.dofs(i), &me[..9 * n * n])?;
+        }
+        Ok(())
+    }
+
+    fn check_densities(&self, density: &[f64]) -> Result<()> {
+        if density.len() != self.materials.len() {
+            return Err(Error::scene(
+                "density",
+                format!(
+                    "{} values given for {} bodies (one per body)",
+                    density.len(),
+                    self.materials.len()
+                ),
+            ));
+        }
+        match density
+            .iter()
+            .enumerate()
+            .find(|(_, rho)| !(rho.is_finite() && **rho >= 0.0))
+        {
+            Some((body, rho)) => Err(Error::scene(
+                "density",
+                format!("body {body}: {rho} is not a finite, non-negative density"),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// Stored energy `Σ ∫ W(F) dV` of this rank's cells at the local-form
+    /// displacement `u_local`. Every cell lives on exactly one rank, so the
+    /// sum over ranks (the caller's reduction) is the total, with no double
+    /// counting of cells on partition boundaries.
+    pub fn strain_energy(&self, u_local: &[f64]) -> Result<f64> {
+        let n = self.npc();
+        let mut u = [[0.0; 3]; 8];
+        let mut energy = 0.0;
+        for (i, geom) in self.geometry.iter().enumerate() {
+            let nodes = self.nodes(i);
+            self.check_local_len(i, u_local)?;
+            gather_nodal(u_local, nodes, &mut u[..n]);
+            let body = self.cell_material[i] as usize;
+            let mat = self.materials.get(body).ok_or_else(|| {
+                self.cell_error(
+                    i,
+                    FemError::LengthMismatch {
+                        what: "materials (one per body)",
+                        expected: body + 1,
+                        got: self.materials.len(),
+                    },
+                )
+            })?;
+            energy += fem::strain_energy(mat, geom, &u[..n]).map_err(|e| self.cell_error(i, e))?;
+        }
+        Ok(energy)
+    }
+
+    /// A local-form array too short for a cell's nodes is an error, not an
+    /// out-of-bounds panic in `gather_nodal`.
+    fn check_local_len(&self, i: usize, local: &[f64]) -> Result<()> {
+        let needed = self.nodes(i).iter().map(|&l| DIM * (l as usize + 1)).max();
+        match needed {
+            Some(needed) if needed > local.len() => Err(self.cell_error(
+                i,
+                FemError::LengthMismatch {
+                    what: "local displacement array",
+                    expected: needed,
+                    got: local.len(),
+                },
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// Records the entries every local cell couples.
     pub fn add_pattern(&self, pattern: &mut PatternBuilder) -> Result<()> {
         for i in 0..self.geometry.len() {
@@ -190,5 +302,182 @@ fn quadrature_rule(cell_type: CellType) -> QuadRule {
     match cell_type {
         CellType::Hex8 => QuadRule::hex_2x2x2(),
         CellType::Tet4 => QuadRule::tet_1(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dofs::LocalNode;
+    use crate::mesh::{stacked_blocks, Perturbation, StackedSpec};
+
+    const RANKS: usize = 2;
+
+    /// The default stacked blocks (`lower` and `upper`, each 1 × 1 × 0.5),
+    /// distorted so the hexes are not parallelepipeds.
+    fn two_bodies(cell_type: CellType) -> Mesh {
+        stacked_blocks(&StackedSpec {
+            cell_type,
+            perturbation: Some(Perturbation {
+                fraction: 0.2,
+                seed: 5,
+            }),
+            ..Default::default()
+        })
+        .unwrap()
+    }
+
+    /// One assembler per pretend rank, cells dealt out alternately, so the
+    /// sums below also check that no cell is counted twice across ranks.
+    fn assemblers(mesh: &Mesh, materials: &[Material]) -> Vec<(DofMap, BulkAssembler)> {
+        let partition: Vec<i32> = (0..mesh.num_cells()).map(|c| (c % RANKS) as i32).collect();
+        (0..RANKS)
+            .map(|rank| {
+                let dofs = DofMap::new(mesh, &partition, rank, RANKS, &[]);
+                let bulk = BulkAssembler::new(mesh, &dofs, materials.to_vec()).unwrap();
+                (dofs, bulk)
+            })
+            .collect()
+    }
+
+    /// Body-indexed materials of different stiffness, so a mix-up of bodies
+    /// changes the energy.
+    fn materials(mesh: &Mesh) -> Vec<Material> {
+        let mut m = vec![
+            Material::LinearElastic {
+                youngs: 1.0,
+                poisson: 0.0
+            };
+            mesh.bodies.len()
+        ];
+        m[mesh.body_id("lower").unwrap() as usize] = Material::LinearElastic {
+            youngs: 1000.0,
+            poisson: 0.3,
+        };
+        m[mesh.body_id("upper").unwrap() as usize] = Material::LinearElastic {
+            youngs: 50.0,
+            poisson: 0.2,
+        };
+        m
+    }
+
+    fn body_density(mesh: &Mesh, lower: f64, upper: f64) -> Vec<f64> {
+        let mut d = vec![0.0; mesh.bodies.len()];
+        d[mesh.body_id("lower").unwrap() as usize] = lower;
+        d[mesh.body_id("upper").unwrap() as usize] = upper;
+        d
+    }
+
+    /// Σ of every entry of every cell's mass block over all ranks, and the
+    /// number of cells that contributed.
+    fn mass_sum(all: &[(DofMap, BulkAssembler)], density: &[f64]) -> Result<(f64, usize)> {
+        let mut total = 0.0;
+        let mut cells = 0;
+        for (_, bulk) in all {
+            bulk.for_each_cell_mass(density, |dofs, me| {
+                assert_eq!(me.len(), dofs.len() * dofs.len());
+                total += me.iter().sum::<f64>();
+                cells += 1;
+                Ok(())
+            })?;
+        }
+        Ok((total, cells))
+    }
+
+    #[test]
+    fn mass_sums_to_density_times_volume_per_body() {
+        // Both blocks are 1 × 1 × 0.5; the perturbation keeps the boundary.
+        let volume = 0.5;
+        for cell_type in [CellType::Hex8, CellType::Tet4] {
+            let mesh = two_bodies(cell_type);
+            let all = assemblers(&mesh, &materials(&mesh));
+            let lower_cells = mesh.body_cells(mesh.body_id("lower").unwrap()).count();
+            for (lower, upper) in [(2.0, 0.0), (0.0, 3.0), (2.0, 3.0)] {
+                let (total, cells) = mass_sum(&all, &body_density(&mesh, lower, upper)).unwrap();
+                // Each of the three components carries the full mass.
+                let expected = 3.0 * volume * (lower + upper);
+                assert!(
+                    (total - expected).abs() < 1e-12 * expected,
+                    "{} ({lower}, {upper}): {total} vs {expected}",
+                    cell_type.name()
+                );
+                let expected_cells = match (lower > 0.0, upper > 0.0) {
+                    (true, true) => mesh.num_cells(),
+                    (true, false) => lower_cells,
+                    _ => mesh.num_cells() - lower_cells,
+                };
+                assert_eq!(cells, expected_cells, "massless cells must add nothing");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_densities_are_errors() {
+        let mesh = two_bodies(CellType::Hex8);
+        let all = assemblers(&mesh, &materials(&mesh));
+        for density in [
+            vec![1.0],
+            vec![1.0; mesh.bodies.len() + 1],
+            body_density(&mesh, 1.0, -1.0),
+            body_density(&mesh, f64::NAN, 1.0),
+            body_density(&mesh, 1.0, f64::INFINITY),
+        ] {
+            let err = mass_sum(&all, &density).unwrap_err();
+            assert!(err.to_string().contains("density"), "{err}");
+        }
+    }
+
+    /// Local-form displacement u = g(X) on one pretend rank.
+    fn local_field(mesh: &Mesh, dofs: &DofMap, g: impl Fn([f64; 3]) -> [f64; 3]) -> Vec<f64> {
+        (0..dofs.num_local_nodes())
+            .flat_map(|l| g(mesh.nodes[dofs.natural(LocalNode(l)).0]))
+            .collect()
+    }
+
+    /// u_x = ε X is a uniaxial strain, which linear elements reproduce
+    /// exactly on any mesh: W = ½ (λ + 2μ) ε² per unit volume.
+    #[test]
+    fn strain_energy_of_uniaxial_strain_is_exact() {
+        let eps = 1e-3;
+        let volume = 0.5;
+        for cell_type in [CellType::Hex8, CellType::Tet4] {
+            let mesh = two_bodies(cell_type);
+            let mats = materials(&mesh);
+            let all = assemblers(&mesh, &mats);
+            let energy: f64 = all
+                .iter()
+                .map(|(dofs, bulk)| {
+                    let u = local_field(&mesh, dofs, |x| [eps * x[0], 0.0, 0.0]);
+                    bulk.strain_energy(&u).unwrap()
+                })
+                .sum();
+            let expected: f64 = ["lower", "upper"]
+                .iter()
+                .map(|b| {
+                    let (lambda, mu) = mats[mesh.body_id(b).unwrap() as usize].lame();
+                    0.5 * (lambda + 2.0 * mu) * eps * eps * volume
+                })
+                .sum();
+            let err = (energy - expected).abs() / expected;
+            assert!(err < 1e-12, "{}: {energy} vs {expected}", cell_type.name());
+        }
+    }
+
+    #[test]
+    fn strain_energy_of_rigid_motion_is_zero_and_short_arrays_fail() {
+        let mesh = two_bodies(CellType::Hex8);
+        let all = assemblers(&mesh, &materials(&mesh));
+        for (dofs, bulk) in &all {
+            let u = local_field(&mesh, dofs, |_| [0.3, -0.2, 1.0]);
+            assert!(bulk.strain_energy(&u).unwrap().abs() < 1e-20);
+            let err = bulk.strain_energy(&u[..u.len() - 1]).unwrap_err();
+            assert!(matches!(
+                err,
+                Error::Element {
+                    source: FemError::LengthMismatch { .. },
+                    ..
+                }
+            ));
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! Surface loads on facet sets: dead tractions and follower pressures.
 use super::{element_dofs, gather_nodal, scatter_add};
+use crate::amplitude::Amplitude;
 use crate::dofs::{DofMap, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
@@ -22,6 +23,7 @@ struct LocalFacet {
     x_ref: Vec<[f64; 3]>,
     dofs: Vec<PetscInt>,
     load: FacetLoad,
+    amplitude: Amplitude,
 }
 
 impl LocalFacet {
@@ -41,15 +43,20 @@ pub struct SurfaceLoads {
 }
 
 impl SurfaceLoads {
-    /// `loads` pairs a facet set's facets with the load applied to them.
-    pub fn new(mesh: &Mesh, dofs: &DofMap, loads: &[(&[FacetRef], FacetLoad)]) -> Result<Self> {
+    /// `loads` pairs a facet set's facets with the load applied to them and
+    /// its amplitude.
+    pub fn new(
+        mesh: &Mesh,
+        dofs: &DofMap,
+        loads: &[(&[FacetRef], FacetLoad, Amplitude)],
+    ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let mut local_cell = vec![false; mesh.num_cells()];
         for &c in &dofs.local_cells {
             local_cell[c] = true;
         }
         let mut facets = Vec::new();
-        for (set, load) in loads {
+        for (set, load, amplitude) in loads {
             for f in set.iter().filter(|f| local_cell[f.cell]) {
                 let natural = mesh.facet_nodes(f)?;
                 let nodes: Vec<u32> = natural
@@ -69,6 +76,7 @@ impl SurfaceLoads {
                     x_ref,
                     dofs: d,
                     load: load.clone(),
+                    amplitude: amplitude.clone(),
                 });
             }
         }
@@ -86,11 +94,13 @@ impl SurfaceLoads {
             .any(|f| matches!(f.load, FacetLoad::Pressure(_)))
     }
 
-    /// Adds the external force at load factor `factor` into `f_local`.
+    /// Adds `scale` times the external force at load factor `factor` (each
+    /// load at its own amplitude) into `f_local`.
     pub fn add_external_force(
         &self,
         u_local: &[f64],
         factor: f64,
+        scale: f64,
         f_local: &mut [f64],
     ) -> Result<()> {
         let n = self.facet_type.nodes();
@@ -115,7 +125,8 @@ impl SurfaceLoads {
                     .map_err(|e| facet.error(e))?;
                 }
             }
-            scatter_add(f_local, &facet.nodes, &fe[..3 * n], factor);
+            let a = scale * facet.amplitude.at(factor);
+            scatter_add(f_local, &facet.nodes, &fe[..3 * n], a);
         }
         Ok(())
     }
@@ -132,7 +143,7 @@ impl SurfaceLoads {
         Ok(())
     }
 
-    /// Adds −factor·∂f_ext/∂u of follower loads into the tangent `k`.
+    /// Adds −a(factor)·∂f_ext/∂u of follower loads into the tangent `k`.
     pub fn add_tangent(&self, u_local: &[f64], factor: f64, k: &mut Matrix) -> Result<()> {
         let n = self.facet_type.nodes();
         let mut u = [[0.0; 3]; 4];
@@ -150,8 +161,9 @@ impl SurfaceLoads {
                     Some(&mut ke[..9 * n * n]),
                 )
                 .map_err(|e| facet.error(e))?;
+                let a = facet.amplitude.at(factor);
                 for v in &mut ke[..9 * n * n] {
-                    *v *= -factor;
+                    *v *= -a;
                 }
                 k.add_block(&facet.dofs, &facet.dofs, &ke[..9 * n * n])?;
             }

@@ -37,6 +37,7 @@
 //!   the scalar type so the dual pass differentiates it exactly: the slip
 //!   branch, the coupling to pN and (in dynamics) the damping term
 //!   `∂r/∂v · ∂v/∂x` all land in `k`, which is then non-symmetric.
+//!
 //! `r` and `k` include the friction only when the link is closed.
 
 use thiserror::Error;
@@ -150,6 +151,11 @@ pub struct LinkState {
     /// `pN = ⟨λN − εN gN⟩`; 0 when the link is open or invalid. This is the
     /// value the Uzawa update stores as the new λN.
     pub pressure: f64,
+    /// `λN − εN gN ≥ 0`: the link is in contact and contributes its tangent.
+    /// Closed with `pN = 0` is exact touching (gN = λN/εN): no force yet,
+    /// but the penalty stiffness, so a body held only by contact is not
+    /// singular at first touch.
+    pub closed: bool,
     pub slave_point: [f64; 3],
     pub master_point: [f64; 3],
     /// False when no valid closest point exists; `r`, `k` and `pressure` are
@@ -171,6 +177,7 @@ impl LinkState {
             normal: [0.0; 3],
             xi: [0.0; 2],
             pressure: 0.0,
+            closed: false,
             slave_point: [0.0; 3],
             master_point: [0.0; 3],
             projection_converged: false,
@@ -311,7 +318,11 @@ fn check_friction(input: &LinkInput, f: &Friction) -> Result<(), LinkError> {
     if let Some(rate) = &f.rate {
         non_negative("time step", rate.dt, true)?;
         non_negative("dv_dx", rate.dv_dx, false)?;
-        let expected_master = if rigid { 1 } else { master_nodes(&input.master) };
+        let expected_master = if rigid {
+            1
+        } else {
+            master_nodes(&input.master)
+        };
         for (what, v, n) in [
             ("slave velocities", rate.slave_v, input.slave_facet.nodes()),
             ("master velocities", rate.master_v, expected_master),
@@ -613,7 +624,12 @@ fn slip_increment<T: Scalar>(
 /// λT as a vector in the current tangent plane.
 fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Vec3<T> {
     match (&kin.frame, history) {
-        (Frame::Facet { tangents: [t1, t2], .. }, SlipHistory::Convected { lambda, .. }) => {
+        (
+            Frame::Facet {
+                tangents: [t1, t2], ..
+            },
+            SlipHistory::Convected { lambda, .. },
+        ) => {
             // Contravariant basis m^α = M^{αβ} τ_β, so that λT·τ_α = λ_α.
             let (m11, m12, m22) = (dual::dot(t1, t1), dual::dot(t1, t2), dual::dot(t2, t2));
             let det = m11 * m22 - m12 * m12;
@@ -721,10 +737,15 @@ fn link_forces<T: Scalar>(
             emit(3 * a + i, *ci * s.n[a]);
         }
     }
-    for b in 0..n_master {
-        for i in 0..3 {
-            let extra = kin.separation[i] * master_extra[b] * input.weight;
-            emit(3 * (ns + b) + i, extra - common[i] * kin.master_n[b]);
+    for (b, (extra_b, n_b)) in master_extra
+        .iter()
+        .zip(&kin.master_n)
+        .take(n_master)
+        .enumerate()
+    {
+        for (i, (sep, c)) in kin.separation.iter().zip(&common).enumerate() {
+            let extra = *sep * *extra_b * input.weight;
+            emit(3 * (ns + b) + i, extra - *c * *n_b);
         }
     }
     state
@@ -773,17 +794,27 @@ fn master_x<'a>(input: &LinkInput<'a>) -> &'a [[f64; 3]] {
 
 /// Residual only (f64 path; the Newton step is then a harmless polish).
 /// `None` where the kernel has no usable closest point.
-fn residual_f64(input: &LinkInput, xi_bar: [f64; 2], r: &mut [f64]) -> Option<Option<FrictionState>> {
+fn residual_f64(
+    input: &LinkInput,
+    xi_bar: [f64; 2],
+    r: &mut [f64],
+) -> Option<Option<FrictionState>> {
     let ns = input.slave_facet.nodes();
     let xm = master_x(input);
     let slave = nodes_as::<f64>(input.slave_x);
     let master = nodes_as::<f64>(xm);
     let kin = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
-    Some(link_forces(input, &kin, &slave[..ns], &master[..xm.len()], |dof, v| {
-        if let Some(ri) = r.get_mut(dof) {
-            *ri = v;
-        }
-    }))
+    Some(link_forces(
+        input,
+        &kin,
+        &slave[..ns],
+        &master[..xm.len()],
+        |dof, v| {
+            if let Some(ri) = r.get_mut(dof) {
+                *ri = v;
+            }
+        },
+    ))
 }
 
 /// Residual and tangent with `N` = number of link DOFs.
@@ -852,6 +883,7 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
                 normal: p.normal,
                 xi: p.xi,
                 pressure: 0.0,
+                closed: false,
                 slave_point: x1,
                 master_point: p.point,
                 projection_converged: p.converged,
@@ -865,6 +897,7 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
                 normal: kin.normal,
                 xi: [0.0; 2],
                 pressure: 0.0,
+                closed: false,
                 slave_point: x1,
                 master_point: kin.master_point,
                 projection_converged: true,
@@ -878,15 +911,18 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
         },
     };
     if state.projection_converged {
-        state.pressure = (input.lambda_n - input.penalty * state.gap).max(0.0);
+        let p = input.lambda_n - input.penalty * state.gap;
+        state.closed = p >= 0.0;
+        state.pressure = p.max(0.0);
     }
-    if state.pressure > 0.0 && input.friction.is_some() {
+    if state.closed && input.friction.is_some() {
         // The friction state comes from the kernel's own kinematics, so the
         // stick/slip decision here is the one the residual makes.
         match residual_f64(input, state.xi, &mut []) {
             Some(friction) => state.friction = friction,
             None => {
                 state.projection_converged = false;
+                state.closed = false;
                 state.pressure = 0.0;
             }
         }
@@ -920,7 +956,7 @@ pub fn residual_tangent(input: &LinkInput, r: &mut [f64], mut k: Option<&mut [f6
     }
     let mut state = evaluate(input);
     // Cheap exit: the f64 gap decides open/closed before any dual work.
-    if state.pressure <= 0.0 {
+    if !state.closed {
         return state;
     }
     let ok = match k.as_deref_mut() {
@@ -936,6 +972,7 @@ pub fn residual_tangent(input: &LinkInput, r: &mut [f64], mut k: Option<&mut [f6
         }
         state = LinkState {
             projection_converged: false,
+            closed: false,
             pressure: 0.0,
             ..state
         };
@@ -967,13 +1004,16 @@ mod tests {
         friction: Option<CaseFriction>,
     }
 
-    /// Owned counterpart of [`Friction`]; `rate` = (slave v, master v, Δt, dv/dx).
+    /// (slave v, master v, Δt, dv/dx).
+    type CaseRate = (Vec<[f64; 3]>, Vec<[f64; 3]>, f64, f64);
+
+    /// Owned counterpart of [`Friction`].
     #[derive(Clone)]
     struct CaseFriction {
         mu: f64,
         penalty: f64,
         history: SlipHistory,
-        rate: Option<(Vec<[f64; 3]>, Vec<[f64; 3]>, f64, f64)>,
+        rate: Option<CaseRate>,
     }
 
     impl Case {
@@ -1798,7 +1838,10 @@ mod tests {
             plain.friction = None;
             let (r, k, _) = c.residual_and_tangent();
             let (r0, k0, _) = plain.residual_and_tangent();
-            assert!(rel_err(&r, &r0) < 1e-14 && rel_err(&k, &k0) < 1e-14, "{name}");
+            assert!(
+                rel_err(&r, &r0) < 1e-14 && rel_err(&k, &k0) < 1e-14,
+                "{name}"
+            );
         }
     }
 
@@ -1909,7 +1952,8 @@ mod tests {
         let base = random_case(FacetType::Quad4, Some(FacetType::Quad4), 0, &mut rng);
         let good = with_friction(&base, 0.5, true, &mut rng);
         assert!(check_input(&good.input()).is_ok());
-        let edits: [(&str, fn(&mut CaseFriction)); 5] = [
+        type Edit = (&'static str, fn(&mut CaseFriction));
+        let edits: [Edit; 5] = [
             ("mu < 0", |f| f.mu = -0.1),
             ("εT = 0", |f| f.penalty = 0.0),
             ("εT NaN", |f| f.penalty = f64::NAN),

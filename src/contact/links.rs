@@ -1,8 +1,8 @@
 //! A contact pair at run time: the links of the current load step (one per
 //! linked slave quadrature point), their search, their contributions to the
 //! residual and tangent, and the Uzawa update of their multipliers.
-use super::link::{self, LinkInput, LinkState, Master};
-use super::multipliers::{updated_multiplier, Multipliers};
+use super::link::{self, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
+use super::multipliers::{updated_multiplier, Multipliers, PointFriction, PointState};
 use super::pair::{MasterSpec, PairSpec, RigidSurface};
 use super::search::{self, SearchIndex};
 use super::surfaces::{MasterSurface, SlaveSurface};
@@ -43,6 +43,8 @@ pub struct UzawaStats {
     pub max_force: f64,
     pub max_multiplier: f64,
     pub active: usize,
+    /// Points sliding (friction), of the `active` ones.
+    pub sliding: usize,
 }
 
 /// Point values for output, for this rank's slave points.
@@ -51,8 +53,45 @@ pub struct PointValues {
     pub pressure: Vec<f64>,
     pub gap: Vec<f64>,
     pub lambda: Vec<f64>,
+    /// Friction (empty for a frictionless pair): tangential traction on the
+    /// slave, slip increment of the step, state (0 open, 1 stick, 2 slip).
+    pub traction: Vec<[f64; 3]>,
+    pub slip: Vec<[f64; 3]>,
+    pub state: Vec<i8>,
     /// Owned slave nodes: reference position and nodal contact pressure.
     pub nodes: Vec<([f64; 3], f64)>,
+}
+
+/// Friction of a pair at run time: μ and εT per slave facet.
+struct PairFriction {
+    mu: f64,
+    penalty: Vec<f64>,
+}
+
+/// Dynamics: the time integrator's velocity, affine in the displacement,
+/// `v = dv_du · u + offset` (local form, per DOF), for the slip rate.
+pub struct SlipRateMap {
+    pub dt: f64,
+    pub dv_du: f64,
+    pub offset: Vec<f64>,
+    /// Velocity of a rigid master (its motion per unit time).
+    pub rigid_velocity: [f64; 3],
+}
+
+/// What a cut-back step restores: the multipliers and friction state of the
+/// last converged step.
+pub struct PairSnapshot {
+    lambda: Vec<f64>,
+    friction: Option<Vec<PointFriction>>,
+}
+
+/// Scratch space for one link's input (no allocation per link).
+#[derive(Default)]
+struct LinkBuffers {
+    xs: [[f64; 3]; 4],
+    xm: [[f64; 3]; 4],
+    vs: [[f64; 3]; 4],
+    vm: [[f64; 3]; 4],
 }
 
 pub struct ContactPair {
@@ -70,6 +109,9 @@ pub struct ContactPair {
     pattern_key: u64,
     /// Master node positions of the last evaluation (deformable masters).
     positions: Vec<[f64; 3]>,
+    friction: Option<PairFriction>,
+    /// Set by the solver in dynamics (slip from velocities); None: quasi-static.
+    pub rate: Option<SlipRateMap>,
 }
 
 const MAX_LINK_NODES: usize = 8;
@@ -92,9 +134,18 @@ impl ContactPair {
             }
             MasterSpec::Rigid(r) => MasterSide::Rigid(*r),
         };
-        let multipliers = Multipliers::new(mesh, dofs, partition, &spec.slave, &slave, &rule)?;
+        let friction_spec = spec.active_friction();
+        let multipliers = Multipliers::new(
+            mesh,
+            dofs,
+            partition,
+            &spec.slave,
+            &slave,
+            &rule,
+            friction_spec.is_some(),
+        )?;
         let penalty = spec.penalty.unwrap_or(10.0 * softest_youngs / slave.h);
-        let facet_penalty = slave
+        let facet_penalty: Vec<f64> = slave
             .facets
             .iter()
             .map(|f| spec.penalty.unwrap_or(10.0 * softest_youngs / f.h))
@@ -111,6 +162,13 @@ impl ContactPair {
         let search_distance = spec
             .search_distance
             .unwrap_or_else(|| default_search_distance(mesh, &master, slave.h));
+        let friction = friction_spec.map(|f| PairFriction {
+            mu: f.mu,
+            penalty: match f.penalty {
+                Some(p) => vec![p; slave.facets.len()],
+                None => facet_penalty.clone(),
+            },
+        });
         Ok(ContactPair {
             spec: spec.clone(),
             slave,
@@ -122,6 +180,8 @@ impl ContactPair {
             links: Vec::new(),
             pattern_key: 0,
             positions: Vec::new(),
+            friction,
+            rate: None,
         })
     }
 
@@ -186,7 +246,7 @@ impl ContactPair {
                 }
             }
             MasterSide::Rigid(spec) => {
-                let geometry = spec.moved(self.spec.motion, factor);
+                let geometry = spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor));
                 for (q, x) in points.iter().enumerate() {
                     if geometry.distance(*x) <= self.search_distance {
                         self.links.push(Link {
@@ -199,6 +259,7 @@ impl ContactPair {
                 }
             }
         }
+        self.start_slip(&points, factor);
         let key = self.coupling_key();
         let changed = key != self.pattern_key;
         self.pattern_key = key;
@@ -287,51 +348,24 @@ impl ContactPair {
         dofs: &DofMap,
     ) -> Result<()> {
         self.follow(u_local);
-        let ns = self.slave.facet_type.nodes();
-        let mut xs = [[0.0; 3]; 4];
-        let mut xm = [[0.0; 3]; 4];
+        let mut buf = LinkBuffers::default();
         let mut r = [0.0; MAX_LINK_DOFS];
         let mut k = vec![0.0; MAX_LINK_DOFS * MAX_LINK_DOFS];
         let mut nodes: Vec<u32> = Vec::with_capacity(MAX_LINK_NODES);
         let mut link_dofs: Vec<PetscInt> = Vec::with_capacity(MAX_LINK_DOFS);
         for li in 0..self.links.len() {
-            let (qp, facet, xi) = (
-                self.links[li].qp as usize,
-                self.links[li].facet,
-                self.links[li].xi,
-            );
-            let sf = qp / self.slave.nqp;
-            self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
+            let link = &self.links[li];
+            let sf = link.qp as usize / self.slave.nqp;
             nodes.clear();
             link_dofs.clear();
             nodes.extend_from_slice(&self.slave.facets[sf].nodes);
             link_dofs.extend_from_slice(&self.slave.facets[sf].dofs);
-            let master = match &self.master {
-                MasterSide::Deformable(m) => {
-                    let fnodes = m.facet_nodes(facet);
-                    for (x, &n) in xm.iter_mut().zip(fnodes) {
-                        *x = self.positions[n as usize];
-                    }
-                    nodes.extend(fnodes.iter().map(|&n| m.node_local[n as usize]));
-                    m.facet_dofs(facet, dofs, &mut link_dofs);
-                    Master::Facet {
-                        facet: m.facet_type,
-                        x: &xm[..fnodes.len()],
-                    }
-                }
-                MasterSide::Rigid(spec) => spec.moved(self.spec.motion, factor).as_master(),
-            };
-            let input = LinkInput {
-                slave_facet: self.slave.facet_type,
-                slave_x: &xs[..ns],
-                zeta: self.slave.qp_zeta[qp],
-                weight: self.slave.qp_weight[qp],
-                master,
-                xi_start: xi,
-                lambda_n: self.multipliers.lambda[qp],
-                penalty: self.facet_penalty[qp / self.slave.nqp],
-                friction: None,
-            };
+            if let MasterSide::Deformable(m) = &self.master {
+                let fnodes = m.facet_nodes(link.facet);
+                nodes.extend(fnodes.iter().map(|&n| m.node_local[n as usize]));
+                m.facet_dofs(link.facet, dofs, &mut link_dofs);
+            }
+            let input = self.link_input(link, u_local, factor, &mut buf);
             let n = link_dofs.len();
             let state = if with_tangent {
                 link::residual_tangent(&input, &mut r[..n], Some(&mut k[..n * n]))
@@ -339,7 +373,7 @@ impl ContactPair {
                 link::residual_tangent(&input, &mut r[..n], None)
             };
             self.links[li].xi = state.xi;
-            if state.pressure > 0.0 {
+            if state.closed {
                 sink(
                     &nodes,
                     &link_dofs,
@@ -350,6 +384,172 @@ impl ContactPair {
             }
         }
         Ok(())
+    }
+
+    /// The kernel's input for one link at the current state: slave and master
+    /// positions, λN, and (with friction) the slip history and velocities.
+    fn link_input<'b>(
+        &'b self,
+        link: &Link,
+        u_local: &[f64],
+        factor: f64,
+        buf: &'b mut LinkBuffers,
+    ) -> LinkInput<'b> {
+        let LinkBuffers { xs, xm, vs, vm } = buf;
+        let qp = link.qp as usize;
+        let sf = qp / self.slave.nqp;
+        let ns = self.slave.facet_type.nodes();
+        self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
+        let (master, master_nodes): (Master, &[u32]) = match &self.master {
+            MasterSide::Deformable(m) => {
+                let fnodes = m.facet_nodes(link.facet);
+                for (x, &n) in xm.iter_mut().zip(fnodes) {
+                    *x = self.positions[n as usize];
+                }
+                let x: &'b [[f64; 3]] = &xm[..fnodes.len()];
+                (
+                    Master::Facet {
+                        facet: m.facet_type,
+                        x,
+                    },
+                    fnodes,
+                )
+            }
+            MasterSide::Rigid(spec) => (
+                spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor))
+                    .as_master(),
+                &[],
+            ),
+        };
+        let friction = match (&self.friction, &self.multipliers.tangential) {
+            (Some(pf), Some(t)) => {
+                let rate = self.rate.as_ref().map(|rate| {
+                    let velocity = |local: u32| {
+                        let d = DIM * local as usize;
+                        [0, 1, 2].map(|c| rate.dv_du * u_local[d + c] + rate.offset[d + c])
+                    };
+                    for (v, &n) in vs.iter_mut().zip(&self.slave.facets[sf].nodes) {
+                        *v = velocity(n);
+                    }
+                    let nm = match &self.master {
+                        MasterSide::Deformable(m) => {
+                            for (v, &n) in vm.iter_mut().zip(master_nodes) {
+                                *v = velocity(m.node_local[n as usize]);
+                            }
+                            master_nodes.len()
+                        }
+                        MasterSide::Rigid(_) => {
+                            vm[0] = rate.rigid_velocity;
+                            1
+                        }
+                    };
+                    SlipRate {
+                        slave_v: &vs[..ns],
+                        master_v: &vm[..nm],
+                        dt: rate.dt,
+                        dv_dx: rate.dv_du,
+                    }
+                });
+                Some(Friction {
+                    mu: pf.mu,
+                    penalty: pf.penalty[sf],
+                    history: self.slip_history(&t.points[qp], link, factor, u_local),
+                    rate,
+                })
+            }
+            _ => None,
+        };
+        LinkInput {
+            slave_facet: self.slave.facet_type,
+            slave_x: &xs[..ns],
+            zeta: self.slave.qp_zeta[qp],
+            weight: self.slave.qp_weight[qp],
+            master,
+            xi_start: link.xi,
+            lambda_n: self.multipliers.lambda[qp],
+            penalty: self.facet_penalty[sf],
+            friction,
+        }
+    }
+
+    /// The point's slip origin and λT in the terms of the link's current
+    /// master: on a facet other than the one they were stored on, they are
+    /// carried over (the origin as the same material point of the reference
+    /// surface, λT as the same vector).
+    fn slip_history(
+        &self,
+        p: &PointFriction,
+        link: &Link,
+        factor: f64,
+        u_local: &[f64],
+    ) -> SlipHistory {
+        match &self.master {
+            MasterSide::Deformable(m) => {
+                let xi_n = match p.origin {
+                    Some((o, f)) if f == link.facet => [o[0], o[1]],
+                    Some((o, f)) => rebase_origin(m, f, [o[0], o[1]], link.facet, link.xi),
+                    None => link.xi,
+                };
+                let lambda = if p.lambda_facet == link.facet || p.lambda == [0.0; 3] {
+                    [p.lambda[0], p.lambda[1]]
+                } else {
+                    rebase_lambda(
+                        m,
+                        &self.positions,
+                        p.lambda_facet,
+                        [p.lambda[0], p.lambda[1]],
+                        link.facet,
+                        link.xi,
+                    )
+                };
+                SlipHistory::Convected { xi_n, lambda }
+            }
+            MasterSide::Rigid(spec) => {
+                let shift = self.rigid_shift(factor);
+                let point_n = match p.origin {
+                    Some((o, _)) => [o[0] + shift[0], o[1] + shift[1], o[2] + shift[2]],
+                    // No history (the step's search sets one for every
+                    // link): no slip yet.
+                    None => spec
+                        .moved(self.spec.motion, factor)
+                        .closest_point(self.slave.qp_position(link.qp as usize, u_local)),
+                };
+                SlipHistory::Spatial {
+                    point_n,
+                    lambda: p.lambda,
+                }
+            }
+        }
+    }
+
+    /// At the step's search: points that come into contact start measuring
+    /// their slip where they first meet the master.
+    fn start_slip(&mut self, points: &[[f64; 3]], factor: f64) {
+        let shift = self.rigid_shift(factor);
+        let Some(t) = &mut self.multipliers.tangential else {
+            return;
+        };
+        for l in &self.links {
+            let p = &mut t.points[l.qp as usize];
+            if p.origin.is_some() {
+                continue;
+            }
+            p.origin = Some(match &self.master {
+                MasterSide::Deformable(_) => ([l.xi[0], l.xi[1], 0.0], l.facet),
+                MasterSide::Rigid(spec) => {
+                    let foot = spec
+                        .moved(self.spec.motion, factor)
+                        .closest_point(points[l.qp as usize]);
+                    (
+                        [foot[0] - shift[0], foot[1] - shift[1], foot[2] - shift[2]],
+                        0,
+                    )
+                }
+            });
+            if p.lambda == [0.0; 3] {
+                p.lambda_facet = l.facet;
+            }
+        }
     }
 
     /// Adds the links' residual r_c = −∫ pN δgN into the local-form array.
@@ -396,10 +596,12 @@ impl ContactPair {
         )
     }
 
-    /// The Uzawa update λN ← ⟨λN − εN gN⟩ at every slave point of this rank
-    /// (points without a link get λN = 0), then the halo exchange.
+    /// The Uzawa update λN ← ⟨λN − εN gN⟩ (and, with friction, λT ← tT) at
+    /// every slave point of this rank (points without a link get λ = 0),
+    /// then the halo exchange.
     pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
         let before = self.multipliers.nodal_forces()?;
+        let before_t = self.multipliers.nodal_tangential_forces()?;
         let states = self.evaluate_links(u_local, factor);
         let mut new_lambda = vec![0.0; self.slave.num_qps()];
         let mut stats = UzawaStats::default();
@@ -417,51 +619,117 @@ impl ContactPair {
         }
         stats.max_multiplier = new_lambda.iter().copied().fold(0.0, f64::max);
         self.multipliers.lambda = new_lambda;
+        stats.sliding = self.update_friction(&states, factor);
         self.multipliers.exchange()?;
         let after = self.multipliers.nodal_forces()?;
         for (b, a) in before.iter().zip(&after) {
             stats.max_change = stats.max_change.max((a - b).abs());
             stats.max_force = stats.max_force.max(a.abs());
         }
+        let after_t = self.multipliers.nodal_tangential_forces()?;
+        for (b, a) in before_t.iter().zip(&after_t) {
+            stats.max_change = stats.max_change.max(norm(sub(*a, *b)));
+        }
         Ok(stats)
+    }
+
+    /// λT ← tT and the stick/slip state of every point from this
+    /// evaluation; returns how many points slide.
+    fn update_friction(&mut self, states: &[LinkState], factor: f64) -> usize {
+        let shift = self.rigid_shift(factor);
+        let Some(t) = &mut self.multipliers.tangential else {
+            return 0;
+        };
+        let mut fresh = vec![PointFriction::default(); t.points.len()];
+        for (p, old) in fresh.iter_mut().zip(&t.points) {
+            // A point that is open keeps where its slip started (it may
+            // close again within the step), but no multiplier.
+            p.origin = old.origin;
+        }
+        let mut sliding = 0;
+        for (l, s) in self.links.iter().zip(states) {
+            let p = &mut fresh[l.qp as usize];
+            let Some(f) = s.friction.filter(|_| s.closed) else {
+                continue;
+            };
+            p.state = if f.sliding {
+                sliding += 1;
+                PointState::Slip
+            } else {
+                PointState::Stick
+            };
+            p.traction = f.traction;
+            p.slip = f.slip;
+            match f.updated {
+                SlipHistory::Convected { xi_n, lambda } => {
+                    p.lambda = [lambda[0], lambda[1], 0.0];
+                    p.lambda_facet = l.facet;
+                    p.next_origin = Some(([xi_n[0], xi_n[1], 0.0], l.facet));
+                }
+                SlipHistory::Spatial { point_n, lambda } => {
+                    p.lambda = lambda;
+                    p.next_origin = Some((
+                        [
+                            point_n[0] - shift[0],
+                            point_n[1] - shift[1],
+                            point_n[2] - shift[2],
+                        ],
+                        0,
+                    ));
+                }
+            }
+        }
+        t.points = fresh;
+        sliding
+    }
+
+    /// A converged step is final: the next one measures slip from here.
+    pub fn commit(&mut self) -> Result<()> {
+        if let Some(t) = &mut self.multipliers.tangential {
+            t.commit();
+            self.multipliers.exchange()?;
+        }
+        Ok(())
+    }
+
+    /// The multipliers and friction state, to restore on a cutback.
+    pub fn snapshot(&self) -> PairSnapshot {
+        PairSnapshot {
+            lambda: self.multipliers.lambda.clone(),
+            friction: self
+                .multipliers
+                .tangential
+                .as_ref()
+                .map(|t| t.points.clone()),
+        }
+    }
+
+    pub fn restore(&mut self, snap: PairSnapshot) -> Result<()> {
+        self.multipliers.lambda = snap.lambda;
+        if let (Some(t), Some(points)) = (&mut self.multipliers.tangential, snap.friction) {
+            t.points = points;
+        }
+        self.multipliers.exchange()
+    }
+
+    /// Translation of a rigid master at load factor `factor`.
+    pub fn rigid_shift(&self, factor: f64) -> [f64; 3] {
+        let a = self.spec.motion_amplitude.at(factor);
+        self.spec.motion.map(|c| c * a)
+    }
+
+    /// Whether the pair computes friction.
+    pub fn has_friction(&self) -> bool {
+        self.friction.is_some()
     }
 
     fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
         self.follow(u_local);
-        let ns = self.slave.facet_type.nodes();
-        let mut xs = [[0.0; 3]; 4];
-        let mut xm = [[0.0; 3]; 4];
-        let mut out = Vec::with_capacity(self.links.len());
-        for l in &self.links {
-            let qp = l.qp as usize;
-            self.slave
-                .facet_positions(qp / self.slave.nqp, u_local, &mut xs[..ns]);
-            let master = match &self.master {
-                MasterSide::Deformable(m) => {
-                    let fnodes = m.facet_nodes(l.facet);
-                    for (x, &n) in xm.iter_mut().zip(fnodes) {
-                        *x = self.positions[n as usize];
-                    }
-                    Master::Facet {
-                        facet: m.facet_type,
-                        x: &xm[..fnodes.len()],
-                    }
-                }
-                MasterSide::Rigid(spec) => spec.moved(self.spec.motion, factor).as_master(),
-            };
-            out.push(link::evaluate(&LinkInput {
-                slave_facet: self.slave.facet_type,
-                slave_x: &xs[..ns],
-                zeta: self.slave.qp_zeta[qp],
-                weight: self.slave.qp_weight[qp],
-                master,
-                xi_start: l.xi,
-                lambda_n: self.multipliers.lambda[qp],
-                penalty: self.facet_penalty[qp / self.slave.nqp],
-                friction: None,
-            }));
-        }
-        out
+        let mut buf = LinkBuffers::default();
+        self.links
+            .iter()
+            .map(|l| link::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
+            .collect()
     }
 
     /// Reference position and nodal contact pressure of every slave node
@@ -496,8 +764,16 @@ impl ContactPair {
             pressure: vec![0.0; nq],
             gap: vec![self.search_distance; nq],
             lambda: self.multipliers.lambda.clone(),
+            traction: Vec::new(),
+            slip: Vec::new(),
+            state: Vec::new(),
             nodes: self.node_values()?,
         };
+        if let Some(t) = &self.multipliers.tangential {
+            values.traction = t.points.iter().map(|p| p.traction).collect();
+            values.slip = t.points.iter().map(|p| p.slip).collect();
+            values.state = t.points.iter().map(|p| p.state as i8).collect();
+        }
         let mut force = [0.0; 3];
         for (l, s) in self.links.iter().zip(&states) {
             let q = l.qp as usize;
@@ -510,6 +786,12 @@ impl ContactPair {
             let w = self.slave.qp_weight[q];
             for (f, n) in force.iter_mut().zip(s.normal) {
                 *f += p * n * w;
+            }
+            if let Some(t) = &self.multipliers.tangential {
+                // The traction of the last Uzawa update, like λN above.
+                for (f, tc) in force.iter_mut().zip(t.points[q].traction) {
+                    *f += tc * w;
+                }
             }
         }
         Ok((values, force))
@@ -541,6 +823,73 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Tangents `∂x/∂ξ_α` of a facet with nodes `x` at `xi`.
+fn facet_tangents(m: &MasterSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
+    let s = crate::fem::shape::facet_shape(m.facet_type, xi);
+    let mut t = [[0.0; 3]; 2];
+    for (xb, dn) in x.iter().zip(&s.dn) {
+        for c in 0..3 {
+            t[0][c] += dn[0] * xb[c];
+            t[1][c] += dn[1] * xb[c];
+        }
+    }
+    t
+}
+
+fn facet_points(m: &MasterSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    m.facet_nodes(facet)
+        .iter()
+        .map(|&n| positions[n as usize])
+        .collect()
+}
+
+/// ξ̄ₙ stored on facet `from`, expressed on facet `to`: the same point of the
+/// reference surface (history data is material, so the conversion is
+/// independent of the current displacements).
+fn rebase_origin(m: &MasterSurface, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
+    let from_x = facet_points(m, from, &m.x_ref);
+    let s = crate::fem::shape::facet_shape(m.facet_type, xi);
+    let mut p = [0.0; 3];
+    for (xb, nb) in from_x.iter().zip(s.n) {
+        for c in 0..3 {
+            p[c] += nb * xb[c];
+        }
+    }
+    let to_x = facet_points(m, to, &m.x_ref);
+    super::projection::project(m.facet_type, &to_x, p, Some(guess)).xi
+}
+
+/// λT's covariant components on facet `from` carried to facet `to` as the
+/// same vector (tangents of `from` at its centre, of `to` at `xi`).
+fn rebase_lambda(
+    m: &MasterSurface,
+    positions: &[[f64; 3]],
+    from: u32,
+    lambda: [f64; 2],
+    to: u32,
+    xi: [f64; 2],
+) -> [f64; 2] {
+    let [t1, t2] = facet_tangents(
+        m,
+        &facet_points(m, from, positions),
+        super::projection::reference_centre(m.facet_type),
+    );
+    let (m11, m12, m22) = (dot(t1, t1), dot(t1, t2), dot(t2, t2));
+    let det = m11 * m22 - m12 * m12;
+    if det.abs() <= f64::MIN_POSITIVE {
+        return [0.0; 2];
+    }
+    let c1 = (m22 * lambda[0] - m12 * lambda[1]) / det;
+    let c2 = (m11 * lambda[1] - m12 * lambda[0]) / det;
+    let v = [0, 1, 2].map(|i| c1 * t1[i] + c2 * t2[i]);
+    let [s1, s2] = facet_tangents(m, &facet_points(m, to, positions), xi);
+    [dot(v, s1), dot(v, s2)]
 }
 
 /// Default search distance: generous enough that bodies approaching within a

@@ -5,8 +5,10 @@
 //! - `search`: spatial index, outer and inner search;
 //! - `projection`: closest-point projection onto a master facet;
 //! - `link`: the kernel of one link: gap, normal, contact pressure
-//!   pN = ⟨λN − εN gN⟩, residual and consistent tangent;
-//! - `multipliers`: λN at the slave points, the Uzawa update rule, halo exchange;
+//!   pN = ⟨λN − εN gN⟩, Coulomb friction (trial traction, stick/slip, return
+//!   map), residual and consistent tangent;
+//! - `multipliers`: λN and the friction state (λT, slip origin, stick/slip)
+//!   at the slave points, the Uzawa update rule, halo exchange;
 //! - `links`: a pair at run time (search per step, assembly, Uzawa update).
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
@@ -20,4 +22,4 @@ pub mod search;
 pub mod surfaces;
 
 pub use links::{ContactPair, UzawaStats};
-pub use pair::{MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
+pub use pair::{FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

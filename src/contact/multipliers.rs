@@ -7,6 +7,11 @@
 //! points of other ranks' slave facets that touch a node this rank owns, so
 //! nodal quantities (the nodal contact pressure) need no further messages.
 //! The ghosts are refreshed by a halo exchange after every Uzawa update.
+//!
+//! With friction every point also carries its tangential state (λT, where
+//! this step's slip is measured from, stick/slip, traction and slip), in a
+//! second ghosted vector with the same owned + ghost layout, exchanged with
+//! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use super::link::reference_weights;
 use super::surfaces::SlaveSurface;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
@@ -32,9 +37,67 @@ struct NodalWeight {
     weight: f64,
 }
 
+/// Contact state of a slave point, as written to the output (`state`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum PointState {
+    #[default]
+    Open = 0,
+    Stick = 1,
+    Slip = 2,
+}
+
+/// Tangential (friction) state of one slave point.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PointFriction {
+    /// λT: covariant components `[λ_1, λ_2, 0]` on master facet
+    /// `lambda_facet` (deformable master), or a vector (rigid master).
+    pub lambda: [f64; 3],
+    pub lambda_facet: u32,
+    /// Where this step's slip is measured from: `[ξ̄ₙ_1, ξ̄ₙ_2, 0]` on the
+    /// given facet, or (rigid master) the contact point in the master's own
+    /// frame (its placement minus its motion). None before first contact.
+    pub origin: Option<([f64; 3], u32)>,
+    /// The origin the next step starts from (the master point of the last
+    /// Uzawa update), taken over by `commit` once the step has converged.
+    pub next_origin: Option<([f64; 3], u32)>,
+    pub state: PointState,
+    /// Tangential traction on the slave per reference area.
+    pub traction: [f64; 3],
+    pub slip: [f64; 3],
+}
+
+/// Values per point in the friction halo: traction (3), λT (3), origin (3),
+/// state (1).
+const FRICTION_WIDTH: usize = 10;
+
+/// The friction state of every owned point and its halo.
+pub struct Tangential {
+    pub points: Vec<PointFriction>,
+    halo: GhostedVector,
+}
+
+impl Tangential {
+    /// Start of a converged step's successor: slip is measured from where
+    /// each closed point now is; open points forget their history.
+    pub fn commit(&mut self) {
+        for p in &mut self.points {
+            p.origin = match p.state {
+                PointState::Open => None,
+                _ => p.next_origin,
+            };
+            if p.state == PointState::Open {
+                p.lambda = [0.0; 3];
+            }
+        }
+    }
+}
+
 pub struct Multipliers {
     /// λN of the owned points (same order as the slave surface's points).
     pub lambda: Vec<f64>,
+    /// Friction state (None for a frictionless pair: nothing is stored,
+    /// exchanged or evaluated).
+    pub tangential: Option<Tangential>,
     halo: GhostedVector,
     n_owned: usize,
     n_ghost: usize,
@@ -54,6 +117,7 @@ impl Multipliers {
         set: &str,
         slave: &SlaveSurface,
         rule: &QuadRule,
+        friction: bool,
     ) -> Result<Self> {
         let facets = mesh
             .facet_sets
@@ -117,8 +181,23 @@ impl Multipliers {
         for (k, &i) in ghost_facets.iter().enumerate() {
             add_facet(i, n_owned + k * nqp)?;
         }
+        let tangential = if friction {
+            let wide: Vec<PetscInt> = ghosts
+                .iter()
+                .flat_map(|&g| {
+                    (0..FRICTION_WIDTH as PetscInt).map(move |c| g * FRICTION_WIDTH as PetscInt + c)
+                })
+                .collect();
+            Some(Tangential {
+                points: vec![PointFriction::default(); n_owned],
+                halo: GhostedVector::new(n_owned * FRICTION_WIDTH, &wide)?,
+            })
+        } else {
+            None
+        };
         Ok(Multipliers {
             lambda: vec![0.0; n_owned],
+            tangential,
             halo,
             n_owned,
             n_ghost: ghosts.len(),
@@ -135,7 +214,39 @@ impl Multipliers {
             .global_mut()
             .with_array_mut(|a| a.copy_from_slice(lambda))?;
         self.halo.update_ghosts()?;
+        if let Some(t) = &mut self.tangential {
+            let points = &t.points;
+            t.halo.global_mut().with_array_mut(|a| {
+                for (chunk, p) in a.chunks_exact_mut(FRICTION_WIDTH).zip(points) {
+                    let origin = p.origin.map_or([f64::NAN; 3], |(o, _)| o);
+                    chunk[..3].copy_from_slice(&p.traction);
+                    chunk[3..6].copy_from_slice(&p.lambda);
+                    chunk[6..9].copy_from_slice(&origin);
+                    chunk[9] = p.state as i32 as f64;
+                }
+            })?;
+            t.halo.update_ghosts()?;
+        }
         Ok(())
+    }
+
+    /// Tangential force carried by each owned slave node: Σ N_a(ζ) w tT over
+    /// every slave point around it (any rank, through the friction halo).
+    /// Zero vectors for a frictionless pair.
+    pub fn nodal_tangential_forces(&self) -> Result<Vec<[f64; 3]>> {
+        let mut forces = vec![[0.0; 3]; self.owned_nodes.len()];
+        if let Some(t) = &self.tangential {
+            t.halo.with_local(|all| {
+                for w in &self.nodal {
+                    let base = FRICTION_WIDTH * w.slot as usize;
+                    let f = &mut forces[w.owned_slot as usize];
+                    for (fi, ti) in f.iter_mut().zip(&all[base..base + 3]) {
+                        *fi += w.weight * ti;
+                    }
+                }
+            })?;
+        }
+        Ok(forces)
     }
 
     /// Normal contact force carried by each owned slave node: Σ N_a(ζ) w λN

@@ -92,6 +92,26 @@ impl RigidSurface {
         }
     }
 
+    /// The point of the surface nearest `x` (for a surface placed by `moved`;
+    /// `x` itself where the nearest point is not unique).
+    pub fn closest_point(&self, x: [f64; 3]) -> [f64; 3] {
+        let d = self.distance(x);
+        let n = match *self {
+            RigidSurface::Plane { normal, .. } => normal,
+            RigidSurface::Sphere { centre, .. } => sub(x, centre),
+            RigidSurface::Cylinder { point, axis, .. } => {
+                let v = sub(x, point);
+                let along = dot(v, axis);
+                sub(v, [along * axis[0], along * axis[1], along * axis[2]])
+            }
+        };
+        let len = norm(n);
+        if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return x;
+        }
+        [0, 1, 2].map(|i| x[i] - d * n[i] / len)
+    }
+
     /// Signed distance of `x` from the surface (negative inside the rigid body),
     /// for a surface placed by `moved`.
     pub fn distance(&self, x: [f64; 3]) -> f64 {
@@ -174,6 +194,15 @@ impl SlaveQuadrature {
     }
 }
 
+/// Coulomb friction of a pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionSpec {
+    /// Friction coefficient μ ≥ 0 (μ = 0 is the same as no friction).
+    pub mu: f64,
+    /// Tangential penalty εT > 0; None: the pair's normal penalty εN.
+    pub penalty: Option<f64>,
+}
+
 /// One contact pair.
 #[derive(Debug, Clone)]
 pub struct PairSpec {
@@ -182,8 +211,10 @@ pub struct PairSpec {
     pub slave: String,
     pub master: MasterSpec,
     pub quadrature: SlaveQuadrature,
-    /// Translation of a rigid master at full load (ramped with the load factor).
+    /// Translation of a rigid master at full amplitude ...
     pub motion: [f64; 3],
+    /// ... and how it follows the load factor (default: a linear ramp).
+    pub motion_amplitude: crate::amplitude::Amplitude,
     /// εN; None: 10·E/h with E the softest body's modulus and h the mean slave facet size.
     pub penalty: Option<f64>,
     /// Uzawa stops when every link's penetration is at most this fraction of its facet's size ...
@@ -194,6 +225,15 @@ pub struct PairSpec {
     /// Slave points farther than this from the master get no link; None: the
     /// larger of 10·h and a tenth of the master's bounding-box diagonal.
     pub search_distance: Option<f64>,
+    /// Coulomb friction; None (or μ = 0): frictionless, no tangential terms.
+    pub friction: Option<FrictionSpec>,
+}
+
+impl PairSpec {
+    /// The pair's friction if it has any to compute (μ > 0).
+    pub fn active_friction(&self) -> Option<FrictionSpec> {
+        self.friction.filter(|f| f.mu > 0.0)
+    }
 }
 
 impl PairSpec {
@@ -204,11 +244,13 @@ impl PairSpec {
             master,
             quadrature: SlaveQuadrature::default(),
             motion: [0.0; 3],
+            motion_amplitude: crate::amplitude::Amplitude::ramp(),
             penalty: None,
             penetration_tol: 1e-3,
             multiplier_tol: 1e-3,
             max_uzawa: 30,
             search_distance: None,
+            friction: None,
         }
     }
 }

@@ -385,6 +385,75 @@ fn add_weighted_load(n: &[f64], b: [f64; 3], jxw: f64, f: &mut [f64]) {
     }
 }
 
+/// Consistent mass `M_{(3a+i)(3b+j)} = δ_ij ∫ ρ N_a N_b dV` over the
+/// reference volume (row-major `(3n) × (3n)`, overwritten). `density` is the
+/// reference density, so in total-Lagrangian form the matrix never changes
+/// with the deformation and is assembled once per run.
+///
+/// Quadrature, chosen so the matrix is exact where it can be and never
+/// singular:
+///
+/// - `Hex8` uses the geometry's own rule. 2×2×2 Gauss integrates `N_a N_b`
+///   exactly on a parallelepiped (constant `det J`); on a distorted hex the
+///   integrand also carries the non-constant `det J` and the result is
+///   approximate, but the total mass `Σ_ab M_ab = ρ V` stays exact because
+///   `Σ_a N_a = 1` reduces it to the volume integral. Rules with fewer than 8
+///   points are rejected: they give a rank-deficient matrix.
+/// - `Tet4` always uses the 4-point degree-2 rule, whatever rule built the
+///   geometry: `N_a N_b` is quadratic and the default 1-point rule would
+///   lump everything onto the centroid (rank 3). `det J` is constant on a
+///   linear tet, so the volume from any rule carries over exactly and the
+///   result is the closed form `ρ V (1 + δ_ab) / 20`.
+pub fn mass_matrix(geom: &ElementGeometry, density: f64, m: &mut [f64]) -> Result<(), FemError> {
+    geom.check()?;
+    if !(density.is_finite() && density >= 0.0) {
+        return Err(FemError::InvalidDensity { density });
+    }
+    let nodes = geom.nodes();
+    check_len("m", 9 * nodes * nodes, m.len())?;
+    m.fill(0.0);
+    match geom.cell_type {
+        CellType::Hex8 => {
+            if geom.n_qp() < nodes {
+                return Err(FemError::UnderintegratedMass {
+                    cell: geom.cell_type.name(),
+                    n_qp: geom.n_qp(),
+                    needed: nodes,
+                });
+            }
+            for (qp, &jxw) in geom.jxw.iter().enumerate() {
+                add_mass_at(geom.qp_n(qp), density * jxw, m);
+            }
+        }
+        CellType::Tet4 => {
+            let rule = QuadRule::tet_4();
+            let reference_volume: f64 = rule.weights.iter().sum();
+            let det_j = element_volume(geom) / reference_volume;
+            for (xi, w) in rule.points.iter().zip(&rule.weights) {
+                let s = shape::tet4(*xi);
+                add_mass_at(&s.n[..nodes], density * det_j * w, m);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `M_{(3a+i)(3b+i)} += weight · N_a N_b`; the three components share one
+/// scalar mass, so only the diagonal of each 3×3 node block is touched.
+fn add_mass_at(n: &[f64], weight: f64, m: &mut [f64]) {
+    let ndof = 3 * n.len();
+    for (a, na) in n.iter().enumerate() {
+        for (b, nb) in n.iter().enumerate() {
+            // `na * nb` first: IEEE products commute, so the matrix comes out
+            // bit-for-bit symmetric and CG sees no asymmetry.
+            let v = weight * (na * nb);
+            for i in 0..3 {
+                m[(3 * a + i) * ndof + 3 * b + i] += v;
+            }
+        }
+    }
+}
+
 /// Reference volume `Σ det J · w`.
 pub fn element_volume(geom: &ElementGeometry) -> f64 {
     geom.jxw.iter().sum()
@@ -883,6 +952,197 @@ mod tests {
             weights: vec![],
         };
         assert!(ElementGeometry::new(CellType::Hex8, &hex8_unit(), &empty).is_err());
+    }
+
+    fn mass(geom: &ElementGeometry, density: f64) -> Vec<f64> {
+        let ndof = 3 * geom.nodes();
+        let mut m = vec![0.0; ndof * ndof];
+        mass_matrix(geom, density, &mut m).unwrap();
+        m
+    }
+
+    /// Every case the mass tests run on: name, geometry and exact volume.
+    fn mass_cases() -> Vec<(&'static str, ElementGeometry, f64)> {
+        let tet = distorted(CellType::Tet4, 21);
+        let e = |i: usize| Vector3::from(tet[i]) - Vector3::from(tet[0]);
+        let tet_volume = e(1).cross(&e(2)).dot(&e(3)) / 6.0;
+        let twisted = twisted_hex();
+        let twisted_volume = element_volume(&geometry(CellType::Hex8, &twisted));
+        let hex3 = QuadRule::hex_3x3x3();
+        vec![
+            ("unit hex8", geometry(CellType::Hex8, &hex8_unit()), 1.0),
+            (
+                "twisted hex8",
+                geometry(CellType::Hex8, &twisted),
+                twisted_volume,
+            ),
+            (
+                "twisted hex8 3x3x3",
+                ElementGeometry::new(CellType::Hex8, &twisted, &hex3).unwrap(),
+                twisted_volume,
+            ),
+            (
+                "unit tet4",
+                geometry(CellType::Tet4, &tet4_unit()),
+                1.0 / 6.0,
+            ),
+            (
+                "distorted tet4 1-pt",
+                geometry(CellType::Tet4, &tet),
+                tet_volume,
+            ),
+            (
+                "distorted tet4 4-pt",
+                ElementGeometry::new(CellType::Tet4, &tet, &QuadRule::tet_4()).unwrap(),
+                tet_volume,
+            ),
+        ]
+    }
+
+    #[test]
+    fn mass_total_is_density_times_volume() {
+        let rho = 7.8;
+        for (name, geom, volume) in mass_cases() {
+            let m = mass(&geom, rho);
+            let ndof = 3 * geom.nodes();
+            for i in 0..3 {
+                for j in 0..3 {
+                    let total: f64 = (0..geom.nodes())
+                        .flat_map(|a| (0..geom.nodes()).map(move |b| (a, b)))
+                        .map(|(a, b)| m[(3 * a + i) * ndof + 3 * b + j])
+                        .sum();
+                    let expected = if i == j { rho * volume } else { 0.0 };
+                    assert!(
+                        (total - expected).abs() < 1e-13 * rho * volume,
+                        "{name} ({i},{j}): {total} vs {expected}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn mass_is_symmetric_positive_definite() {
+        for (name, geom, _) in mass_cases() {
+            let m = mass(&geom, 2.5);
+            let ndof = 3 * geom.nodes();
+            let dm = DMatrix::from_row_slice(ndof, ndof, &m);
+            assert_eq!(dm, dm.transpose(), "{name} not symmetric");
+            let eig = dm.symmetric_eigenvalues();
+            let (lo, hi) = (eig.min(), eig.max());
+            println!("{name}: mass eigenvalues in [{lo:.3e}, {hi:.3e}]");
+            assert!(lo > 1e-3 * hi, "{name}: smallest eigenvalue {lo:e}");
+        }
+    }
+
+    /// Unit cube: M is the tensor product of the 1D linear mass
+    /// `h/6 [[2, 1], [1, 2]]`, so `M_ab = ρ/216 · Π_d (2 if a, b share
+    /// coordinate d else 1)`: ρ/27 on the diagonal, 4ρ/216 along an edge,
+    /// 2ρ/216 across a face, ρ/216 across the body.
+    #[test]
+    fn mass_of_unit_cube_hex8_is_exact() {
+        let rho = 3.0;
+        let x = hex8_unit();
+        let m = mass(&geometry(CellType::Hex8, &x), rho);
+        for a in 0..8 {
+            assert!((m[(3 * a) * 24 + 3 * a] - rho / 27.0).abs() < 1e-15);
+            for b in 0..8 {
+                let factor: f64 = (0..3)
+                    .map(|d| if x[a][d] == x[b][d] { 2.0 } else { 1.0 })
+                    .product();
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let exact = if i == j { rho * factor / 216.0 } else { 0.0 };
+                        let got = m[(3 * a + i) * 24 + 3 * b + j];
+                        assert!((got - exact).abs() < 1e-15, "a={a} b={b}: {got} vs {exact}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// On a parallelepiped det J is constant and 2×2×2 Gauss is exact, so
+    /// the mass is the unit cube's scaled by the volume.
+    #[test]
+    fn mass_of_affine_hex8_scales_with_volume() {
+        let a = Matrix3::new(1.1, 0.2, -0.1, 0.05, 0.9, 0.3, -0.2, 0.1, 1.2);
+        let shift = Vector3::new(0.3, -2.0, 5.0);
+        let mapped: Vec<[f64; 3]> = hex8_unit()
+            .iter()
+            .map(|p| {
+                let q = a * Vector3::from(*p) + shift;
+                [q.x, q.y, q.z]
+            })
+            .collect();
+        let m = mass(&geometry(CellType::Hex8, &mapped), 1.0);
+        let unit: Vec<f64> = mass(&geometry(CellType::Hex8, &hex8_unit()), 1.0)
+            .iter()
+            .map(|v| v * a.determinant())
+            .collect();
+        assert!(rel_err(&m, &unit) < 1e-14);
+    }
+
+    #[test]
+    fn mass_of_tet4_matches_closed_form_for_any_rule() {
+        let rho = 1.7;
+        let tet = distorted(CellType::Tet4, 22);
+        let e = |i: usize| Vector3::from(tet[i]) - Vector3::from(tet[0]);
+        let volume = e(1).cross(&e(2)).dot(&e(3)) / 6.0;
+        let exact: Vec<f64> = (0..144)
+            .map(|k| {
+                let (r, c) = (k / 12, k % 12);
+                if r % 3 != c % 3 {
+                    0.0
+                } else if r / 3 == c / 3 {
+                    rho * volume / 10.0
+                } else {
+                    rho * volume / 20.0
+                }
+            })
+            .collect();
+        for rule in [QuadRule::tet_1(), QuadRule::tet_4()] {
+            let geom = ElementGeometry::new(CellType::Tet4, &tet, &rule).unwrap();
+            let err = rel_err(&mass(&geom, rho), &exact);
+            assert!(err < 1e-14, "{} points: {err:e}", rule.len());
+        }
+    }
+
+    #[test]
+    fn mass_bad_arguments_are_errors() {
+        let geom = geometry(CellType::Hex8, &hex8_unit());
+        let mut m = vec![1.0; 576];
+        mass_matrix(&geom, 0.0, &mut m).unwrap();
+        assert!(
+            m.iter().all(|&v| v == 0.0),
+            "zero density must give zero mass"
+        );
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                mass_matrix(&geom, bad, &mut m),
+                Err(FemError::InvalidDensity { .. })
+            ));
+        }
+        assert!(matches!(
+            mass_matrix(&geom, 1.0, &mut m[..575]),
+            Err(FemError::LengthMismatch { what: "m", .. })
+        ));
+        let one_point = ElementGeometry::new(
+            CellType::Hex8,
+            &hex8_unit(),
+            &QuadRule::hex_gauss(1).unwrap(),
+        )
+        .unwrap();
+        assert!(matches!(
+            mass_matrix(&one_point, 1.0, &mut m),
+            Err(FemError::UnderintegratedMass {
+                n_qp: 1,
+                needed: 8,
+                ..
+            })
+        ));
+        let mut broken = geom.clone();
+        broken.n.pop();
+        assert!(mass_matrix(&broken, 1.0, &mut m).is_err());
     }
 
     /// Lateral stretch of the uniaxial Neo-Hookean test: P22 = 0 with

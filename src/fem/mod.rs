@@ -20,8 +20,8 @@ pub mod surface;
 
 pub use element::{
     body_force, body_force_fn, deformation_gradient, element_volume, internal_force,
-    internal_force_and_tangent, interpolate, linear_stiffness, qp_positions, strain_energy,
-    ElementGeometry,
+    internal_force_and_tangent, interpolate, linear_stiffness, mass_matrix, qp_positions,
+    strain_energy, ElementGeometry,
 };
 pub use material::{Material, MaterialError, Tangent};
 pub use quadrature::QuadRule;
@@ -177,6 +177,21 @@ pub enum FemError {
     MalformedRule { points: usize, weights: usize },
     #[error("quadrature point {qp} out of range (element has {n_qp})")]
     QpOutOfRange { qp: usize, n_qp: usize },
+    /// A reference density that is negative or not finite. Zero is allowed:
+    /// a massless body is quasi-static inside a dynamic run.
+    #[error("invalid density {density}: must be finite and ≥ 0")]
+    InvalidDensity { density: f64 },
+    /// A quadrature rule with fewer points than the cell has nodes makes
+    /// the mass matrix singular, and with it the dynamic tangent of a body
+    /// with no Dirichlet support.
+    #[error(
+        "{cell} mass matrix needs at least {needed} quadrature points, the geometry has {n_qp}"
+    )]
+    UnderintegratedMass {
+        cell: &'static str,
+        n_qp: usize,
+        needed: usize,
+    },
     /// A facet with (numerically) zero area has no normal.
     #[error("degenerate {facet} facet: area element {area:e}")]
     DegenerateFacet { facet: &'static str, area: f64 },

@@ -1,4 +1,5 @@
 //! Dirichlet conditions as this rank's constrained DOFs.
+use crate::amplitude::Amplitude;
 use crate::dofs::{DofMap, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use std::collections::BTreeMap;
@@ -12,6 +13,8 @@ pub struct DirichletSpec {
     pub components: Vec<usize>,
     /// Full-load displacement of each node in `nodes` (only `components` used).
     pub values: Vec<[f64; 3]>,
+    /// How the values follow the load factor (default: linear ramp).
+    pub amplitude: Amplitude,
 }
 
 impl DirichletSpec {
@@ -23,6 +26,7 @@ impl DirichletSpec {
             nodes,
             components,
             values,
+            amplitude: Amplitude::ramp(),
         }
     }
 }
@@ -44,6 +48,8 @@ pub struct Dirichlet {
     pub dofs: Vec<ConstrainedDof>,
     pub set_of_dof: Vec<u16>,
     pub set_names: Vec<String>,
+    /// Amplitude of each set.
+    pub amplitudes: Vec<Amplitude>,
 }
 
 impl Dirichlet {
@@ -93,6 +99,7 @@ impl Dirichlet {
             dofs: dofs_v,
             set_of_dof: sets,
             set_names: specs.iter().map(|s| s.set.clone()).collect(),
+            amplitudes: specs.iter().map(|s| s.amplitude.clone()).collect(),
         })
     }
 
@@ -102,16 +109,24 @@ impl Dirichlet {
 
     /// Writes the prescribed values at load factor `factor` into owned entries.
     pub fn apply(&self, owned: &mut [f64], factor: f64) {
-        for d in &self.dofs {
-            owned[d.owned_index] = factor * d.value;
+        for (d, a) in self.with_amplitude(factor) {
+            owned[d.owned_index] = a * d.value;
         }
     }
 
     /// Replaces constrained residual entries by x − ū(factor).
     pub fn constrain_residual(&self, x: &[f64], r: &mut [f64], factor: f64) {
-        for d in &self.dofs {
-            r[d.owned_index] = x[d.owned_index] - factor * d.value;
+        for (d, a) in self.with_amplitude(factor) {
+            r[d.owned_index] = x[d.owned_index] - a * d.value;
         }
+    }
+
+    fn with_amplitude(&self, factor: f64) -> impl Iterator<Item = (&ConstrainedDof, f64)> {
+        let amp: Vec<f64> = self.amplitudes.iter().map(|a| a.at(factor)).collect();
+        self.dofs
+            .iter()
+            .zip(&self.set_of_dof)
+            .map(move |(d, &s)| (d, amp[s as usize]))
     }
 
     /// Sum of the reaction force over each set's owned DOFs on this rank

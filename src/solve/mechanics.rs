@@ -111,7 +111,7 @@ impl<'a> Mechanics<'a> {
                 if !linear {
                     bulk.add_internal_force(u_local, r_local)?;
                 }
-                loads.add_external_force(u_local, -factor, r_local)?;
+                loads.add_external_force(u_local, factor, -1.0, r_local)?;
                 for pair in contact.iter_mut() {
                     pair.add_residual(dofs, u_local, factor, r_local)?;
                 }

@@ -8,6 +8,7 @@
 pub mod boundary;
 pub mod mechanics;
 pub mod natural;
+pub mod newmark;
 
 pub use boundary::{Dirichlet, DirichletSpec};
 pub use mechanics::Mechanics;
@@ -66,8 +67,8 @@ pub struct Model {
     /// Material of each body, indexed like `mesh.bodies`.
     pub materials: Vec<Material>,
     pub dirichlet: Vec<DirichletSpec>,
-    /// (facet set name, load at full load factor).
-    pub facet_loads: Vec<(String, FacetLoad)>,
+    /// (facet set name, load at full amplitude, amplitude).
+    pub facet_loads: Vec<(String, FacetLoad, crate::amplitude::Amplitude)>,
     /// Body force per body (per unit reference volume) at full load.
     pub body_force: Vec<[f64; 3]>,
     /// A spatially varying body force b(X) at full load (manufactured solutions).
@@ -87,6 +88,8 @@ pub struct ContactReport {
     pub force: [f64; 3],
     pub max_penetration: f64,
     pub active_points: usize,
+    /// Active points that slide (friction).
+    pub sliding_points: usize,
     pub penalty: f64,
 }
 
@@ -212,7 +215,10 @@ impl<'m> Simulation<'m> {
         let model = self.model;
         let stage_solve = LogStage::register("Solve")?;
         let stage_search = LogStage::register("Contact search")?;
-        let symmetric = !self.loads.has_follower() && self.contact.is_empty();
+        // Frictionless contact keeps the tangent symmetric (it is the Hessian
+        // of a potential); friction and follower loads do not.
+        let friction = self.contact.iter().any(ContactPair::has_friction);
+        let symmetric = !self.loads.has_follower() && !friction;
         set_solver_defaults(&model.solver, symmetric, DIM * self.dofs.num_global_nodes())?;
         let Simulation {
             dofs,
@@ -269,11 +275,7 @@ impl<'m> Simulation<'m> {
             let target = (done + increment).min(1.0);
             let t0 = Instant::now();
             x_prev.copy_from(&x)?;
-            let lambda_prev: Vec<Vec<f64>> = mech
-                .contact
-                .iter()
-                .map(|p| p.multipliers.lambda.clone())
-                .collect();
+            let contact_prev: Vec<_> = mech.contact.iter().map(|p| p.snapshot()).collect();
             mech.factor = target;
             x.with_array_mut(|xa| dirichlet.apply(xa, target))?;
             if !mech.contact.is_empty() {
@@ -304,9 +306,8 @@ impl<'m> Simulation<'m> {
                 Ok(done_step) => done_step,
                 Err(failure) => {
                     x.copy_from(&x_prev)?;
-                    for (p, l) in mech.contact.iter_mut().zip(lambda_prev) {
-                        p.multipliers.lambda = l;
-                        p.multipliers.exchange()?;
+                    for (p, snap) in mech.contact.iter_mut().zip(contact_prev) {
+                        p.restore(snap)?;
                     }
                     cutbacks_here += 1;
                     let why = failure_text(&failure);
@@ -361,6 +362,9 @@ impl<'m> Simulation<'m> {
                 .map(|(pair, values)| PairFields { pair, values })
                 .collect();
             sink.step(&report, &x, &reaction, &pair_fields, &nodal_pressure)?;
+            for pair in mech.contact.iter_mut() {
+                pair.commit()?;
+            }
             steps.push(report);
             cutbacks_here = 0;
             // Grow back towards the scene's increment after a successful cut step.
@@ -451,6 +455,7 @@ fn uzawa_loop(
                     max_force: a.max_force.max(s.max_force),
                     max_multiplier: a.max_multiplier.max(s.max_multiplier),
                     active: a.active + s.active,
+                    sliding: a.sliding + s.sliding,
                 });
             return Ok(Err(StepFailure::Uzawa {
                 iterations: k,
@@ -493,14 +498,16 @@ fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaSta
             ];
             let mut g = [0.0; 4];
             world.all_reduce_into(&maxes[..], &mut g[..], SystemOperation::max());
-            let mut active = 0u64;
-            world.all_reduce_into(&(s.active as u64), &mut active, SystemOperation::sum());
+            let counts = [s.active as u64, s.sliding as u64];
+            let mut total = [0u64; 2];
+            world.all_reduce_into(&counts[..], &mut total[..], SystemOperation::sum());
             UzawaStats {
                 max_penetration: g[0],
                 max_change: g[1],
                 max_force: g[2],
                 max_multiplier: g[3],
-                active: active as usize,
+                active: total[0] as usize,
+                sliding: total[1] as usize,
             }
         })
         .collect()
@@ -525,6 +532,7 @@ fn contact_reports(
                 force: total,
                 max_penetration: s.max_penetration,
                 active_points: s.active,
+                sliding_points: s.sliding,
                 penalty: p.penalty,
             }
         })
@@ -586,14 +594,14 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
     )?;
     let mut facet_loads = Vec::new();
-    for (set, load) in &model.facet_loads {
+    for (set, load, amplitude) in &model.facet_loads {
         let facets = mesh.facet_sets.get(set).ok_or_else(|| {
             Error::scene(
                 "loads",
                 format!("facet set '{set}' does not exist in the mesh"),
             )
         })?;
-        facet_loads.push((facets.as_slice(), load.clone()));
+        facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
     }
     let loads = SurfaceLoads::new(mesh, &dofs, &facet_loads)?;
     let dirichlet = collective(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
@@ -748,8 +756,8 @@ fn print_step(s: &StepReport) {
     );
     for c in &s.contact {
         println!(
-            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], {} active points, max penetration {:.3e} h, penalty {:.3e}",
-            c.name, c.force[0], c.force[1], c.force[2], c.active_points, c.max_penetration, c.penalty
+            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], {} active points ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
+            c.name, c.force[0], c.force[1], c.force[2], c.active_points, c.sliding_points, c.max_penetration, c.penalty
         );
     }
 }
