@@ -10,7 +10,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-mpi bench hertz-study lint fmt clean
+.PHONY: deps build demo test test-mpi bench hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -58,6 +58,20 @@ hertz-study: build
 	  echo "== hertz-sphere $$args"; \
 	  $(MPIRUN) -n 2 target/release/contactlink run hertz-sphere -q $$args | grep -E "Hertz|done" ; \
 	done
+
+# Ironing (Puso & Laursen 2004 style): contact force history as CSV and PNG.
+PYTHON ?= /usr/bin/python3
+ironing: build
+	@mkdir -p out
+	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5
+	$(PYTHON) scripts/plot_history.py out/ironing.csv out/ironing.png --pair ironing --mu 0.3 --title "ironing: die dragged over a soft slab (μ = 0.3)"
+
+# The friction and dynamics figures of the README (block-slide, ironing, impact).
+friction-figures: ironing
+	$(MPIRUN) -n $(NP) target/release/contactlink run block-slide -q -o out/block-slide.h5
+	$(PYTHON) scripts/plot_history.py out/block-slide.csv out/block-slide.png --pair floor --mu 0.3 --title "block-slide (μ = 0.3)"
+	$(MPIRUN) -n $(NP) target/release/contactlink run impact -q -o out/impact.h5
+	$(MPIRUN) -n $(NP) target/release/contactlink run impact -q -o out/impact-friction.h5 --set contact.friction=0.3
 
 lint:
 	$(CARGO) fmt --all -- --check

@@ -71,6 +71,7 @@ fn model(n: usize) -> Model {
         hertz: None,
         steps: 1,
         solver: SolverSettings::default(),
+        dynamics: None,
         mesh,
     }
 }

@@ -259,6 +259,7 @@ fn model_with(
             atol: Some(1e-11),
             ..Default::default()
         },
+        dynamics: None,
     }
 }
 

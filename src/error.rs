@@ -36,6 +36,9 @@ pub enum Error {
     },
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// A broken internal invariant (a bug, not bad input).
+    #[error("internal error: {0}")]
+    Internal(String),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -146,10 +146,25 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
                     .join(", ")
             );
             for p in &model.contact {
+                let friction = match p.active_friction() {
+                    Some(f) => format!(", Coulomb friction μ = {}", f.mu),
+                    None => ", frictionless".into(),
+                };
                 println!(
-                    "  contact {}: slave {} master {:?}",
+                    "  contact {}: slave {} master {:?}{friction}",
                     p.name, p.slave, p.master
                 );
+            }
+            match &model.dynamics {
+                Some(d) => println!(
+                    "  dynamics: Newmark β = {}, γ = {}, Δt = {}, t_end = {}, densities {:?}",
+                    d.newmark.beta,
+                    d.newmark.gamma,
+                    d.time_step,
+                    d.time_step * model.steps as f64,
+                    d.density
+                ),
+                None => println!("  quasi-static (no mass matrix)"),
             }
             println!(
                 "  steps {}, output {}",
@@ -211,9 +226,10 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                 }
                 match &summary.output {
                     Some(p) => println!(
-                        "output: {} (+ {})",
+                        "output: {} (+ {}, per-step history {})",
                         p.display(),
-                        p.with_extension("xmf").display()
+                        p.with_extension("xmf").display(),
+                        p.with_extension("csv").display()
                     ),
                     None => println!("output: none (give -o FILE.h5)"),
                 }

@@ -81,7 +81,9 @@ pub fn run_model(
             }
             rt.world().barrier();
             let file = create_result_file(rt, &sim, path)?;
+            let history = HistoryCsv::create(rt, &path.with_extension("csv"))?;
             let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut hertz);
+            let mut sink = Tee(history, &mut sink);
             sim.run(rt, &mut sink, echo)?
         }
         None => sim.run(rt, &mut hertz, echo)?,
@@ -96,6 +98,132 @@ pub fn run_model(
     })
 }
 
+/// Per-step history as CSV next to the HDF5 file (rank 0 writes it): load
+/// factor, time, iterations, each pair's contact force (vector, normal and
+/// tangential parts, active and sliding points), each Dirichlet set's
+/// reaction, and in dynamics the energies and momentum. One row per
+/// converged step, flushed as it goes.
+struct HistoryCsv {
+    out: Option<std::io::BufWriter<std::fs::File>>,
+    path: PathBuf,
+    header_written: bool,
+}
+
+impl HistoryCsv {
+    fn create(rt: &Runtime, path: &Path) -> Result<Self> {
+        let out = if rt.rank() == 0 {
+            let f = std::fs::File::create(path).map_err(|e| {
+                std::io::Error::new(e.kind(), format!("cannot create {}: {e}", path.display()))
+            });
+            Some(f.map(std::io::BufWriter::new))
+        } else {
+            None
+        };
+        let out = crate::solve::collective(&rt.world(), out.transpose().map_err(Into::into))?;
+        Ok(HistoryCsv {
+            out,
+            path: path.to_path_buf(),
+            header_written: false,
+        })
+    }
+
+    fn header(report: &StepReport) -> Vec<String> {
+        let mut h: Vec<String> = ["step", "load_factor", "time", "newton", "uzawa"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        for c in &report.contact {
+            for k in [
+                "fx",
+                "fy",
+                "fz",
+                "normal",
+                "tangential",
+                "active",
+                "sliding",
+            ] {
+                h.push(format!("{}.{k}", c.name));
+            }
+        }
+        for (i, (set, _)) in report.reactions.iter().enumerate() {
+            for k in ["rx", "ry", "rz"] {
+                h.push(format!("dirichlet{i}:{set}.{k}"));
+            }
+        }
+        if report.dynamics.is_some() {
+            for k in ["kinetic", "strain", "px", "py", "pz"] {
+                h.push(k.to_string());
+            }
+        }
+        h
+    }
+
+    fn row(report: &StepReport) -> Vec<String> {
+        let time = report.dynamics.map_or(report.load_factor, |d| d.time);
+        let mut r = vec![
+            report.index.to_string(),
+            format!("{:.12e}", report.load_factor),
+            format!("{time:.12e}"),
+            report.newton_iterations.to_string(),
+            report.uzawa_iterations.to_string(),
+        ];
+        let num = |v: f64| format!("{v:.12e}");
+        for c in &report.contact {
+            r.extend(c.force.iter().map(|v| num(*v)));
+            r.push(num(c.normal_force));
+            r.push(num(c.tangential_force));
+            r.push(c.active_points.to_string());
+            r.push(c.sliding_points.to_string());
+        }
+        for (_, f) in &report.reactions {
+            r.extend(f.iter().map(|v| num(*v)));
+        }
+        if let Some(d) = &report.dynamics {
+            r.push(num(d.kinetic));
+            r.push(num(d.strain));
+            r.extend(d.momentum.iter().map(|v| num(*v)));
+        }
+        r
+    }
+}
+
+impl StepSink for HistoryCsv {
+    fn step(
+        &mut self,
+        report: &StepReport,
+        _: &Vector,
+        _: &Vector,
+        _: &[PairFields],
+        _: &[f64],
+        _: Option<&Vector>,
+    ) -> Result<()> {
+        use std::io::Write;
+        let Some(out) = &mut self.out else {
+            return Ok(());
+        };
+        let mut write = || -> std::io::Result<()> {
+            if !self.header_written {
+                writeln!(out, "{}", Self::header(report).join(","))?;
+            }
+            writeln!(out, "{}", Self::row(report).join(","))?;
+            out.flush()
+        };
+        // Only rank 0 writes, so a failure here must not end the run (the
+        // other ranks would wait in the next collective): warn and stop.
+        match write() {
+            Ok(()) => self.header_written = true,
+            Err(e) => {
+                eprintln!(
+                    "contactlink: warning: writing {} failed ({e}); no further history rows",
+                    self.path.display()
+                );
+                self.out = None;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Two sinks in a row.
 struct Tee<'a, A: StepSink>(A, &'a mut dyn StepSink);
 
@@ -107,9 +235,10 @@ impl<A: StepSink> StepSink for Tee<'_, A> {
         r: &Vector,
         contact: &[PairFields],
         nodal: &[f64],
+        velocity: Option<&Vector>,
     ) -> Result<()> {
-        self.0.step(report, u, r, contact, nodal)?;
-        self.1.step(report, u, r, contact, nodal)
+        self.0.step(report, u, r, contact, nodal, velocity)?;
+        self.1.step(report, u, r, contact, nodal, velocity)
     }
 }
 
@@ -139,6 +268,7 @@ impl StepSink for HertzObserver {
         _: &Vector,
         contact: &[PairFields],
         _: &[f64],
+        _: Option<&Vector>,
     ) -> Result<()> {
         let Some(check) = &self.check else {
             return Ok(());
@@ -244,7 +374,9 @@ impl Hdf5Sink {
             ("gap", v.gap.clone()),
             ("lambda_n", v.lambda.clone()),
         ];
-        if !v.state.is_empty() {
+        // Decided by the pair, not by this rank's points: a rank may own no
+        // slave point, and every rank must write the same datasets.
+        if fields.pair.has_friction() {
             vectors.push(("traction_t", flat(&v.traction)));
             vectors.push(("slip", flat(&v.slip)));
             // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
@@ -289,51 +421,53 @@ impl StepSink for Hdf5Sink {
         reaction: &Vector,
         contact: &[PairFields],
         nodal_pressure: &[f64],
+        velocity: Option<&Vector>,
     ) -> Result<()> {
         let (start, u) = self.natural.block_of(displacement)?;
         let (_, r) = self.natural.block_of(reaction)?;
+        let v = velocity.map(|v| self.natural.block_of(v)).transpose()?;
         let info = StepInfo {
             index: report.index,
-            time: report.load_factor,
+            time: report.dynamics.map_or(report.load_factor, |d| d.time),
             load_factor: report.load_factor,
             newton_iterations: report.newton_iterations,
             uzawa_iterations: report.uzawa_iterations,
             converged: true,
             wall_seconds: report.wall_seconds,
         };
-        let ub = BlockRows {
+        let nodal = |data| BlockRows {
             global_rows: self.nodes,
             start,
             cols: 3,
-            data: &u,
+            data,
         };
-        let rb = BlockRows {
-            global_rows: self.nodes,
-            start,
-            cols: 3,
-            data: &r,
-        };
-        if contact.is_empty() {
-            self.file
-                .write_step(&info, &[("displacement", ub), ("reaction", rb)], &[])?;
-            return Ok(());
+        let mut fields = vec![("displacement", nodal(&u)), ("reaction", nodal(&r))];
+        if let Some((_, v)) = &v {
+            fields.push(("velocity", nodal(v)));
         }
-        let (pstart, p) = self.natural_scalar.block_of_owned(nodal_pressure)?;
-        let pb = BlockRows {
-            global_rows: self.nodes,
-            start: pstart,
-            cols: 1,
-            data: &p,
+        let p = if contact.is_empty() {
+            None
+        } else {
+            Some(self.natural_scalar.block_of_owned(nodal_pressure)?)
         };
-        self.file.write_step(
-            &info,
-            &[
-                ("displacement", ub),
-                ("reaction", rb),
-                ("contact_pressure", pb),
-            ],
-            &[],
-        )?;
+        if let Some((pstart, p)) = &p {
+            fields.push((
+                "contact_pressure",
+                BlockRows {
+                    global_rows: self.nodes,
+                    start: *pstart,
+                    cols: 1,
+                    data: p,
+                },
+            ));
+        }
+        self.file.write_step(&info, &fields, &[])?;
+        if let Some(d) = &report.dynamics {
+            self.file
+                .write_step_small(report.index, "energy", &[d.kinetic, d.strain])?;
+            self.file
+                .write_step_small(report.index, "momentum", &d.momentum)?;
+        }
         for (i, fields) in contact.iter().enumerate() {
             self.write_pair(report.index, i, fields, report)?;
         }

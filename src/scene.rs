@@ -12,7 +12,8 @@ use crate::mesh::generate::{
     self, BoxSpec, Grading, HertzCylinderSpec, HertzSphereSpec, StackedSpec,
 };
 use crate::mesh::Mesh;
-use crate::solve::{DirichletSpec, Model, SolverSettings};
+use crate::solve::newmark::Newmark;
+use crate::solve::{DirichletSpec, DynamicsSpec, Model, SolverSettings};
 use crate::verify::{HertzCheck, HertzKind};
 use serde::Deserialize;
 use std::path::Path;
@@ -43,6 +44,16 @@ pub const BUILTIN: &[(&str, &str, &str)] = &[
         "block-slide",
         "Block pressed on a rigid plane and pulled: Coulomb friction (μ = 0.3), stick then slip",
         include_str!("../scenes/block-slide.toml"),
+    ),
+    (
+        "ironing",
+        "Stiff die pressed into a soft slab and dragged along it, μ = 0.3 (Puso & Laursen 2004)",
+        include_str!("../scenes/ironing.toml"),
+    ),
+    (
+        "impact",
+        "Two free blocks colliding obliquely, implicit dynamics: momentum conserved",
+        include_str!("../scenes/impact.toml"),
     ),
     (
         "block-compress",
@@ -81,6 +92,7 @@ pub struct Scene {
     pub hertz: Option<HertzSection>,
     #[serde(default)]
     pub steps: StepsSection,
+    pub dynamics: Option<DynamicsSection>,
     #[serde(default)]
     pub solver: SolverSection,
     #[serde(default)]
@@ -211,6 +223,24 @@ pub struct BodySection {
     pub material: MaterialName,
     pub youngs: f64,
     pub poisson: f64,
+    /// Mass density (needed in dynamics only).
+    pub density: Option<f64>,
+    /// Initial velocity of the whole body (dynamics).
+    pub initial_velocity: Option<[f64; 3]>,
+}
+
+/// Implicit dynamics: Newmark time stepping; `[steps] count` steps of
+/// `time_step`, loads and amplitudes follow t / t_end.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSection {
+    pub time_step: f64,
+    /// "newmark" (the only method; β, γ below).
+    pub method: Option<String>,
+    /// Newmark β (default 1/4, or (γ + 1/2)²/4 when only γ is given).
+    pub beta: Option<f64>,
+    /// Newmark γ (default 1/2: the trapezoidal rule, no numerical damping).
+    pub gamma: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -523,6 +553,7 @@ impl Scene {
             return Err(err("[steps] count must be at least 1".into()));
         }
         let solver = self.solver_settings().map_err(&err)?;
+        let dynamics = self.dynamics_spec(&mesh).map_err(&err)?;
         Ok(Model {
             name: self.title.clone().unwrap_or_else(|| origin.to_owned()),
             mesh,
@@ -535,7 +566,74 @@ impl Scene {
             hertz,
             steps: self.steps.count,
             solver,
+            dynamics,
         })
+    }
+
+    /// The dynamics settings, checked: a time step, valid Newmark parameters
+    /// and a density for every body. Densities or initial velocities in a
+    /// static scene are an error too (they would silently do nothing).
+    fn dynamics_spec(&self, mesh: &Mesh) -> std::result::Result<Option<DynamicsSpec>, String> {
+        let Some(d) = &self.dynamics else {
+            if let Some(b) = self
+                .bodies
+                .iter()
+                .find(|b| b.density.is_some() || b.initial_velocity.is_some())
+            {
+                return Err(format!(
+                    "[[body]] '{}' has a density or initial_velocity but the scene has no [dynamics] section",
+                    b.name
+                ));
+            }
+            return Ok(None);
+        };
+        if !(d.time_step > 0.0 && d.time_step.is_finite()) {
+            return Err(format!(
+                "[dynamics] time_step must be positive (got {})",
+                d.time_step
+            ));
+        }
+        match d.method.as_deref() {
+            None | Some("newmark") => {}
+            Some(other) => {
+                return Err(format!(
+                    "[dynamics] method '{other}' is not known (use \"newmark\")"
+                ))
+            }
+        }
+        let newmark = match (d.beta, d.gamma) {
+            (None, None) => Newmark::trapezoidal(),
+            (None, Some(g)) => Newmark::with_dissipation(g),
+            (Some(b), g) => Newmark {
+                beta: b,
+                gamma: g.unwrap_or(0.5),
+            },
+        };
+        newmark.validate().map_err(|e| format!("[dynamics] {e}"))?;
+        let mut density = Vec::with_capacity(mesh.bodies.len());
+        let mut velocity = Vec::with_capacity(mesh.bodies.len());
+        for body in &mesh.bodies {
+            let b = self.bodies.iter().find(|b| &b.name == body);
+            let rho = b.and_then(|b| b.density).ok_or_else(|| {
+                format!("[[body]] '{body}' needs a density: the scene has [dynamics]")
+            })?;
+            if !(rho > 0.0 && rho.is_finite()) {
+                return Err(format!(
+                    "[[body]] '{body}': density must be positive (got {rho})"
+                ));
+            }
+            let v0 = b.and_then(|b| b.initial_velocity).unwrap_or([0.0; 3]);
+            v0.iter()
+                .try_for_each(|&v| check_finite(v, "[[body]] initial_velocity"))?;
+            density.push(rho);
+            velocity.push(v0);
+        }
+        Ok(Some(DynamicsSpec {
+            time_step: d.time_step,
+            newmark,
+            density,
+            initial_velocity: velocity,
+        }))
     }
 
     fn solver_settings(&self) -> std::result::Result<SolverSettings, String> {

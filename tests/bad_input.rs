@@ -239,3 +239,78 @@ fn good_contact_scene_passes_check() {
     let o = run(&["check", path.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
 }
+
+#[test]
+fn negative_friction_coefficient_is_rejected() {
+    check_fails(
+        "friction-negative",
+        &stacked(&format!("{CONTACT}friction = -0.2")),
+        &["friction", "-0.2", "[[contact]] 'c'"],
+    );
+}
+
+#[test]
+fn non_positive_tangential_penalty_is_rejected() {
+    check_fails(
+        "friction-penalty",
+        &stacked(&format!(
+            "{CONTACT}friction = 0.3\ntangential_penalty = 0.0"
+        )),
+        &["tangential_penalty", "positive"],
+    );
+}
+
+#[test]
+fn tangential_penalty_without_friction_is_rejected() {
+    check_fails(
+        "friction-penalty-alone",
+        &stacked(&format!("{CONTACT}tangential_penalty = 10.0")),
+        &["tangential_penalty", "friction"],
+    );
+}
+
+#[test]
+fn dynamics_without_density_names_the_body() {
+    let scene = GOOD.to_string() + "\n[dynamics]\ntime_step = 0.01\n";
+    check_fails("dynamics-density", &scene, &["block", "density"]);
+}
+
+#[test]
+fn dynamics_without_time_step_is_named() {
+    let scene = GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0")
+        + "\n[dynamics]\ngamma = 0.6\n";
+    check_fails("dynamics-dt", &scene, &["time_step"]);
+}
+
+#[test]
+fn non_positive_time_step_is_rejected() {
+    let scene = GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0")
+        + "\n[dynamics]\ntime_step = -0.1\n";
+    check_fails("dynamics-dt-negative", &scene, &["time_step", "positive"]);
+}
+
+#[test]
+fn unstable_newmark_parameters_are_rejected() {
+    let scene = GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0")
+        + "\n[dynamics]\ntime_step = 0.1\nbeta = 0.1\ngamma = 0.5\n";
+    check_fails("dynamics-newmark", &scene, &["dynamics", "beta", "gamma/2"]);
+}
+
+#[test]
+fn density_in_a_static_scene_is_rejected() {
+    let scene = GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0");
+    check_fails("static-density", &scene, &["density", "[dynamics]"]);
+}
+
+#[test]
+fn bad_amplitude_is_named() {
+    let scene = GOOD.replace(
+        "value = 1.0",
+        "value = 1.0\namplitude = [[0.0, 0.0], [0.5, 1.0], [0.4, 1.0]]",
+    );
+    check_fails(
+        "amplitude",
+        &scene,
+        &["[[pressure]]", "block.top", "increase"],
+    );
+}

@@ -62,6 +62,32 @@ pub struct PointValues {
     pub nodes: Vec<([f64; 3], f64)>,
 }
 
+/// A pair's contact force on the slave surface (this rank's part, or the
+/// total): the vector, and in the contact frame the normal force Σ pN w and
+/// the tangential force Σ |tT| w (μ times the normal force when every active
+/// point slides).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PairForce {
+    pub force: [f64; 3],
+    pub normal: f64,
+    pub tangential: f64,
+}
+
+impl PairForce {
+    pub fn to_array(self) -> [f64; 5] {
+        let [x, y, z] = self.force;
+        [x, y, z, self.normal, self.tangential]
+    }
+
+    pub fn from_array(a: [f64; 5]) -> Self {
+        PairForce {
+            force: [a[0], a[1], a[2]],
+            normal: a[3],
+            tangential: a[4],
+        }
+    }
+}
+
 /// Friction of a pair at run time: μ and εT per slave facet.
 struct PairFriction {
     mu: f64,
@@ -712,6 +738,16 @@ impl ContactPair {
         self.multipliers.exchange()
     }
 
+    /// The smallest nodal force the Uzawa test resolves: the force of a
+    /// penetration at the tolerance on one facet (εN · tol·h · h²). Below it
+    /// a change in the multipliers cannot move the solution by more than the
+    /// penetration tolerance already allows, so a near-empty contact (a
+    /// grazing touch) is not iterated to relative precision.
+    pub fn force_floor(&self) -> f64 {
+        let h = self.slave.h;
+        self.penalty * self.spec.penetration_tol * h * h * h
+    }
+
     /// Translation of a rigid master at load factor `factor`.
     pub fn rigid_shift(&self, factor: f64) -> [f64; 3] {
         let a = self.spec.motion_amplitude.at(factor);
@@ -754,7 +790,7 @@ impl ContactPair {
         &mut self,
         u_local: &[f64],
         factor: f64,
-    ) -> Result<(PointValues, [f64; 3])> {
+    ) -> Result<(PointValues, PairForce)> {
         let nq = self.slave.num_qps();
         let states = self.evaluate_links(u_local, factor);
         let mut values = PointValues {
@@ -774,7 +810,7 @@ impl ContactPair {
             values.slip = t.points.iter().map(|p| p.slip).collect();
             values.state = t.points.iter().map(|p| p.state as i8).collect();
         }
-        let mut force = [0.0; 3];
+        let mut force = PairForce::default();
         for (l, s) in self.links.iter().zip(&states) {
             let q = l.qp as usize;
             // The updated multiplier ⟨λN − εN gN⟩ is exactly the pressure the
@@ -784,14 +820,17 @@ impl ContactPair {
             values.pressure[q] = p;
             values.gap[q] = s.gap;
             let w = self.slave.qp_weight[q];
-            for (f, n) in force.iter_mut().zip(s.normal) {
+            for (f, n) in force.force.iter_mut().zip(s.normal) {
                 *f += p * n * w;
             }
+            force.normal += p * w;
             if let Some(t) = &self.multipliers.tangential {
                 // The traction of the last Uzawa update, like λN above.
-                for (f, tc) in force.iter_mut().zip(t.points[q].traction) {
+                let traction = t.points[q].traction;
+                for (f, tc) in force.force.iter_mut().zip(traction) {
                     *f += tc * w;
                 }
+                force.tangential += norm(traction) * w;
             }
         }
         Ok((values, force))

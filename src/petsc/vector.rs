@@ -93,6 +93,14 @@ impl Vector {
         }
     }
 
+    /// The global dot product `self · other` (collective).
+    pub fn dot(&self, other: &Vector) -> Result<f64> {
+        let mut d = 0.0;
+        // SAFETY: both valid vecs of the same layout (PETSc checks); out-pointer valid.
+        unsafe { petsc_call!(VecDot(self.raw, other.raw, &mut d))? };
+        Ok(d)
+    }
+
     pub fn norm2(&self) -> Result<f64> {
         self.norm(sys::NormType_NORM_2)
     }

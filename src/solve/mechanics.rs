@@ -2,6 +2,7 @@
 //! that SNES solves at one load factor with the contact multipliers λ fixed,
 //! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
+use super::dynamics::Inertia;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
@@ -23,6 +24,8 @@ pub struct Mechanics<'a> {
     /// body force; scaled by the load factor.
     pub fixed_external: Option<Vec<f64>>,
     pub factor: f64,
+    /// Dynamics: the inertia term of the current time step (None: static).
+    pub inertia: Option<Inertia>,
     u: GhostedVector,
     r: GhostedVector,
     /// Bulk stiffness when every body is linear: assembled once, reused.
@@ -56,6 +59,7 @@ impl<'a> Mechanics<'a> {
             body_force,
             fixed_external: None,
             factor: 0.0,
+            inertia: None,
             u,
             r,
             linear_k: None,
@@ -131,6 +135,9 @@ impl<'a> Mechanics<'a> {
             k.mult(x, &mut self.work)?;
             out.axpy(1.0, &self.work)?;
         }
+        if let Some(inertia) = &mut self.inertia {
+            inertia.add_force(x, out)?;
+        }
         Ok(())
     }
 
@@ -154,6 +161,11 @@ impl<'a> Mechanics<'a> {
         self.load_state(x)?;
         j.zero_entries()?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
+        // Whole-matrix additions (MatAXPY) need the assembled (zeroed)
+        // matrix, so they come before any element values are set.
+        if let Some(inertia) = &self.inertia {
+            j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
+        }
         match &self.linear_k {
             Some(k) => j.add_scaled_subset(1.0, k)?,
             None => {

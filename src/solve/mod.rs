@@ -6,15 +6,18 @@
 //! This module sits above `assembly` and `contact`: they know nothing of
 //! SNES, and only this module calls the solver.
 pub mod boundary;
+pub mod dynamics;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
 
 pub use boundary::{Dirichlet, DirichletSpec};
+pub use dynamics::{DynamicsReport, DynamicsSpec};
 pub use mechanics::Mechanics;
 pub use natural::NaturalOrder;
 
 use crate::assembly::{BulkAssembler, FacetLoad, SurfaceLoads};
+use crate::contact::links::PairForce;
 use crate::contact::{ContactPair, MasterSpec, PairSpec, UzawaStats};
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
@@ -78,6 +81,8 @@ pub struct Model {
     pub hertz: Option<crate::verify::HertzCheck>,
     pub steps: usize,
     pub solver: SolverSettings,
+    /// Implicit dynamics (None: quasi-static load stepping).
+    pub dynamics: Option<DynamicsSpec>,
 }
 
 /// What a contact pair did in one converged step (figures over all ranks).
@@ -86,6 +91,9 @@ pub struct ContactReport {
     pub name: String,
     /// Total contact force on the slave surface.
     pub force: [f64; 3],
+    /// Normal force Σ pN w and tangential force Σ |tT| w (contact frame).
+    pub normal_force: f64,
+    pub tangential_force: f64,
     pub max_penetration: f64,
     pub active_points: usize,
     /// Active points that slide (friction).
@@ -109,6 +117,8 @@ pub struct StepReport {
     /// Total reaction force of each Dirichlet set (summed over ranks).
     pub reactions: Vec<(String, [f64; 3])>,
     pub contact: Vec<ContactReport>,
+    /// Time, energy and momentum (dynamics only).
+    pub dynamics: Option<DynamicsReport>,
 }
 
 /// The result of a run: per-step reports and the final displacement.
@@ -137,6 +147,7 @@ pub trait StepSink {
         reaction: &Vector,
         contact: &[PairFields],
         nodal_pressure: &[f64],
+        velocity: Option<&Vector>,
     ) -> Result<()>;
 }
 
@@ -175,7 +186,9 @@ pub struct Simulation<'m> {
 
 /// Why a load increment failed.
 enum StepFailure {
-    Newton(SnesOutcome),
+    /// Newton failed; with the link states of the last Uzawa update before
+    /// it (empty when it failed in the step's first solve).
+    Newton(SnesOutcome, Vec<(String, UzawaStats)>),
     Uzawa {
         iterations: usize,
         stats: UzawaStats,
@@ -248,6 +261,15 @@ impl<'m> Simulation<'m> {
             )?;
             mech.fixed_external = Some(f);
         }
+        let mut stepper = match &model.dynamics {
+            Some(spec) => {
+                let (stepper, inertia) =
+                    dynamics::TimeStepper::new(spec, model.steps, &model.mesh, dofs, bulk)?;
+                mech.inertia = Some(inertia);
+                Some(stepper)
+            }
+            None => None,
+        };
         let mut x = Vector::new_mpi(dofs.num_owned_dofs())?;
         x.set_block_size(DIM)?;
         x.set_all(0.0)?;
@@ -277,6 +299,10 @@ impl<'m> Simulation<'m> {
             x_prev.copy_from(&x)?;
             let contact_prev: Vec<_> = mech.contact.iter().map(|p| p.snapshot()).collect();
             mech.factor = target;
+            let coefficients = match &mut stepper {
+                Some(s) => Some(prepare_time_step(s, &mut mech, done, target)?),
+                None => None,
+            };
             x.with_array_mut(|xa| dirichlet.apply(xa, target))?;
             if !mech.contact.is_empty() {
                 let changed = stage_search.scope(|| {
@@ -327,6 +353,20 @@ impl<'m> Simulation<'m> {
                 }
             };
             done = target;
+            let dynamics_report = match (&mut stepper, &coefficients) {
+                (Some(s), Some(c)) => {
+                    s.advance(&x, c)?;
+                    let strain = mech.with_state(&x, |u, _| bulk.strain_energy(u))?;
+                    let time = done * s.t_end;
+                    let inertia = mech
+                        .inertia
+                        .as_mut()
+                        .ok_or_else(|| Error::Internal("dynamics without inertia".into()))?;
+                    Some(s.report(&world, inertia, strain, time)?)
+                }
+                _ => None,
+            };
+            // In dynamics the support also carries the inertia of its rows.
             mech.raw_residual(&x, &mut reaction)?;
             let reactions = reaction_totals(&world, dirichlet, &reaction, dofs.owned_dof_start())?;
             zero_unconstrained(&mut reaction, dirichlet)?;
@@ -335,7 +375,7 @@ impl<'m> Simulation<'m> {
                     .iter_mut()
                     .map(|p| p.point_values(u, target))
                     .collect::<Result<Vec<_>>>()?;
-                Ok(values.into_iter().unzip::<_, [f64; 3], Vec<_>, Vec<_>>())
+                Ok(values.into_iter().unzip::<_, PairForce, Vec<_>, Vec<_>>())
             })?;
             let contact_reports = contact_reports(&world, mech.contact, &forces, &stats);
             let nodal_pressure = nodal_pressure(dofs, mech.contact)?;
@@ -351,6 +391,7 @@ impl<'m> Simulation<'m> {
                 wall_seconds: t0.elapsed().as_secs_f64(),
                 reactions,
                 contact: contact_reports,
+                dynamics: dynamics_report,
             };
             if echo && rt.rank() == 0 {
                 print_step(&report);
@@ -361,7 +402,15 @@ impl<'m> Simulation<'m> {
                 .zip(fields)
                 .map(|(pair, values)| PairFields { pair, values })
                 .collect();
-            sink.step(&report, &x, &reaction, &pair_fields, &nodal_pressure)?;
+            let velocity = stepper.as_ref().map(|s| s.velocity());
+            sink.step(
+                &report,
+                &x,
+                &reaction,
+                &pair_fields,
+                &nodal_pressure,
+                velocity,
+            )?;
             for pair in mech.contact.iter_mut() {
                 pair.commit()?;
             }
@@ -381,6 +430,30 @@ impl<'m> Simulation<'m> {
             pattern_builds,
         })
     }
+}
+
+/// Sets up one time step from load factor `from` to `to`: the Newmark
+/// coefficients for its Δt, the inertia term, and the slip rate of every
+/// frictional pair.
+fn prepare_time_step(
+    stepper: &mut dynamics::TimeStepper,
+    mech: &mut Mechanics,
+    from: f64,
+    to: f64,
+) -> Result<newmark::Coefficients> {
+    let dt = (to - from) * stepper.t_end;
+    let c = stepper.coefficients(to - from);
+    let inertia = mech
+        .inertia
+        .as_mut()
+        .ok_or_else(|| Error::Internal("dynamics without inertia".into()))?;
+    stepper.prepare(&c, inertia)?;
+    for pair in mech.contact.iter_mut().filter(|p| p.has_friction()) {
+        let (a, b) = (pair.rigid_shift(from), pair.rigid_shift(to));
+        let rigid_velocity = [0, 1, 2].map(|i| (b[i] - a[i]) / dt);
+        pair.rate = Some(stepper.slip_rate(&c, dt, rigid_velocity)?);
+    }
+    Ok(c)
 }
 
 type StepResult = std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), StepFailure>;
@@ -409,6 +482,7 @@ fn uzawa_loop(
     let mut linear = 0usize;
     let mut history = Vec::new();
     let mut k = 0;
+    let mut last_links: Vec<(String, UzawaStats)> = Vec::new();
     loop {
         k += 1;
         // Between Uzawa iterations only λ changes, so the tangent barely
@@ -423,7 +497,7 @@ fn uzawa_loop(
         linear += outcome.linear_iterations;
         history.extend_from_slice(&outcome.history);
         if !outcome.converged {
-            return Ok(Err(StepFailure::Newton(outcome)));
+            return Ok(Err(StepFailure::Newton(outcome, last_links)));
         }
         if mech.contact.is_empty() {
             return Ok(Ok((outcome, 0, Vec::new())));
@@ -435,9 +509,15 @@ fn uzawa_loop(
                 .collect()
         })?;
         let stats = reduce_stats(world, &local);
+        last_links = mech
+            .contact
+            .iter()
+            .map(|p| p.spec.name.clone())
+            .zip(stats.iter().copied())
+            .collect();
         let converged = mech.contact.iter().zip(&stats).all(|(p, s)| {
             s.max_penetration <= p.spec.penetration_tol
-                && s.max_change <= p.spec.multiplier_tol * s.max_force.max(f64::MIN_POSITIVE)
+                && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
         });
         if converged {
             outcome.iterations = newton;
@@ -467,10 +547,19 @@ fn uzawa_loop(
 
 fn failure_text(f: &StepFailure) -> String {
     match f {
-        StepFailure::Newton(o) => match &o.domain_error {
-            Some(d) => format!("{} ({d})", o.reason_text),
-            None => format!("{} after {} iterations, |R| = {:.3e}", o.reason_text, o.iterations, o.residual_norm),
-        },
+        StepFailure::Newton(o, links) => {
+            let mut text = match &o.domain_error {
+                Some(d) => format!("{} ({d})", o.reason_text),
+                None => format!("{} after {} iterations, |R| = {:.3e}", o.reason_text, o.iterations, o.residual_norm),
+            };
+            for (name, s) in links {
+                text += &format!(
+                    "; links of pair '{name}' at the last Uzawa update: {} in contact, {} sliding, {} sticking, max penetration {:.3e} h",
+                    s.active, s.sliding, s.active - s.sliding.min(s.active), s.max_penetration
+                );
+            }
+            text
+        }
         StepFailure::Uzawa { iterations, stats } => format!(
             "Uzawa loop did not converge in {iterations} iterations (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
             stats.max_penetration, stats.max_change, stats.max_force
@@ -516,7 +605,7 @@ fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaSta
 fn contact_reports(
     world: &impl Communicator,
     pairs: &[ContactPair],
-    forces: &[[f64; 3]],
+    forces: &[PairForce],
     stats: &[UzawaStats],
 ) -> Vec<ContactReport> {
     pairs
@@ -524,12 +613,15 @@ fn contact_reports(
         .zip(forces)
         .enumerate()
         .map(|(i, (p, f))| {
-            let mut total = [0.0; 3];
-            world.all_reduce_into(&f[..], &mut total[..], SystemOperation::sum());
+            let mut total = [0.0; 5];
+            world.all_reduce_into(&f.to_array()[..], &mut total[..], SystemOperation::sum());
+            let total = PairForce::from_array(total);
             let s = stats.get(i).copied().unwrap_or_default();
             ContactReport {
                 name: p.spec.name.clone(),
-                force: total,
+                force: total.force,
+                normal_force: total.normal,
+                tangential_force: total.tangential,
                 max_penetration: s.max_penetration,
                 active_points: s.active,
                 sliding_points: s.sliding,
@@ -754,10 +846,16 @@ fn print_step(s: &StepReport) {
         s.wall_seconds,
         hist.join(" ")
     );
+    if let Some(d) = &s.dynamics {
+        println!(
+            "     t = {:.6e}: kinetic {:.6e}, strain {:.6e}, total {:.6e}, momentum [{:.6e}, {:.6e}, {:.6e}]",
+            d.time, d.kinetic, d.strain, d.kinetic + d.strain, d.momentum[0], d.momentum[1], d.momentum[2]
+        );
+    }
     for c in &s.contact {
         println!(
-            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], {} active points ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
-            c.name, c.force[0], c.force[1], c.force[2], c.active_points, c.sliding_points, c.max_penetration, c.penalty
+            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], normal {:.6e}, tangential {:.6e}, {} active points ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
+            c.name, c.force[0], c.force[1], c.force[2], c.normal_force, c.tangential_force, c.active_points, c.sliding_points, c.max_penetration, c.penalty
         );
     }
 }
