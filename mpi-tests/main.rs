@@ -41,6 +41,14 @@ const CASES: &[Case] = &[
         "neo_hookean_uniaxial_stretch_matches_closed_form",
         uniaxial_stretch_closed_form,
     ),
+    (
+        "block_slide_transmits_mu_n_while_sliding",
+        block_slide_transmits_mu_n,
+    ),
+    (
+        "frictional_impact_conserves_momentum_and_dissipates",
+        frictional_impact_conserves_momentum,
+    ),
 ];
 
 fn main() -> ExitCode {
@@ -481,5 +489,67 @@ fn uniaxial_stretch_closed_form(rt: &Runtime) -> Result<(), String> {
     }
     ensure(e_lat < 1e-8 && e_p < 1e-8, || {
         format!("lateral stretch error {e_lat:.2e}, stress error {e_p:.2e}")
+    })
+}
+
+/// Friction on any rank count: once every contact point slides, the rigid
+/// plane transmits exactly μN; before the pull nothing slides.
+fn block_slide_transmits_mu_n(rt: &Runtime) -> Result<(), String> {
+    let (model, _) = pipeline::load_model("block-slide", &[]).map_err(|e| e.to_string())?;
+    let summary = pipeline::run_model(rt, &model, None, false).map_err(|e| e.to_string())?;
+    let mut sliding_steps = 0;
+    for step in &summary.report.steps {
+        let c = step.contact.first().ok_or("no contact report")?;
+        if c.active_points > 0 && c.sliding_points == c.active_points {
+            let ratio = c.force[0].abs() / c.force[2];
+            ensure((ratio - 0.3).abs() < 1e-6 * 0.3, || {
+                format!("step {}: Fx/Fz = {ratio}", step.index)
+            })?;
+            sliding_steps += 1;
+        }
+        if step.load_factor <= 0.25 + 1e-12 {
+            ensure(c.force[0].abs() < 1e-8 * c.force[2], || {
+                format!("step {}: tangential force before the pull", step.index)
+            })?;
+        }
+    }
+    if rt.rank() == 0 {
+        println!("  block-slide: {sliding_steps} fully sliding steps at Fx/Fz = 0.3");
+    }
+    ensure(sliding_steps >= 5, || {
+        format!("{sliding_steps} sliding steps")
+    })
+}
+
+/// Dynamics with friction on any rank count: momentum is conserved through
+/// the impact and the energy never grows.
+fn frictional_impact_conserves_momentum(rt: &Runtime) -> Result<(), String> {
+    let (model, _) = pipeline::load_model("impact", &["contact.friction=0.3".to_string()])
+        .map_err(|e| e.to_string())?;
+    let summary = pipeline::run_model(rt, &model, None, false).map_err(|e| e.to_string())?;
+    let p0 = [0.25, 0.0, -0.5];
+    let mut energy = f64::INFINITY;
+    let mut contact_steps = 0;
+    for step in &summary.report.steps {
+        let d = step.dynamics.ok_or("no dynamics report")?;
+        for c in 0..3 {
+            ensure((d.momentum[c] - p0[c]).abs() < 1e-10, || {
+                format!("step {}: momentum {:?}", step.index, d.momentum)
+            })?;
+        }
+        let e = d.kinetic + d.strain;
+        ensure(e <= energy * (1.0 + 1e-9), || {
+            format!("step {}: energy grew to {e}", step.index)
+        })?;
+        energy = e;
+        if step.contact.first().is_some_and(|c| c.active_points > 0) {
+            contact_steps += 1;
+        }
+    }
+    if rt.rank() == 0 {
+        println!("  impact (μ = 0.3): final energy {energy:.6} of 0.3125, {contact_steps} steps in contact");
+    }
+    ensure(contact_steps >= 3 && energy < 0.3125, || {
+        format!("{contact_steps} contact steps, energy {energy}")
     })
 }

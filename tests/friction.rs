@@ -213,3 +213,40 @@ fn frictional_scenes_same_on_1_and_2_ranks() {
     same_on_1_and_2_ranks("block-slide", &[], "floor");
     same_on_1_and_2_ranks("impact", &["--set", "contact.friction=0.3"], "impact");
 }
+
+#[test]
+fn slip_heavy_step_that_cannot_converge_reports_its_link_states() {
+    let dir = scratch("friction-failure");
+    let out = dir.join("fail.h5");
+    // Two Newton iterations and no cutback: the first sliding step fails.
+    let o = mpirun(
+        1,
+        &[
+            "run",
+            "block-slide",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            "solver.max_newton=2",
+            "--set",
+            "solver.max_cutbacks=0",
+        ],
+    );
+    let t = text(&o);
+    assert!(!o.status.success(), "the run should fail:\n{t}");
+    assert!(!t.contains("panicked"), "{t}");
+    for expect in [
+        "did not converge",
+        "links of pair 'floor'",
+        "sliding",
+        "sticking",
+    ] {
+        assert!(t.contains(expect), "message lacks {expect:?}:\n{t}");
+    }
+    // Every step before the failure is in the file and readable.
+    let steps = list_steps(&out).expect("the file stays valid");
+    assert!(!steps.is_empty());
+    let rows = history(&out);
+    assert_eq!(rows.len(), steps.len());
+}

@@ -754,6 +754,18 @@ impl ContactPair {
         self.spec.motion.map(|c| c * a)
     }
 
+    /// This rank's points in contact (λN > 0) and, of those, sliding.
+    pub fn multiplier_states(&self) -> (usize, usize) {
+        let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();
+        let sliding = self.multipliers.tangential.as_ref().map_or(0, |t| {
+            t.points
+                .iter()
+                .filter(|p| p.state == PointState::Slip)
+                .count()
+        });
+        (active, sliding)
+    }
+
     /// Whether the pair computes friction.
     pub fn has_friction(&self) -> bool {
         self.friction.is_some()

@@ -482,7 +482,10 @@ fn uzawa_loop(
     let mut linear = 0usize;
     let mut history = Vec::new();
     let mut k = 0;
-    let mut last_links: Vec<(String, UzawaStats)> = Vec::new();
+    // What the links carried into this step (the last converged step's
+    // multipliers), replaced after every Uzawa update: reported if Newton
+    // fails for good.
+    let mut last_links = link_summaries(world, mech.contact);
     loop {
         k += 1;
         // Between Uzawa iterations only λ changes, so the tangent barely
@@ -545,6 +548,28 @@ fn uzawa_loop(
     }
 }
 
+/// Per pair: points in contact and sliding under the current multipliers
+/// (totals over ranks).
+fn link_summaries(world: &impl Communicator, pairs: &[ContactPair]) -> Vec<(String, UzawaStats)> {
+    pairs
+        .iter()
+        .map(|p| {
+            let (active, sliding) = p.multiplier_states();
+            let mine = [active as u64, sliding as u64];
+            let mut total = [0u64; 2];
+            world.all_reduce_into(&mine[..], &mut total[..], SystemOperation::sum());
+            let stats = UzawaStats {
+                active: total[0] as usize,
+                sliding: total[1] as usize,
+                // Not measured until the step's first Uzawa update.
+                max_penetration: f64::NAN,
+                ..UzawaStats::default()
+            };
+            (p.spec.name.clone(), stats)
+        })
+        .collect()
+}
+
 fn failure_text(f: &StepFailure) -> String {
     match f {
         StepFailure::Newton(o, links) => {
@@ -554,9 +579,12 @@ fn failure_text(f: &StepFailure) -> String {
             };
             for (name, s) in links {
                 text += &format!(
-                    "; links of pair '{name}' at the last Uzawa update: {} in contact, {} sliding, {} sticking, max penetration {:.3e} h",
-                    s.active, s.sliding, s.active - s.sliding.min(s.active), s.max_penetration
+                    "; links of pair '{name}' at the last multiplier update: {} in contact, {} sliding, {} sticking",
+                    s.active, s.sliding, s.active - s.sliding.min(s.active)
                 );
+                if s.max_penetration.is_finite() {
+                    text += &format!(", max penetration {:.3e} h", s.max_penetration);
+                }
             }
             text
         }
