@@ -953,3 +953,78 @@ fn default_search_distance(mesh: &Mesh, master: &MasterSide, h: f64) -> f64 {
     };
     (10.0 * h).max(0.1 * diag)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::FacetType;
+
+    /// Two unit quads side by side in z = 0 (x ∈ [0, 1] and [1, 2]), the
+    /// second one's nodes listed from a different corner so its ξ axes are
+    /// turned against the first's.
+    fn two_quads() -> MasterSurface {
+        MasterSurface {
+            facet_type: FacetType::Quad4,
+            node_local: (0..6).collect(),
+            x_ref: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [2.0, 1.0, 0.0],
+            ],
+            facets: vec![[0, 1, 4, 3], [5, 4, 1, 2]],
+        }
+    }
+
+    fn point_on(m: &MasterSurface, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
+        let s = crate::fem::shape::facet_shape(m.facet_type, xi);
+        let mut p = [0.0; 3];
+        for (&n, nb) in m.facet_nodes(facet).iter().zip(s.n) {
+            for c in 0..3 {
+                p[c] += nb * x[n as usize][c];
+            }
+        }
+        p
+    }
+
+    #[test]
+    fn slip_origin_moves_to_a_neighbour_facet_as_the_same_point() {
+        let m = two_quads();
+        // A point of facet 0 near its edge with facet 1.
+        let xi = [0.8, -0.3];
+        let p = point_on(&m, 0, &m.x_ref, xi);
+        let xi1 = rebase_origin(&m, 0, xi, 1, [0.0, 0.0]);
+        let q = point_on(&m, 1, &m.x_ref, xi1);
+        assert!(norm(sub(p, q)) < 1e-12, "{p:?} vs {q:?}");
+        // And back.
+        let back = rebase_origin(&m, 1, xi1, 0, [0.0, 0.0]);
+        assert!((back[0] - xi[0]).abs() < 1e-12 && (back[1] - xi[1]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tangential_multiplier_moves_to_a_neighbour_facet_as_the_same_vector() {
+        let m = two_quads();
+        // Current positions: both facets stretched 1.5× in x, sheared in y.
+        let x: Vec<[f64; 3]> = m
+            .x_ref
+            .iter()
+            .map(|p| [1.5 * p[0] + 0.2 * p[1], p[1], 0.0])
+            .collect();
+        let vector = [0.7, -0.4, 0.0];
+        let covariant = |facet: u32, xi: [f64; 2]| {
+            let [t1, t2] = facet_tangents(&m, &facet_points(&m, facet, &x), xi);
+            [dot(vector, t1), dot(vector, t2)]
+        };
+        let centre = crate::contact::projection::reference_centre(FacetType::Quad4);
+        let on_0 = covariant(0, centre);
+        let xi = [-0.5, 0.25];
+        let moved = rebase_lambda(&m, &x, 0, on_0, 1, xi);
+        let expect = covariant(1, xi);
+        assert!(
+            (moved[0] - expect[0]).abs() < 1e-12 && (moved[1] - expect[1]).abs() < 1e-12,
+            "{moved:?} vs {expect:?}"
+        );
+    }
+}
