@@ -248,3 +248,29 @@ fn slip_heavy_step_that_cannot_converge_reports_its_link_states() {
     let rows = history(&out);
     assert_eq!(rows.len(), steps.len());
 }
+
+#[test]
+fn a_frictionless_static_scene_carries_no_friction_or_dynamics_data() {
+    let dir = scratch("pays-only-for-what-it-uses");
+    let plain = dir.join("plain.h5");
+    let rough = dir.join("rough.h5");
+    run_scene(1, "patch-test", &plain, &[]);
+    run_scene(1, "patch-test", &rough, &["--set", "contact.friction=0.3"]);
+    let last = *list_steps(&plain).unwrap().last().unwrap();
+    let has = |f: &Path, rel: &str| read_dataset::<f64>(f, &format!("/steps/{last:06}/{rel}")).is_ok();
+    // μ absent: no friction state, hence no tangential arrays; static: no
+    // mass matrix, hence no velocity, energy or momentum.
+    for rel in ["contact/interface/traction_t", "contact/interface/state", "velocity", "energy"] {
+        assert!(!has(&plain, rel), "frictionless static run wrote {rel}");
+    }
+    assert!(has(&rough, "contact/interface/traction_t"));
+    assert!(!has(&rough, "velocity"));
+    // Uniform compression: friction changes nothing here but must not break
+    // the patch test (normal force identical to 1e-8).
+    let (h0, h1) = (history(&plain), history(&rough));
+    let (n0, n1) = (
+        h0.last().unwrap()["interface.normal"],
+        h1.last().unwrap()["interface.normal"],
+    );
+    assert!((n0 - n1).abs() < 1e-6 * n0, "{n0} vs {n1}");
+}
