@@ -171,6 +171,9 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
                 model.steps,
                 out.unwrap_or_else(|| "(none)".into())
             );
+            for w in model.warnings() {
+                println!("  warning: {w}");
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

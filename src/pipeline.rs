@@ -57,6 +57,11 @@ pub fn run_model(
     output: Option<&Path>,
     echo: bool,
 ) -> Result<RunSummary> {
+    if rt.rank() == 0 {
+        for w in model.warnings() {
+            eprintln!("contactlink: warning: {w}");
+        }
+    }
     let mut sim = Simulation::setup(rt, model)?;
     if echo && rt.rank() == 0 {
         println!(
