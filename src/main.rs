@@ -207,6 +207,7 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                     rt.size(),
                     r.wall_seconds
                 );
+                println!("{}", phase_summary(&r.phases, r.wall_seconds));
                 if let Some(last) = r.steps.last() {
                     for (set, f) in &last.reactions {
                         println!(
@@ -246,4 +247,20 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     };
     drop(rt);
     code
+}
+
+/// "where the time went" line: each phase's seconds and share of the run.
+fn phase_summary(t: &contactlink::solve::phases::PhaseTimes, wall: f64) -> String {
+    use contactlink::solve::phases::Phase;
+    let share = |s: f64| if wall > 0.0 { 100.0 * s / wall } else { 0.0 };
+    let mut parts: Vec<String> = Phase::ALL
+        .iter()
+        .map(|&p| format!("{} {:.3} s ({:.1} %)", p.name(), t.get(p), share(t.get(p))))
+        .collect();
+    let other = (wall - t.total()).max(0.0);
+    parts.push(format!("other {other:.3} s ({:.1} %)", share(other)));
+    format!(
+        "  time per phase (largest over ranks): {}",
+        parts.join(", ")
+    )
 }

@@ -7,6 +7,7 @@ use crate::output::{BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
+use crate::solve::phases::Phase;
 use crate::solve::{Model, NaturalOrder, PairFields, RunReport, Simulation, StepReport, StepSink};
 use crate::verify::{HertzCheck, HertzComparison};
 use mpi::traits::{Communicator, CommunicatorCollectives};
@@ -160,6 +161,7 @@ impl HistoryCsv {
                 h.push(k.to_string());
             }
         }
+        h.extend(Phase::ALL.iter().map(|p| p.key().to_string()));
         h
     }
 
@@ -188,6 +190,11 @@ impl HistoryCsv {
             r.push(num(d.strain));
             r.extend(d.momentum.iter().map(|v| num(*v)));
         }
+        r.extend(
+            Phase::ALL
+                .iter()
+                .map(|&p| format!("{:.6e}", report.phases.get(p))),
+        );
         r
     }
 }

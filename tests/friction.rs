@@ -257,10 +257,16 @@ fn a_frictionless_static_scene_carries_no_friction_or_dynamics_data() {
     run_scene(1, "patch-test", &plain, &[]);
     run_scene(1, "patch-test", &rough, &["--set", "contact.friction=0.3"]);
     let last = *list_steps(&plain).unwrap().last().unwrap();
-    let has = |f: &Path, rel: &str| read_dataset::<f64>(f, &format!("/steps/{last:06}/{rel}")).is_ok();
+    let has =
+        |f: &Path, rel: &str| read_dataset::<f64>(f, &format!("/steps/{last:06}/{rel}")).is_ok();
     // μ absent: no friction state, hence no tangential arrays; static: no
     // mass matrix, hence no velocity, energy or momentum.
-    for rel in ["contact/interface/traction_t", "contact/interface/state", "velocity", "energy"] {
+    for rel in [
+        "contact/interface/traction_t",
+        "contact/interface/state",
+        "velocity",
+        "energy",
+    ] {
         assert!(!has(&plain, rel), "frictionless static run wrote {rel}");
     }
     assert!(has(&rough, "contact/interface/traction_t"));

@@ -98,6 +98,8 @@ pub struct Multipliers {
     /// Friction state (None for a frictionless pair: nothing is stored,
     /// exchanged or evaluated).
     pub tangential: Option<Tangential>,
+    /// Wall time spent in halo exchanges, for the phase report.
+    pub exchange_seconds: f64,
     halo: GhostedVector,
     n_owned: usize,
     n_ghost: usize,
@@ -198,6 +200,7 @@ impl Multipliers {
         Ok(Multipliers {
             lambda: vec![0.0; n_owned],
             tangential,
+            exchange_seconds: 0.0,
             halo,
             n_owned,
             n_ghost: ghosts.len(),
@@ -209,6 +212,13 @@ impl Multipliers {
 
     /// Halo exchange: ghost copies take their owners' current multipliers.
     pub fn exchange(&mut self) -> Result<()> {
+        let start = std::time::Instant::now();
+        let out = self.exchange_now();
+        self.exchange_seconds += start.elapsed().as_secs_f64();
+        out
+    }
+
+    fn exchange_now(&mut self) -> Result<()> {
         let lambda = &self.lambda;
         self.halo
             .global_mut()

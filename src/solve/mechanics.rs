@@ -3,6 +3,7 @@
 //! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
 use super::dynamics::Inertia;
+use super::phases::{Phase, PhaseTimes, Stages};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
@@ -26,6 +27,9 @@ pub struct Mechanics<'a> {
     pub factor: f64,
     /// Dynamics: the inertia term of the current time step (None: static).
     pub inertia: Option<Inertia>,
+    /// Time spent per phase in these callbacks (this rank).
+    pub times: PhaseTimes,
+    stages: Stages,
     u: GhostedVector,
     r: GhostedVector,
     /// Bulk stiffness when every body is linear: assembled once, reused.
@@ -60,6 +64,8 @@ impl<'a> Mechanics<'a> {
             fixed_external: None,
             factor: 0.0,
             inertia: None,
+            times: PhaseTimes::default(),
+            stages: Stages::register()?,
             u,
             r,
             linear_k: None,
@@ -82,8 +88,11 @@ impl<'a> Mechanics<'a> {
     }
 
     fn load_state(&mut self, x: &Vector) -> Result<()> {
-        self.u.global_mut().copy_from(x)?;
-        self.u.update_ghosts()?;
+        let u = &mut self.u;
+        self.stages.time(Phase::HaloExchange, &mut self.times, || {
+            u.global_mut().copy_from(x)?;
+            u.update_ghosts()
+        })?;
         Ok(())
     }
 
@@ -109,36 +118,45 @@ impl<'a> Mechanics<'a> {
         let fixed = self.fixed_external.as_deref();
         let contact = &mut *self.contact;
         let u = &self.u;
+        let (stages, times) = (self.stages, &mut self.times);
         self.r.with_local_mut(|r_local| -> Result<()> {
             r_local.fill(0.0);
             u.with_local(|u_local| -> Result<()> {
-                if !linear {
-                    bulk.add_internal_force(u_local, r_local)?;
-                }
-                loads.add_external_force(u_local, factor, -1.0, r_local)?;
-                for pair in contact.iter_mut() {
-                    pair.add_residual(dofs, u_local, factor, r_local)?;
-                }
-                Ok(())
-            })??;
-            bulk.add_body_force(body_force, -factor, r_local)?;
-            if let Some(f) = fixed {
-                for (r, f) in r_local.iter_mut().zip(f) {
-                    *r -= factor * f;
-                }
+                stages.time(Phase::BulkAssembly, times, || -> Result<()> {
+                    if !linear {
+                        bulk.add_internal_force(u_local, r_local)?;
+                    }
+                    loads.add_external_force(u_local, factor, -1.0, r_local)?;
+                    bulk.add_body_force(body_force, -factor, r_local)?;
+                    if let Some(f) = fixed {
+                        for (r, f) in r_local.iter_mut().zip(f) {
+                            *r -= factor * f;
+                        }
+                    }
+                    Ok(())
+                })?;
+                stages.time(Phase::ContactAssembly, times, || -> Result<()> {
+                    for pair in contact.iter_mut() {
+                        pair.add_residual(dofs, u_local, factor, r_local)?;
+                    }
+                    Ok(())
+                })
+            })?
+        })??;
+        let r = &mut self.r;
+        stages.time(Phase::HaloExchange, times, || r.accumulate_ghosts())?;
+        out.copy_from(self.r.global())?;
+        let (linear_k, work, inertia) = (&self.linear_k, &mut self.work, &mut self.inertia);
+        stages.time(Phase::BulkAssembly, times, || -> Result<()> {
+            if let Some(k) = linear_k {
+                k.mult(x, work)?;
+                out.axpy(1.0, work)?;
+            }
+            if let Some(inertia) = inertia {
+                inertia.add_force(x, out)?;
             }
             Ok(())
-        })??;
-        self.r.accumulate_ghosts()?;
-        out.copy_from(self.r.global())?;
-        if let Some(k) = &self.linear_k {
-            k.mult(x, &mut self.work)?;
-            out.axpy(1.0, &self.work)?;
-        }
-        if let Some(inertia) = &mut self.inertia {
-            inertia.add_force(x, out)?;
-        }
-        Ok(())
+        })
     }
 
     /// ‖R(x)‖ with the Dirichlet rows replaced, as SNES sees it.
@@ -159,34 +177,49 @@ impl<'a> Mechanics<'a> {
     fn jacobian_impl(&mut self, x: &Vector, j: &mut Matrix) -> Result<()> {
         self.jacobian_evaluations += 1;
         self.load_state(x)?;
-        j.zero_entries()?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
-        // Whole-matrix additions (MatAXPY) need the assembled (zeroed)
-        // matrix, so they come before any element values are set.
-        if let Some(inertia) = &self.inertia {
-            j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
-        }
-        match &self.linear_k {
-            Some(k) => j.add_scaled_subset(1.0, k)?,
-            None => {
-                self.u
-                    .with_local(|u_local| bulk.add_tangent(u_local, j))??;
-                self.bulk_tangent_assemblies += 1;
+        let (stages, times) = (self.stages, &mut self.times);
+        let (u, inertia, linear_k) = (&self.u, &self.inertia, &self.linear_k);
+        let assembled_bulk = stages.time(Phase::BulkAssembly, times, || -> Result<bool> {
+            j.zero_entries()?;
+            // Whole-matrix additions (MatAXPY) need the assembled (zeroed)
+            // matrix, so they come before any element values are set.
+            if let Some(inertia) = inertia {
+                j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
             }
+            let assembled = match linear_k {
+                Some(k) => {
+                    j.add_scaled_subset(1.0, k)?;
+                    false
+                }
+                None => {
+                    u.with_local(|u_local| bulk.add_tangent(u_local, j))??;
+                    true
+                }
+            };
+            if loads.has_follower() {
+                u.with_local(|u_local| loads.add_tangent(u_local, factor, j))??;
+            }
+            Ok(assembled)
+        })?;
+        if assembled_bulk {
+            self.bulk_tangent_assemblies += 1;
         }
         let contact = &mut *self.contact;
-        self.u.with_local(|u_local| -> Result<()> {
-            if loads.has_follower() {
-                loads.add_tangent(u_local, factor, j)?;
-            }
-            for pair in contact.iter_mut() {
-                pair.add_tangent(dofs, u_local, factor, j)?;
-            }
+        stages.time(Phase::ContactAssembly, times, || {
+            u.with_local(|u_local| -> Result<()> {
+                for pair in contact.iter_mut() {
+                    pair.add_tangent(dofs, u_local, factor, j)?;
+                }
+                Ok(())
+            })?
+        })?;
+        let rows = self.dirichlet.global_rows();
+        stages.time(Phase::BulkAssembly, times, || -> Result<()> {
+            j.assemble()?;
+            j.zero_rows_columns_identity(&rows)?;
             Ok(())
-        })??;
-        j.assemble()?;
-        j.zero_rows_columns_identity(&self.dirichlet.global_rows())?;
-        Ok(())
+        })
     }
 }
 

@@ -10,6 +10,7 @@ pub mod dynamics;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
+pub mod phases;
 
 pub use boundary::{Dirichlet, DirichletSpec};
 pub use dynamics::{DynamicsReport, DynamicsSpec};
@@ -27,6 +28,7 @@ use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, Ve
 use crate::runtime::Runtime;
 use mpi::collective::SystemOperation;
 use mpi::traits::*;
+use phases::{Phase, PhaseTimes};
 use std::time::Instant;
 
 /// Newton and load-stepping settings.
@@ -135,6 +137,9 @@ pub struct StepReport {
     pub contact: Vec<ContactReport>,
     /// Time, energy and momentum (dynamics only).
     pub dynamics: Option<DynamicsReport>,
+    /// Seconds per phase in this step on this rank (the output phase of
+    /// the step itself is booked to the next step's report).
+    pub phases: PhaseTimes,
 }
 
 /// The result of a run: per-step reports and the final displacement.
@@ -146,6 +151,8 @@ pub struct RunReport {
     pub displacement: Vec<f64>,
     pub bulk_tangent_assemblies: usize,
     pub pattern_builds: usize,
+    /// Seconds per phase over the run, the largest over the ranks.
+    pub phases: PhaseTimes,
 }
 
 /// This rank's contact values of one pair at a converged step, for output.
@@ -245,7 +252,9 @@ impl<'m> Simulation<'m> {
         let world = rt.world();
         let model = self.model;
         let stage_solve = LogStage::register("Solve")?;
-        let stage_search = LogStage::register("Contact search")?;
+        let stages = phases::Stages::register()?;
+        // Phases booked here; the callbacks book theirs in `mech.times`.
+        let mut times = PhaseTimes::default();
         // Frictionless contact keeps the tangent symmetric (it is the Hessian
         // of a potential); friction and follower loads do not.
         let friction = self.contact.iter().any(ContactPair::has_friction);
@@ -324,16 +333,21 @@ impl<'m> Simulation<'m> {
                 None => None,
             };
             x.with_array_mut(|xa| dirichlet.apply(xa, target))?;
+            let step_start_times = add_times(&times, &mech.times);
             if !mech.contact.is_empty() {
-                let changed = stage_search.scope(|| {
+                let mark = PhaseMark::new(&mech);
+                let changed = stages.scope(Phase::ContactSearch, || {
                     mech.with_state(&x, |u, pairs| {
                         Ok(pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c))
                     })
                 })?;
                 if any_rank(&world, changed) || pattern_builds == 0 {
-                    *jac = build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)?;
+                    *jac = stages.scope(Phase::ContactSearch, || {
+                        build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)
+                    })?;
                     pattern_builds += 1;
                 }
+                mark.book(Phase::ContactSearch, &mut times, &mech);
             }
             if model.solver.atol.is_none() && !user_atol {
                 // The step's own force scale: the residual once the new loads
@@ -346,8 +360,17 @@ impl<'m> Simulation<'m> {
                     model.solver.max_newton,
                 )?;
             }
-            let attempt = stage_solve
-                .scope(|| uzawa_loop(&world, &mut snes, &mut mech, &mut x, &mut r, jac, target));
+            let attempt = stage_solve.scope(|| {
+                let mut ctx = StepContext {
+                    snes: &mut snes,
+                    x: &mut x,
+                    r: &mut r,
+                    jac,
+                    stages: &stages,
+                    times: &mut times,
+                };
+                uzawa_loop(&world, &mut ctx, &mut mech, target)
+            });
             let (outcome, uzawa_iterations, stats) = match attempt? {
                 Ok(done_step) => done_step,
                 Err(failure) => {
@@ -386,6 +409,7 @@ impl<'m> Simulation<'m> {
                 }
                 _ => None,
             };
+            let output_mark = PhaseMark::new(&mech);
             // In dynamics the support also carries the inertia of its rows.
             mech.raw_residual(&x, &mut reaction)?;
             let reactions = reaction_totals(&world, dirichlet, &reaction, dofs.owned_dof_start())?;
@@ -412,6 +436,7 @@ impl<'m> Simulation<'m> {
                 reactions,
                 contact: contact_reports,
                 dynamics: dynamics_report,
+                phases: PhaseTimes::default(),
             };
             if echo && rt.rank() == 0 {
                 print_step(&report);
@@ -422,15 +447,21 @@ impl<'m> Simulation<'m> {
                 .zip(fields)
                 .map(|(pair, values)| PairFields { pair, values })
                 .collect();
+            let mut report = report;
+            report.phases = add_times(&times, &mech.times).since(&step_start_times);
             let velocity = stepper.as_ref().map(|s| s.velocity());
-            sink.step(
-                &report,
-                &x,
-                &reaction,
-                &pair_fields,
-                &nodal_pressure,
-                velocity,
-            )?;
+            stages.scope(Phase::Output, || {
+                sink.step(
+                    &report,
+                    &x,
+                    &reaction,
+                    &pair_fields,
+                    &nodal_pressure,
+                    velocity,
+                )
+            })?;
+            drop(pair_fields);
+            output_mark.book(Phase::Output, &mut times, &mech);
             for pair in mech.contact.iter_mut() {
                 pair.commit()?;
             }
@@ -448,8 +479,63 @@ impl<'m> Simulation<'m> {
             displacement,
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
             pattern_builds,
+            phases: max_over_ranks(&world, add_times(&times, &mech.times)),
         })
     }
+}
+
+fn add_times(a: &PhaseTimes, b: &PhaseTimes) -> PhaseTimes {
+    let mut t = *a;
+    for (x, y) in t.0.iter_mut().zip(b.0) {
+        *x += y;
+    }
+    t
+}
+
+fn max_over_ranks(world: &impl Communicator, t: PhaseTimes) -> PhaseTimes {
+    let mut out = PhaseTimes::default();
+    world.all_reduce_into(&t.0[..], &mut out.0[..], SystemOperation::max());
+    out
+}
+
+/// The solver state one Uzawa loop works on.
+struct StepContext<'s> {
+    snes: &'s mut Snes,
+    x: &'s mut Vector,
+    r: &'s mut Vector,
+    jac: &'s mut Matrix,
+    stages: &'s phases::Stages,
+    times: &'s mut PhaseTimes,
+}
+
+/// The start of a phase measured around work that may call the residual or
+/// Jacobian (which book their own phases) or exchange multipliers (halo):
+/// `book` charges the phase with the rest only, so nothing counts twice.
+struct PhaseMark {
+    start: Instant,
+    callbacks: f64,
+    halo: f64,
+}
+
+impl PhaseMark {
+    fn new(mech: &Mechanics) -> Self {
+        PhaseMark {
+            start: Instant::now(),
+            callbacks: mech.times.total(),
+            halo: multiplier_halo_seconds(mech.contact),
+        }
+    }
+
+    fn book(self, p: Phase, times: &mut PhaseTimes, mech: &Mechanics) {
+        let halo = multiplier_halo_seconds(mech.contact) - self.halo;
+        let nested = mech.times.total() - self.callbacks + halo;
+        times.add(p, (self.start.elapsed().as_secs_f64() - nested).max(0.0));
+        times.add(Phase::HaloExchange, halo);
+    }
+}
+
+fn multiplier_halo_seconds(pairs: &[ContactPair]) -> f64 {
+    pairs.iter().map(|p| p.multipliers.exchange_seconds).sum()
 }
 
 /// Sets up one time step from load factor `from` to `to`: the Newmark
@@ -484,13 +570,18 @@ type StepResult = std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), Ste
 /// Newton iterations are summed over the Uzawa iterations.
 fn uzawa_loop(
     world: &impl Communicator,
-    snes: &mut Snes,
+    ctx: &mut StepContext,
     mech: &mut Mechanics,
-    x: &mut Vector,
-    r: &mut Vector,
-    jac: &mut Matrix,
     factor: f64,
 ) -> Result<StepResult> {
+    let StepContext {
+        snes,
+        x,
+        r,
+        jac,
+        stages,
+        times,
+    } = ctx;
     let max_uzawa = mech
         .contact
         .iter()
@@ -515,7 +606,9 @@ fn uzawa_loop(
         } else {
             -1
         })?;
-        let mut outcome = snes.solve(mech, x, r, jac)?;
+        let mark = PhaseMark::new(mech);
+        let mut outcome = stages.scope(Phase::LinearSolve, || snes.solve(mech, x, r, jac))?;
+        mark.book(Phase::LinearSolve, times, mech);
         newton += outcome.iterations;
         linear += outcome.linear_iterations;
         history.extend_from_slice(&outcome.history);
@@ -525,12 +618,16 @@ fn uzawa_loop(
         if mech.contact.is_empty() {
             return Ok(Ok((outcome, 0, Vec::new())));
         }
-        let local: Vec<UzawaStats> = mech.with_state(x, |u, pairs| {
-            pairs
-                .iter_mut()
-                .map(|p| p.uzawa_update(u, factor))
-                .collect()
+        let mark = PhaseMark::new(mech);
+        let local: Vec<UzawaStats> = stages.scope(Phase::UzawaUpdate, || {
+            mech.with_state(x, |u, pairs| {
+                pairs
+                    .iter_mut()
+                    .map(|p| p.uzawa_update(u, factor))
+                    .collect()
+            })
         })?;
+        mark.book(Phase::UzawaUpdate, times, mech);
         let stats = reduce_stats(world, &local);
         last_links = mech
             .contact
