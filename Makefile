@@ -3,6 +3,8 @@ SHELL := /bin/bash
 NP ?= 2
 MPIRUN ?= mpirun --allow-run-as-root --oversubscribe
 CARGO ?= cargo
+# Debian's Python (python3-matplotlib is installed for it), not a pyenv shim.
+PYTHON ?= /usr/bin/python3
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
@@ -10,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-mpi bench hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi bench work-precision hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -48,6 +50,13 @@ bench: deps
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/assembly-$$n.csv || exit 1; \
 	done
 
+# Run time against error for the Hertz line contact: mesh size × penalty ×
+# Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto front in
+# bench-results/ (about 5 minutes on 2 cores).
+work-precision: build
+	@mkdir -p bench-results
+	$(PYTHON) scripts/work_precision.py --scene hertz-cylinder --np $(NP) --repeats 3
+
 # Hertz verification under refinement (figures in the README).
 hertz-study: build
 	@for args in "--set mesh.fine_size=0.2" "" "--set mesh.level=1 --set solver.direct_max_dofs=200000"; do \
@@ -60,7 +69,6 @@ hertz-study: build
 	done
 
 # Ironing (Puso & Laursen 2004 style): contact force history as CSV and PNG.
-PYTHON ?= /usr/bin/python3
 ironing: build
 	@mkdir -p out
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5

@@ -341,13 +341,14 @@ impl<'m> Simulation<'m> {
                         Ok(pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c))
                     })
                 })?;
+                mark.book(Phase::ContactSearch, &mut times, &mech);
                 if any_rank(&world, changed) || pattern_builds == 0 {
-                    *jac = stages.scope(Phase::ContactSearch, || {
+                    // A new coupling pattern is contact assembly's cost.
+                    *jac = stages.time(Phase::ContactAssembly, &mut times, || {
                         build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)
                     })?;
                     pattern_builds += 1;
                 }
-                mark.book(Phase::ContactSearch, &mut times, &mech);
             }
             if model.solver.atol.is_none() && !user_atol {
                 // The step's own force scale: the residual once the new loads

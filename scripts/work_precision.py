@@ -1,0 +1,142 @@
+#!/usr/bin/python3
+"""Work-precision sweep for the Hertz scenes: run time against error.
+
+usage: work_precision.py --scene hertz-cylinder [--np 2] [--repeats 3]
+                         [--sizes 0.4,0.2,0.1] [--penalties 0.1,1,10]
+                         [--tols 1e-2,1e-3,1e-4] [--out bench-results]
+
+Every configuration (contact-zone element size h, penalty as a multiple of
+the default 10·E/h, Uzawa tolerance for both penetration and multiplier
+change) runs `--repeats` times under mpirun; the row keeps the median wall
+time (the whole process, what a user waits), the DOFs, Newton and Uzawa
+iteration counts and the relative errors of p0 and of b (or a) against
+Hertz. Writes <out>/wp-<scene>.csv and a log-log PNG of max(|e_p0|, |e_b|)
+against wall time with the Pareto front (no other run is both faster and
+more accurate) marked.
+"""
+import argparse
+import csv
+import os
+import re
+import statistics
+import subprocess
+import sys
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+YOUNGS = 1000.0  # both Hertz scenes use E = 1000 on both bodies
+DONE = re.compile(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs")
+HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
+
+
+def run_once(scene, np_, args, h5):
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
+           "target/release/contactlink", "run", scene, "-q", "-o", h5] + args
+    env = dict(os.environ, OMPI_MCA_btl="self,vader",
+               OMPI_MCA_btl_vader_single_copy_mechanism="none",
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - t0
+    out = p.stdout + p.stderr
+    if p.returncode != 0:
+        return None, out
+    d, h = DONE.search(out), HERTZ.search(out.split("Hertz:")[-1])
+    if not d or not h:
+        return None, out
+    with open(h5[:-3] + ".csv") as f:
+        uzawa = sum(int(r["uzawa"]) for r in csv.DictReader(f))
+    return {
+        "wall": wall, "steps": int(d[1]), "newton": int(d[2]), "dofs": int(d[3]),
+        "uzawa": uzawa, "e_p0": float(h[1]) / 100, "e_b": float(h[2]) / 100,
+    }, out
+
+
+def pareto(rows):
+    front = []
+    for r in sorted(rows, key=lambda r: (r["wall"], r["error"])):
+        if not front or r["error"] < front[-1]["error"]:
+            front.append(r)
+    return front
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scene", default="hertz-cylinder")
+    ap.add_argument("--np", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--sizes", default="0.4,0.2,0.1")
+    ap.add_argument("--penalties", default="0.1,1,10")
+    ap.add_argument("--tols", default="1e-2,1e-3,1e-4")
+    ap.add_argument("--out", default="bench-results")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for h in [float(v) for v in a.sizes.split(",")]:
+        for k in [float(v) for v in a.penalties.split(",")]:
+            for tol in [float(v) for v in a.tols.split(",")]:
+                args = ["--set", f"mesh.fine_size={h}",
+                        "--set", f"contact.penalty={k * 10 * YOUNGS / h}",
+                        "--set", f"contact.penetration_tol={tol}",
+                        "--set", f"contact.multiplier_tol={tol}",
+                        "--set", "contact.max_uzawa=60",
+                        "--set", "solver.direct_max_dofs=200000"]
+                runs = []
+                for i in range(a.repeats):
+                    r, out = run_once(a.scene, a.np, args, f"{a.out}/wp-run.h5")
+                    if r is None:
+                        print(f"h={h} penalty×{k} tol={tol}: failed\n{out[-400:]}",
+                              file=sys.stderr)
+                        break
+                    runs.append(r)
+                if not runs:
+                    continue
+                row = dict(runs[0])
+                row["wall"] = statistics.median(x["wall"] for x in runs)
+                row.update(h=h, penalty_factor=k, tol=tol, repeats=len(runs))
+                row["error"] = max(abs(row["e_p0"]), abs(row["e_b"]))
+                rows.append(row)
+                print(f"h={h:<5} penalty×{k:<4} tol={tol:<6} DOFs {row['dofs']:>7} "
+                      f"wall {row['wall']:6.2f} s  Newton {row['newton']:3d} "
+                      f"Uzawa {row['uzawa']:3d}  e_p0 {100 * row['e_p0']:+.3f} % "
+                      f"e_b {100 * row['e_b']:+.3f} %", flush=True)
+    if not rows:
+        sys.exit("no run succeeded")
+    front = pareto(rows)
+    for r in rows:
+        r["pareto"] = int(r in front)
+    keys = ["h", "penalty_factor", "tol", "dofs", "wall", "repeats", "steps",
+            "newton", "uzawa", "e_p0", "e_b", "error", "pareto"]
+    path = f"{a.out}/wp-{a.scene}.csv"
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for h in sorted({r["h"] for r in rows}, reverse=True):
+        sel = [r for r in rows if r["h"] == h]
+        ax.scatter([r["wall"] for r in sel], [r["error"] for r in sel], label=f"h = {h}")
+    ax.plot([r["wall"] for r in front], [r["error"] for r in front], "k--",
+            label="Pareto front")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"wall time on {a.np} ranks [s] (median of {a.repeats})")
+    ax.set_ylabel("max(|error p0|, |error b|)")
+    ax.set_title(f"{a.scene}: work against precision")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(f"{a.out}/wp-{a.scene}.png", dpi=120)
+    print(f"work-precision: {path}, {a.out}/wp-{a.scene}.png")
+    print("Pareto front:")
+    for r in front:
+        print(f"  h={r['h']} penalty×{r['penalty_factor']} tol={r['tol']}: "
+              f"{r['wall']:.2f} s, error {100 * r['error']:.3f} %")
+
+
+if __name__ == "__main__":
+    main()
