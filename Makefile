@@ -12,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-mpi bench work-precision hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi bench work-precision scaling hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -56,6 +56,12 @@ bench: deps
 work-precision: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/work_precision.py --scene hertz-cylinder --np $(NP) --repeats 3
+
+# Strong (152k DOFs, 1/2 ranks, 4 oversubscribed for correctness) and weak
+# scaling of the Hertz line contact, with the halo volume (about 4 minutes).
+scaling: build
+	@mkdir -p bench-results
+	$(PYTHON) scripts/scaling.py --repeats 3
 
 # Hertz verification under refinement (figures in the README).
 hertz-study: build

@@ -208,6 +208,12 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                     r.wall_seconds
                 );
                 println!("{}", phase_summary(&r.phases, r.wall_seconds));
+                if rt.size() > 1 {
+                    println!(
+                        "  halo (all ranks): {} ghost displacement values per residual, {} ghost multiplier values per Uzawa update",
+                        r.halo_displacements, r.halo_multipliers
+                    );
+                }
                 if let Some(last) = r.steps.last() {
                     for (set, f) in &last.reactions {
                         println!(

@@ -240,6 +240,17 @@ impl Multipliers {
         Ok(())
     }
 
+    /// Values one halo exchange brings to this rank: λN of every ghost point,
+    /// and the friction record of each with friction.
+    pub fn ghost_values(&self) -> usize {
+        let width = if self.tangential.is_some() {
+            1 + FRICTION_WIDTH
+        } else {
+            1
+        };
+        self.n_ghost * width
+    }
+
     /// Tangential force carried by each owned slave node: Σ N_a(ζ) w tT over
     /// every slave point around it (any rank, through the friction halo).
     /// Zero vectors for a frictionless pair.

@@ -153,6 +153,11 @@ pub struct RunReport {
     pub pattern_builds: usize,
     /// Seconds per phase over the run, the largest over the ranks.
     pub phases: PhaseTimes,
+    /// Halo volume, summed over ranks: ghost displacement values refreshed
+    /// before every residual/Jacobian, and ghost multiplier values refreshed
+    /// after every Uzawa update.
+    pub halo_displacements: usize,
+    pub halo_multipliers: usize,
 }
 
 /// This rank's contact values of one pair at a converged step, for output.
@@ -481,6 +486,14 @@ impl<'m> Simulation<'m> {
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
             pattern_builds,
             phases: max_over_ranks(&world, add_times(&times, &mech.times)),
+            halo_displacements: sum_over_ranks(&world, dofs.ghost_dofs().len()),
+            halo_multipliers: sum_over_ranks(
+                &world,
+                mech.contact
+                    .iter()
+                    .map(|p| p.multipliers.ghost_values())
+                    .sum(),
+            ),
         })
     }
 }
@@ -491,6 +504,12 @@ fn add_times(a: &PhaseTimes, b: &PhaseTimes) -> PhaseTimes {
         *x += y;
     }
     t
+}
+
+fn sum_over_ranks(world: &impl Communicator, n: usize) -> usize {
+    let mut total = 0u64;
+    world.all_reduce_into(&(n as u64), &mut total, SystemOperation::sum());
+    total as usize
 }
 
 fn max_over_ranks(world: &impl Communicator, t: PhaseTimes) -> PhaseTimes {

@@ -1,0 +1,91 @@
+#!/usr/bin/python3
+"""Strong and weak scaling of the Hertz line contact.
+
+usage: scaling.py [--repeats 3] [--out bench-results]
+
+Strong: hertz-cylinder at h = 0.05 (152,316 DOFs) on 1 and 2 ranks (median
+of --repeats runs of the solve time printed by contactlink), and on 4 ranks
+with --oversubscribe for correctness only (2 cores). Weak: about 16k DOFs
+per rank (h = 0.2 on 1 rank, h = 0.1414 on 2). Prints a table, the parallel
+efficiency, the halo volume, and that 2 and 4 ranks reproduce 1 rank's
+Hertz figures; writes <out>/scaling.csv.
+"""
+import argparse
+import csv
+import os
+import re
+import statistics
+import subprocess
+
+DONE = re.compile(r"done: \d+ steps, (\d+) Newton iterations, (\d+) DOFs on (\d+) rank\(s\), ([0-9.]+) s")
+HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
+HALO = re.compile(r"halo \(all ranks\): (\d+) ghost displacement values per residual, (\d+) ghost multiplier")
+
+
+def run(np_, args):
+    env = dict(os.environ, OMPI_MCA_btl="self,vader",
+               OMPI_MCA_btl_vader_single_copy_mechanism="none",
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
+           "target/release/contactlink", "run", "hertz-cylinder", "-q",
+           "--set", "solver.direct_max_dofs=200000"] + args
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    out = p.stdout + p.stderr
+    d = DONE.search(out)
+    if p.returncode != 0 or not d:
+        raise SystemExit(f"{' '.join(cmd)} failed:\n{out[-600:]}")
+    h = HERTZ.search(out.split("Hertz:")[-1])
+    halo = HALO.search(out)
+    return {
+        "ranks": np_, "dofs": int(d[2]), "newton": int(d[1]), "seconds": float(d[4]),
+        "e_p0": float(h[1]), "e_b": float(h[2]),
+        "halo_u": int(halo[1]) if halo else 0, "halo_lambda": int(halo[2]) if halo else 0,
+    }
+
+
+def median_run(np_, args, repeats):
+    runs = [run(np_, args) for _ in range(repeats)]
+    row = dict(runs[0])
+    row["seconds"] = statistics.median(r["seconds"] for r in runs)
+    row["repeats"] = repeats
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default="bench-results")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    strong = ["--set", "mesh.level=1"]
+    for np_ in (1, 2):
+        rows.append(dict(median_run(np_, strong, a.repeats), kind="strong"))
+    rows.append(dict(median_run(4, strong, 1), kind="strong (4 ranks on 2 cores: correctness only)"))
+    rows.append(dict(median_run(1, ["--set", "mesh.fine_size=0.2"], a.repeats), kind="weak"))
+    rows.append(dict(median_run(2, ["--set", "mesh.fine_size=0.1414"], a.repeats), kind="weak"))
+    t1 = rows[0]["seconds"]
+    for r in rows:
+        if r["kind"] == "strong":
+            r["efficiency"] = t1 / (r["ranks"] * r["seconds"])
+    w1 = rows[3]
+    rows[4]["efficiency"] = w1["seconds"] / rows[4]["seconds"] * (rows[4]["dofs"] / rows[4]["ranks"]) / w1["dofs"]
+    keys = ["kind", "ranks", "dofs", "repeats", "seconds", "efficiency", "newton",
+            "e_p0", "e_b", "halo_u", "halo_lambda"]
+    with open(f"{a.out}/scaling.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    for r in rows:
+        eff = f"{100 * r['efficiency']:.0f} %" if "efficiency" in r else "-"
+        print(f"{r['kind']:<48} {r['ranks']} ranks {r['dofs']:>7} DOFs {r['seconds']:7.2f} s "
+              f"eff {eff:>6}  Newton {r['newton']:3d}  p0 {r['e_p0']:+.3f} % b {r['e_b']:+.3f} %  "
+              f"halo {r['halo_u']} u / {r['halo_lambda']} λ")
+    same = all(abs(r["e_p0"] - rows[0]["e_p0"]) < 1e-3 and abs(r["e_b"] - rows[0]["e_b"]) < 1e-3
+               for r in rows[:3])
+    print("strong-scaling runs agree on the Hertz figures:", same)
+    print(f"scaling: {a.out}/scaling.csv")
+
+
+if __name__ == "__main__":
+    main()
