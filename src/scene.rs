@@ -93,6 +93,7 @@ pub struct Scene {
     #[serde(default)]
     pub steps: StepsSection,
     pub dynamics: Option<DynamicsSection>,
+    pub distort: Option<DistortSection>,
     #[serde(default)]
     pub solver: SolverSection,
     #[serde(default)]
@@ -227,6 +228,17 @@ pub struct BodySection {
     pub density: Option<f64>,
     /// Initial velocity of the whole body (dynamics).
     pub initial_velocity: Option<[f64; 3]>,
+}
+
+/// Random distortion of the generated mesh (stress tests): every node moves
+/// by up to `fraction` of its shortest edge; nodes on flat boundaries move
+/// only within them, corners and edges of the bodies stay.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistortSection {
+    pub fraction: f64,
+    #[serde(default)]
+    pub seed: u64,
 }
 
 /// Implicit dynamics: Newmark time stepping; `[steps] count` steps of
@@ -460,8 +472,12 @@ impl Scene {
     /// Builds the mesh and checks every reference in the scene against it.
     pub fn build(&self, origin: &str) -> Result<Model> {
         let err = |m: String| Error::scene(origin, m);
-        let mesh = self.build_mesh()?;
+        let mut mesh = self.build_mesh()?;
         mesh.validate()?;
+        if let Some(d) = &self.distort {
+            mesh = generate::perturb_interior(&mesh, d.fraction, d.seed)
+                .map_err(|e| err(format!("[distort]: {e}")))?;
+        }
         let mut materials = Vec::with_capacity(mesh.bodies.len());
         for body in &mesh.bodies {
             let section = self

@@ -314,3 +314,9 @@ fn bad_amplitude_is_named() {
         &["[[pressure]]", "block.top", "increase"],
     );
 }
+
+#[test]
+fn too_strong_distortion_is_rejected() {
+    let scene = GOOD.to_string() + "\n[distort]\nfraction = 0.5\n";
+    check_fails("distort", &scene, &["[distort]", "fraction", "0.3"]);
+}

@@ -126,3 +126,24 @@ fn nearly_incompressible_bodies_converge() {
     // Uniaxial stress (free sides): the force does not depend on ν.
     assert_force("ν = 0.49", n, 0.0);
 }
+
+#[test]
+fn distorted_meshes_keep_the_patch_test() {
+    // Interior nodes moved by up to 30 % of h, boundary nodes within their
+    // faces (the contact surfaces stay flat, so the answer stays uniform).
+    for seed in ["1", "7"] {
+        let (n, newton, uzawa) = patch(
+            &format!("distorted-{seed}"),
+            &[
+                "--set",
+                "distort.fraction=0.3",
+                "--set",
+                &format!("distort.seed={seed}"),
+            ],
+        );
+        println!(
+            "distorted 30 % (seed {seed}): normal force {n:.9}, Newton {newton}, Uzawa {uzawa}"
+        );
+        assert_force("distorted", n, 0.0);
+    }
+}
