@@ -40,8 +40,9 @@ test-mpi:
 	  $(MPIRUN) -n $$n $$bin || exit 1; \
 	done
 
-# Assembly throughput and solve time against DOFs, and one contact solve against
-# one plain elastic solve of the same mesh; 1 vs 2 ranks (CSV in bench-results/).
+# Assembly throughput and solve time against DOFs; one contact solve against one
+# plain elastic solve of the same mesh; what each reuse saves; 1 vs 2 ranks
+# (CSV in bench-results/).
 bench: deps
 	@mkdir -p bench-results
 	@bin=$$($(CARGO) bench --bench assembly --no-run 2>&1 | grep -o 'target/release/deps/assembly-[0-9a-f]*' | head -1); \
@@ -50,11 +51,11 @@ bench: deps
 	  echo "assembly benchmark on $$n rank(s)"; \
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/assembly-$$n.csv || exit 1; \
 	done
-	@bin=$$($(CARGO) bench --bench contact_vs_plain --no-run 2>&1 | grep -o 'target/release/deps/contact_vs_plain-[0-9a-f]*' | head -1); \
-	test -n "$$bin" || { echo "could not find the contact-vs-plain benchmark"; exit 1; }; \
+	@bin=$$($(CARGO) bench --bench solve_costs --no-run 2>&1 | grep -o 'target/release/deps/solve_costs-[0-9a-f]*' | head -1); \
+	test -n "$$bin" || { echo "could not find the solve-costs benchmark"; exit 1; }; \
 	for n in 1 2; do \
-	  echo "contact solve vs plain elastic solve on $$n rank(s)"; \
-	  $(MPIRUN) -n $$n $$bin | tee bench-results/contact-vs-plain-$$n.csv || exit 1; \
+	  echo "contact solve vs plain elastic solve, and what reuse saves, on $$n rank(s)"; \
+	  $(MPIRUN) -n $$n $$bin | tee bench-results/solve-costs-$$n.csv || exit 1; \
 	done
 
 # Run time against error for the Hertz line contact: mesh size × penalty ×

@@ -354,6 +354,10 @@ pub struct SolverSection {
     /// Up to this many DOFs the default linear solver is direct (MUMPS).
     pub direct_max_dofs: Option<usize>,
     pub petsc_options: Option<String>,
+    /// Reuse switches (default true), to measure what each saves.
+    pub reuse_linear_stiffness: Option<bool>,
+    pub reuse_pattern: Option<bool>,
+    pub lag_preconditioner: Option<bool>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -669,6 +673,11 @@ impl Scene {
             max_cutbacks: s.max_cutbacks.unwrap_or(d.max_cutbacks),
             direct_max_dofs: s.direct_max_dofs.unwrap_or(d.direct_max_dofs),
             petsc_options: s.petsc_options.clone().unwrap_or_default(),
+            reuse: crate::solve::Reuse {
+                linear_stiffness: s.reuse_linear_stiffness.unwrap_or(d.reuse.linear_stiffness),
+                pattern: s.reuse_pattern.unwrap_or(d.reuse.pattern),
+                preconditioner: s.lag_preconditioner.unwrap_or(d.reuse.preconditioner),
+            },
         })
     }
 

@@ -49,6 +49,7 @@ impl<'a> Mechanics<'a> {
         dirichlet: &'a Dirichlet,
         contact: &'a mut [ContactPair],
         body_force: Vec<[f64; 3]>,
+        reuse_linear_stiffness: bool,
     ) -> Result<Self> {
         let ghosts = dofs.ghost_dofs();
         let u = GhostedVector::new(dofs.num_owned_dofs(), &ghosts)?;
@@ -74,7 +75,7 @@ impl<'a> Mechanics<'a> {
             jacobian_evaluations: 0,
             bulk_tangent_assemblies: 0,
         };
-        if bulk.is_linear() {
+        if bulk.is_linear() && reuse_linear_stiffness {
             let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
             bulk.add_pattern(&mut pattern)?;
             let mut k = pattern.build()?;

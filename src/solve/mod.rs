@@ -47,6 +47,31 @@ pub struct SolverSettings {
     pub max_cutbacks: usize,
     /// PETSc options (defaults that the command line and PETSC_OPTIONS override).
     pub petsc_options: String,
+    /// What is computed once and reused (all on by default; switches exist
+    /// to measure each saving).
+    pub reuse: Reuse,
+}
+
+/// Work a run reuses instead of redoing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Reuse {
+    /// Linear-elastic bulk stiffness assembled once (residual = K u − f).
+    pub linear_stiffness: bool,
+    /// Jacobian sparsity pattern kept while the contact couplings are unchanged.
+    pub pattern: bool,
+    /// Preconditioner (LU factors) of an Uzawa iteration's first solve kept
+    /// for the following ones.
+    pub preconditioner: bool,
+}
+
+impl Default for Reuse {
+    fn default() -> Self {
+        Reuse {
+            linear_stiffness: true,
+            pattern: true,
+            preconditioner: true,
+        }
+    }
 }
 
 impl Default for SolverSettings {
@@ -58,6 +83,7 @@ impl Default for SolverSettings {
             direct_max_dofs: 20_000,
             max_cutbacks: 8,
             petsc_options: String::new(),
+            reuse: Reuse::default(),
         }
     }
 }
@@ -284,6 +310,7 @@ impl<'m> Simulation<'m> {
             dirichlet,
             contact,
             model.body_force.clone(),
+            model.solver.reuse.linear_stiffness,
         )?;
         if let Some(b) = &model.body_force_fn {
             let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
@@ -347,7 +374,8 @@ impl<'m> Simulation<'m> {
                     })
                 })?;
                 mark.book(Phase::ContactSearch, &mut times, &mech);
-                if any_rank(&world, changed) || pattern_builds == 0 {
+                let rebuild = !model.solver.reuse.pattern || pattern_builds == 0;
+                if any_rank(&world, changed) || rebuild {
                     // A new coupling pattern is contact assembly's cost.
                     *jac = stages.time(Phase::ContactAssembly, &mut times, || {
                         build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)
@@ -374,6 +402,7 @@ impl<'m> Simulation<'m> {
                     jac,
                     stages: &stages,
                     times: &mut times,
+                    reuse_preconditioner: model.solver.reuse.preconditioner,
                 };
                 uzawa_loop(&world, &mut ctx, &mut mech, target)
             });
@@ -526,6 +555,7 @@ struct StepContext<'s> {
     jac: &'s mut Matrix,
     stages: &'s phases::Stages,
     times: &'s mut PhaseTimes,
+    reuse_preconditioner: bool,
 }
 
 /// The start of a phase measured around work that may call the residual or
@@ -601,7 +631,9 @@ fn uzawa_loop(
         jac,
         stages,
         times,
+        reuse_preconditioner,
     } = ctx;
+    let reuse_preconditioner = *reuse_preconditioner;
     let max_uzawa = mech
         .contact
         .iter()
@@ -621,11 +653,13 @@ fn uzawa_loop(
         k += 1;
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
-        snes.set_lag_preconditioner(if k == 1 || mech.contact.is_empty() {
-            1
-        } else {
-            -1
-        })?;
+        snes.set_lag_preconditioner(
+            if k == 1 || mech.contact.is_empty() || !reuse_preconditioner {
+                1
+            } else {
+                -1
+            },
+        )?;
         let mark = PhaseMark::new(mech);
         let mut outcome = stages.scope(Phase::LinearSolve, || snes.solve(mech, x, r, jac))?;
         mark.book(Phase::LinearSolve, times, mech);
