@@ -57,6 +57,10 @@ bench: deps
 	  echo "contact solve vs plain elastic solve, and what reuse saves, on $$n rank(s)"; \
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/solve-costs-$$n.csv || exit 1; \
 	done
+	@bin=$$($(CARGO) bench --bench search --no-run 2>&1 | grep -o 'target/release/deps/search-[0-9a-f]*' | head -1); \
+	test -n "$$bin" || { echo "could not find the search benchmark"; exit 1; }; \
+	echo "contact search against slave points (serial)"; \
+	$$bin | tee bench-results/search.csv
 
 # Run time against error for the Hertz line contact: mesh size × penalty ×
 # Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto front in
