@@ -169,6 +169,17 @@ pub struct LinkState {
 }
 
 impl LinkState {
+    /// The link without force: no usable closest point after all.
+    fn dropped(self) -> Self {
+        LinkState {
+            projection_converged: false,
+            closed: false,
+            pressure: 0.0,
+            friction: None,
+            ..self
+        }
+    }
+
     /// "No link": far apart, no force. Finite where possible so output stays
     /// readable.
     fn invalid() -> Self {
@@ -866,6 +877,20 @@ fn residual_tangent_sized(
 /// the Uzawa update and output). Bad input or a failed projection gives
 /// `projection_converged = false`, `pressure = 0`.
 pub fn evaluate(input: &LinkInput) -> LinkState {
+    let mut state = evaluate_normal(input);
+    if state.closed && input.friction.is_some() {
+        // The friction state comes from the kernel's own kinematics, so the
+        // stick/slip decision here is the one the residual makes.
+        match residual_f64(input, state.xi, &mut []) {
+            Some(friction) => state.friction = friction,
+            None => state = state.dropped(),
+        }
+    }
+    state
+}
+
+/// Gap, normal, pressure and open/closed, without the friction state.
+fn evaluate_normal(input: &LinkInput) -> LinkState {
     if check_input(input).is_err() {
         return LinkState::invalid();
     }
@@ -915,18 +940,6 @@ pub fn evaluate(input: &LinkInput) -> LinkState {
         state.closed = p >= 0.0;
         state.pressure = p.max(0.0);
     }
-    if state.closed && input.friction.is_some() {
-        // The friction state comes from the kernel's own kinematics, so the
-        // stick/slip decision here is the one the residual makes.
-        match residual_f64(input, state.xi, &mut []) {
-            Some(friction) => state.friction = friction,
-            None => {
-                state.projection_converged = false;
-                state.closed = false;
-                state.pressure = 0.0;
-            }
-        }
-    }
     state
 }
 
@@ -954,30 +967,29 @@ pub fn residual_tangent(input: &LinkInput, r: &mut [f64], mut k: Option<&mut [f6
     if check_input(input).is_err() || check_buffers(input, r.len(), k_len).is_err() {
         return LinkState::invalid();
     }
-    let mut state = evaluate(input);
+    let state = evaluate_normal(input);
     // Cheap exit: the f64 gap decides open/closed before any dual work.
     if !state.closed {
         return state;
     }
-    let ok = match k.as_deref_mut() {
+    let forces = match k.as_deref_mut() {
         Some(k) => residual_tangent_sized(input, state.xi, r, k),
         None => residual_f64(input, state.xi, r),
     };
-    if ok.is_none() {
-        // The closest point has no usable Hessian or normal in the kernel's
-        // own evaluation: drop the link rather than return a wrong tangent.
-        r.fill(0.0);
-        if let Some(k) = k {
-            k.fill(0.0);
+    match forces {
+        // The friction state of the same pass that formed the forces.
+        Some(friction) => LinkState { friction, ..state },
+        None => {
+            // The closest point has no usable Hessian or normal in the
+            // kernel's own evaluation: drop the link rather than return a
+            // wrong tangent.
+            r.fill(0.0);
+            if let Some(k) = k {
+                k.fill(0.0);
+            }
+            state.dropped()
         }
-        state = LinkState {
-            projection_converged: false,
-            closed: false,
-            pressure: 0.0,
-            ..state
-        };
     }
-    state
 }
 
 #[cfg(test)]

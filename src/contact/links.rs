@@ -1,6 +1,7 @@
 //! A contact pair at run time: the links of the current load step (one per
 //! linked slave quadrature point), their search, their contributions to the
 //! residual and tangent, and the Uzawa update of their multipliers.
+use super::dual::{dot, norm, sub};
 use super::link::{self, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
 use super::multipliers::{updated_multiplier, Multipliers, PointFriction, PointState};
 use super::pair::{MasterSpec, PairSpec, RigidSurface};
@@ -654,7 +655,7 @@ impl ContactPair {
         }
         let after_t = self.multipliers.nodal_tangential_forces()?;
         for (b, a) in before_t.iter().zip(&after_t) {
-            stats.max_change = stats.max_change.max(norm(sub(*a, *b)));
+            stats.max_change = stats.max_change.max(norm(&sub(a, b)));
         }
         Ok(stats)
     }
@@ -842,7 +843,7 @@ impl ContactPair {
                 for (f, tc) in force.force.iter_mut().zip(traction) {
                     *f += tc * w;
                 }
-                force.tangential += norm(traction) * w;
+                force.tangential += norm(&traction) * w;
             }
         }
         Ok((values, force))
@@ -866,18 +867,6 @@ fn still_inside(
     }
     let p = super::projection::project(surface.facet_type, &xm[..n], x, Some(xi));
     (p.converged && p.outside <= STICKY).then_some(p)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// Tangents `∂x/∂ξ_α` of a facet with nodes `x` at `xi`.
@@ -931,7 +920,7 @@ fn rebase_lambda(
         &facet_points(m, from, positions),
         super::projection::reference_centre(m.facet_type),
     );
-    let (m11, m12, m22) = (dot(t1, t1), dot(t1, t2), dot(t2, t2));
+    let (m11, m12, m22) = (dot(&t1, &t1), dot(&t1, &t2), dot(&t2, &t2));
     let det = m11 * m22 - m12 * m12;
     if det.abs() <= f64::MIN_POSITIVE {
         return [0.0; 2];
@@ -940,15 +929,16 @@ fn rebase_lambda(
     let c2 = (m11 * lambda[1] - m12 * lambda[0]) / det;
     let v = [0, 1, 2].map(|i| c1 * t1[i] + c2 * t2[i]);
     let [s1, s2] = facet_tangents(m, &facet_points(m, to, positions), xi);
-    [dot(v, s1), dot(v, s2)]
+    [dot(&v, &s1), dot(&v, &s2)]
 }
 
 /// Default search distance: generous enough that bodies approaching within a
 /// load step are linked (an open link costs only its evaluation).
 fn default_search_distance(mesh: &Mesh, master: &MasterSide, h: f64) -> f64 {
     let diag = match master {
-        MasterSide::Deformable(m) => search::points_bounding_box(&m.x_ref)
-            .map_or(0.0, |(lo, hi)| dot(sub(hi, lo), sub(hi, lo)).sqrt()),
+        MasterSide::Deformable(m) => {
+            search::points_bounding_box(&m.x_ref).map_or(0.0, |(lo, hi)| norm(&sub(&hi, &lo)))
+        }
         MasterSide::Rigid(_) => mesh.bounding_box().map_or(0.0, |b| b.diagonal()),
     };
     (10.0 * h).max(0.1 * diag)
@@ -997,7 +987,7 @@ mod tests {
         let p = point_on(&m, 0, &m.x_ref, xi);
         let xi1 = rebase_origin(&m, 0, xi, 1, [0.0, 0.0]);
         let q = point_on(&m, 1, &m.x_ref, xi1);
-        assert!(norm(sub(p, q)) < 1e-12, "{p:?} vs {q:?}");
+        assert!(norm(&sub(&p, &q)) < 1e-12, "{p:?} vs {q:?}");
         // And back.
         let back = rebase_origin(&m, 1, xi1, 0, [0.0, 0.0]);
         assert!((back[0] - xi[0]).abs() < 1e-12 && (back[1] - xi[1]).abs() < 1e-12);
@@ -1015,7 +1005,7 @@ mod tests {
         let vector = [0.7, -0.4, 0.0];
         let covariant = |facet: u32, xi: [f64; 2]| {
             let [t1, t2] = facet_tangents(&m, &facet_points(&m, facet, &x), xi);
-            [dot(vector, t1), dot(vector, t2)]
+            [dot(&vector, &t1), dot(&vector, &t2)]
         };
         let centre = crate::contact::projection::reference_centre(FacetType::Quad4);
         let on_0 = covariant(0, centre);

@@ -1,5 +1,6 @@
 //! Contact pairs as a scene states them: which surfaces meet, the penalty, and
 //! the Uzawa tolerances.
+use super::dual::{dot, norm, sub};
 use super::link::Master;
 
 /// A rigid analytic master surface (no DOFs), as given at load factor 0.
@@ -22,7 +23,7 @@ impl RigidSurface {
     /// Why the surface is unusable, if it is.
     pub fn validate(&self) -> Result<(), String> {
         let nonzero = |v: [f64; 3], key: &str| {
-            let n = norm(v);
+            let n = norm(&v);
             if n > 0.0 && n.is_finite() {
                 Ok(())
             } else {
@@ -98,14 +99,14 @@ impl RigidSurface {
         let d = self.distance(x);
         let n = match *self {
             RigidSurface::Plane { normal, .. } => normal,
-            RigidSurface::Sphere { centre, .. } => sub(x, centre),
+            RigidSurface::Sphere { centre, .. } => sub(&x, &centre),
             RigidSurface::Cylinder { point, axis, .. } => {
-                let v = sub(x, point);
-                let along = dot(v, axis);
-                sub(v, [along * axis[0], along * axis[1], along * axis[2]])
+                let v = sub(&x, &point);
+                let along = dot(&v, &axis);
+                sub(&v, &axis.map(|a| along * a))
             }
         };
-        let len = norm(n);
+        let len = norm(&n);
         if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return x;
         }
@@ -116,35 +117,23 @@ impl RigidSurface {
     /// for a surface placed by `moved`.
     pub fn distance(&self, x: [f64; 3]) -> f64 {
         match *self {
-            RigidSurface::Plane { point, normal } => dot(sub(x, point), normal),
-            RigidSurface::Sphere { centre, radius } => norm(sub(x, centre)) - radius,
+            RigidSurface::Plane { point, normal } => dot(&sub(&x, &point), &normal),
+            RigidSurface::Sphere { centre, radius } => norm(&sub(&x, &centre)) - radius,
             RigidSurface::Cylinder {
                 point,
                 axis,
                 radius,
             } => {
-                let d = sub(x, point);
-                let along = dot(d, axis);
-                norm(sub(d, [along * axis[0], along * axis[1], along * axis[2]])) - radius
+                let d = sub(&x, &point);
+                let along = dot(&d, &axis);
+                norm(&sub(&d, &axis.map(|a| along * a))) - radius
             }
         }
     }
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
 fn unit(v: [f64; 3]) -> [f64; 3] {
-    let n = norm(v);
+    let n = norm(&v);
     [v[0] / n, v[1] / n, v[2] / n]
 }
 

@@ -35,16 +35,18 @@ pub struct Inertia {
     pub a_u: f64,
     pub offset: Vector,
     pub work: Vector,
+    /// a(x), kept so every residual evaluation reuses one vector.
+    acceleration: Vector,
 }
 
 impl Inertia {
     /// Adds `M a(x)` to `out`.
     pub fn add_force(&mut self, x: &Vector, out: &mut Vector) -> Result<()> {
-        let mut acc = x.duplicate()?;
+        let acc = &mut self.acceleration;
         acc.copy_from(x)?;
         acc.scale(self.a_u)?;
         acc.axpy(1.0, &self.offset)?;
-        self.mass.mult(&acc, &mut self.work)?;
+        self.mass.mult(acc, &mut self.work)?;
         out.axpy(1.0, &self.work)?;
         Ok(())
     }
@@ -110,6 +112,7 @@ impl TimeStepper {
             a_u: 0.0,
             offset: u_n.duplicate()?,
             work: u_n.duplicate()?,
+            acceleration: u_n.duplicate()?,
             mass,
         };
         Ok((

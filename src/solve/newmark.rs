@@ -159,11 +159,9 @@ impl Coefficients {
         a_n: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
-        check_lengths(u, u_n, v_n, a_n, out)?;
-        for ((((o, &u), &u_n), &v_n), &a_n) in out.iter_mut().zip(u).zip(u_n).zip(v_n).zip(a_n) {
-            *o = self.acceleration(u, u_n, v_n, a_n);
-        }
-        Ok(())
+        entrywise(u, u_n, v_n, a_n, out, |u, u_n, v_n, a_n| {
+            self.acceleration(u, u_n, v_n, a_n)
+        })
     }
 
     /// [`Coefficients::velocity`] entry by entry into `out`.
@@ -175,12 +173,26 @@ impl Coefficients {
         a_n: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
-        check_lengths(u, u_n, v_n, a_n, out)?;
-        for ((((o, &u), &u_n), &v_n), &a_n) in out.iter_mut().zip(u).zip(u_n).zip(v_n).zip(a_n) {
-            *o = self.velocity(u, u_n, v_n, a_n);
-        }
-        Ok(())
+        entrywise(u, u_n, v_n, a_n, out, |u, u_n, v_n, a_n| {
+            self.velocity(u, u_n, v_n, a_n)
+        })
     }
+}
+
+/// `out[i] = f(u[i], u_n[i], v_n[i], a_n[i])` for slices of one length.
+fn entrywise(
+    u: &[f64],
+    u_n: &[f64],
+    v_n: &[f64],
+    a_n: &[f64],
+    out: &mut [f64],
+    f: impl Fn(f64, f64, f64, f64) -> f64,
+) -> Result<(), String> {
+    check_lengths(u, u_n, v_n, a_n, out)?;
+    for ((((o, &u), &u_n), &v_n), &a_n) in out.iter_mut().zip(u).zip(u_n).zip(v_n).zip(a_n) {
+        *o = f(u, u_n, v_n, a_n);
+    }
+    Ok(())
 }
 
 /// `zip` would silently stop at the shortest slice and leave the rest of
