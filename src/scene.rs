@@ -107,6 +107,15 @@ pub enum MeshSection {
     HertzCylinder(HertzCylinderSection),
     HertzSphere(HertzSphereSection),
     StackedBlocks(StackedSection),
+    Gmsh(GmshSection),
+}
+
+/// A Gmsh `.msh` 4.1 file; a relative `file` is relative to the scene
+/// file's directory (for a built-in scene, the crate's `scenes/`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GmshSection {
+    pub file: String,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, Default)]
@@ -476,7 +485,7 @@ impl Scene {
     /// Builds the mesh and checks every reference in the scene against it.
     pub fn build(&self, origin: &str) -> Result<Model> {
         let err = |m: String| Error::scene(origin, m);
-        let mut mesh = self.build_mesh()?;
+        let mut mesh = self.build_mesh(origin)?;
         mesh.validate()?;
         if let Some(d) = &self.distort {
             mesh = generate::perturb_interior(&mesh, d.fraction, d.seed)
@@ -681,7 +690,7 @@ impl Scene {
         })
     }
 
-    fn build_mesh(&self) -> Result<Mesh> {
+    fn build_mesh(&self, origin: &str) -> Result<Mesh> {
         let mesh = match &self.mesh {
             MeshSection::Box(b) => generate::graded_box(&BoxSpec {
                 body: b.body.clone(),
@@ -731,6 +740,21 @@ impl Scene {
                     cell_type: s.cell_type.map(CellType::from).unwrap_or(d.cell_type),
                     ..d
                 })?
+            }
+            MeshSection::Gmsh(g) => {
+                // `origin` is the scene's path, or names a built-in scene,
+                // which is compiled in from the crate's scenes/ directory.
+                let builtin = BUILTIN
+                    .iter()
+                    .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
+                let base = match Path::new(origin).parent() {
+                    _ if builtin => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+                    Some(dir) => dir.to_path_buf(),
+                    None => Default::default(),
+                };
+                crate::mesh::read_gmsh(&base.join(&g.file))
+                    .map_err(|e| Error::scene(origin, format!("[mesh] gmsh: {e}")))?
+                    .0
             }
         };
         Ok(mesh)

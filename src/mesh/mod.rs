@@ -13,6 +13,7 @@ mod cell;
 mod error;
 pub mod generate;
 mod geometry;
+mod gmsh;
 mod ops;
 mod tets;
 mod topology;
@@ -30,6 +31,7 @@ pub use generate::{
     HertzCylinderSpec, HertzSphereSpec, Perturbation, StackedSpec,
 };
 pub use geometry::BoundingBox;
+pub use gmsh::{parse_gmsh, read_gmsh, GmshError, GmshErrorKind, GmshReport, Location};
 pub use topology::Csr;
 
 /// One face of one cell; its orientation is the cell's outward one as given
