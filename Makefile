@@ -22,7 +22,7 @@ build: deps
 
 demo: build
 	@mkdir -p out
-	$(MPIRUN) -n $(NP) target/release/contactlink run $(or $(SCENE),hertz-cylinder) -o out/demo.h5
+	$(MPIRUN) -n $(NP) target/release/contactlink run $(or $(SCENE),hertz-cylinder) -v -o out/demo.h5
 	@echo "demo: results in out/demo.h5 (open out/demo.xmf in ParaView; h5ls -r out/demo.h5 lists it)"
 
 # Every test: unit, verification and end-to-end (serial and mpirun -n 1/2/3),
@@ -79,11 +79,11 @@ scaling: build
 hertz-study: build
 	@for args in "--set mesh.fine_size=0.2" "" "--set mesh.level=1 --set solver.direct_max_dofs=200000"; do \
 	  echo "== hertz-cylinder $$args"; \
-	  $(MPIRUN) -n 2 target/release/contactlink run hertz-cylinder -q $$args | grep -E "Hertz|done" ; \
+	  $(MPIRUN) -n 2 target/release/contactlink run hertz-cylinder $$args | grep -E "Hertz|done" ; \
 	done
 	@for args in "--set mesh.fine_size=0.5" ""; do \
 	  echo "== hertz-sphere $$args"; \
-	  $(MPIRUN) -n 2 target/release/contactlink run hertz-sphere -q $$args | grep -E "Hertz|done" ; \
+	  $(MPIRUN) -n 2 target/release/contactlink run hertz-sphere $$args | grep -E "Hertz|done" ; \
 	done
 
 # Ironing (Puso & Laursen 2004 style): contact force history as CSV and PNG.

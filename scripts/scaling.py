@@ -27,7 +27,7 @@ def run(np_, args):
                OMPI_MCA_btl_vader_single_copy_mechanism="none",
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           "target/release/contactlink", "run", "hertz-cylinder", "-q",
+           "target/release/contactlink", "run", "hertz-cylinder",
            "--set", "solver.direct_max_dofs=200000"] + args
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     out = p.stdout + p.stderr

@@ -35,7 +35,7 @@ HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
 
 def run_once(scene, np_, args, h5):
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           "target/release/contactlink", "run", scene, "-q", "-o", h5] + args
+           "target/release/contactlink", "run", scene, "-o", h5] + args
     env = dict(os.environ, OMPI_MCA_btl="self,vader",
                OMPI_MCA_btl_vader_single_copy_mechanism="none",
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")

@@ -14,6 +14,7 @@
 //! the only places that touch C libraries directly.
 pub mod amplitude;
 pub mod assembly;
+pub mod check;
 pub mod contact;
 pub mod dofs;
 pub mod error;
@@ -23,6 +24,7 @@ pub mod output;
 pub mod partition;
 pub mod petsc;
 pub mod pipeline;
+pub mod results;
 pub mod runtime;
 pub mod scene;
 pub mod solve;

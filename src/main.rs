@@ -1,8 +1,9 @@
 //! The `contactlink` command line: run a scene, list the built-in scenes,
-//! check a scene without solving.
+//! check a scene without solving, summarise or plot a result file.
 use contactlink::pipeline::{self, RunOptions};
 use contactlink::runtime::Runtime;
 use contactlink::scene::BUILTIN;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -10,8 +11,10 @@ const USAGE: &str = "\
 contactlink — parallel 3D contact mechanics on PETSc
 
 usage:
-  contactlink run SCENE [-o OUT.h5] [--set key=value]... [-q] [PETSc options]
+  contactlink run SCENE [-o OUT.h5] [--set key=value]... [-v | -q] [PETSc options]
   contactlink check SCENE [--set key=value]...
+  contactlink summary OUT.h5 [--csv]
+  contactlink plot OUT.h5 [-o profile.png] [--step N]
   contactlink scenes
   contactlink help
 
@@ -20,6 +23,16 @@ Run under MPI with e.g. `mpirun -n 2 contactlink run block-compress -o out.h5`.
 Any other option starting with '-' goes to PETSc (e.g. -ksp_type gmres -snes_monitor);
 PETSC_OPTIONS in the environment is read too. Options given here override the scene's
 [solver] petsc_options and the program's defaults.
+
+run prints one line per load step when its output goes to a terminal (under mpirun:
+when mpirun's does) or with -v (--verbose),
+then a summary (`done:`, time per phase, Hertz, `output:`); -q (--quiet) prints
+nothing on success.
+summary prints one row per step of a result file: load, iterations, wall time and per
+contact pair the force, normal force, contact area, peak pressure and active points
+(--csv: the same as CSV).
+plot draws a Hertz scene's contact pressure against the closed form to a PNG
+(default: OUT.png next to OUT.h5; --step N: that step instead of the last).
 ";
 
 /// Parsed command line.
@@ -28,6 +41,12 @@ struct Cli {
     scene: Option<String>,
     run: RunOptions,
     petsc: Vec<String>,
+    /// -v/--verbose: per-step lines even when stdout is not a terminal.
+    verbose: bool,
+    /// summary --csv.
+    csv: bool,
+    /// plot --step N.
+    step: Option<usize>,
 }
 
 fn parse_args(args: &[String]) -> Result<Cli, String> {
@@ -36,11 +55,11 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
     let mut cli = Cli {
         command,
         scene: None,
-        run: RunOptions {
-            echo: true,
-            ..Default::default()
-        },
+        run: RunOptions::default(),
         petsc: Vec::new(),
+        verbose: false,
+        csv: false,
+        step: None,
     };
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -55,7 +74,16 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
                 }
                 cli.run.overrides.push(kv.clone());
             }
-            "-q" | "--quiet" => cli.run.echo = false,
+            "-q" | "--quiet" => cli.run.quiet = true,
+            "-v" | "--verbose" => cli.verbose = true,
+            "--csv" => cli.csv = true,
+            "--step" => {
+                let n = it.next().ok_or("--step needs a step number")?;
+                let n = n
+                    .parse()
+                    .map_err(|_| format!("--step {n}: expected a step number"))?;
+                cli.step = Some(n);
+            }
             s if s.starts_with('-') && s.len() > 1 => {
                 cli.petsc.push(s.to_owned());
                 if let Some(v) = it.peek() {
@@ -72,6 +100,12 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
             }
         }
     }
+    if cli.run.quiet && cli.verbose {
+        return Err("-q and -v contradict each other".into());
+    }
+    // Per-step lines are for a person watching; piped into a file or a
+    // script they are noise (scripts parse the summary lines).
+    cli.run.echo = !cli.run.quiet && (cli.verbose || output_reaches_terminal());
     Ok(cli)
 }
 
@@ -103,8 +137,29 @@ fn main() -> ExitCode {
             Some(scene) => run(scene, &cli),
             None => usage_error("run needs a SCENE"),
         },
+        "summary" | "plot" => match (cli.scene.as_deref(), cli.petsc.first()) {
+            (_, Some(opt)) => usage_error(&format!("{}: unknown option '{opt}'", cli.command)),
+            (Some(file), None) if cli.command == "summary" => summary(file, cli.csv),
+            (Some(file), None) => plot(file, &cli),
+            (None, None) => usage_error(&format!("{} needs a result file OUT.h5", cli.command)),
+        },
         other => usage_error(&format!("unknown command '{other}'")),
     }
+}
+
+/// Whether what this process prints ends up on a terminal. Under Open MPI's
+/// mpirun a rank's stdout is a pty the launcher creates even when mpirun's
+/// own output goes to a pipe or file, so there the launcher's (the parent
+/// process's) stdout decides; where that cannot be read, no.
+fn output_reaches_terminal() -> bool {
+    if std::env::var_os("OMPI_COMM_WORLD_SIZE").is_none() {
+        return std::io::stdout().is_terminal();
+    }
+    let parent = std::os::unix::process::parent_id();
+    std::fs::read_link(format!("/proc/{parent}/fd/1")).is_ok_and(|target| {
+        let t = target.to_string_lossy();
+        t.starts_with("/dev/pts/") || t.starts_with("/dev/tty")
+    })
 }
 
 fn usage_error(msg: &str) -> ExitCode {
@@ -113,67 +168,9 @@ fn usage_error(msg: &str) -> ExitCode {
 }
 
 fn check(scene: &str, overrides: &[String]) -> ExitCode {
-    match pipeline::load_model(scene, overrides) {
-        Ok((model, out)) => {
-            let m = &model.mesh;
-            println!("{}", model.name);
-            println!(
-                "  cells {} ({}), nodes {}, DOFs {}",
-                m.num_cells(),
-                m.cell_type.name(),
-                m.num_nodes(),
-                3 * m.num_nodes()
-            );
-            for (b, mat) in m.bodies.iter().zip(&model.materials) {
-                println!("  body {b}: {mat:?}");
-            }
-            println!(
-                "  dirichlet sets: {}",
-                model
-                    .dirichlet
-                    .iter()
-                    .map(|d| d.set.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-            println!(
-                "  loads: {}",
-                model
-                    .facet_loads
-                    .iter()
-                    .map(|(s, l, _)| format!("{s} {l:?}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-            for p in &model.contact {
-                let friction = match p.active_friction() {
-                    Some(f) => format!(", Coulomb friction μ = {}", f.mu),
-                    None => ", frictionless".into(),
-                };
-                println!(
-                    "  contact {}: slave {} master {:?}{friction}",
-                    p.name, p.slave, p.master
-                );
-            }
-            match &model.dynamics {
-                Some(d) => println!(
-                    "  dynamics: Newmark β = {}, γ = {}, Δt = {}, t_end = {}, densities {:?}",
-                    d.newmark.beta,
-                    d.newmark.gamma,
-                    d.time_step,
-                    d.time_step * model.steps as f64,
-                    d.density
-                ),
-                None => println!("  quasi-static (no mass matrix)"),
-            }
-            println!(
-                "  steps {}, output {}",
-                model.steps,
-                out.unwrap_or_else(|| "(none)".into())
-            );
-            for w in model.warnings() {
-                println!("  warning: {w}");
-            }
+    match contactlink::check::load(scene, overrides) {
+        Ok(checked) => {
+            print!("{}", contactlink::check::summary(&checked));
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -195,8 +192,9 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     let result = pipeline::run_scene(&rt, scene, &cli.run);
     let code = match result {
         Ok(summary) => {
-            // -q quiets the per-step lines; the summary always prints.
-            if rank == 0 {
+            // The summary prints unless -q (scripts parse its `done:` and
+            // `Hertz:` lines); the per-step lines were decided in parse_args.
+            if rank == 0 && !cli.run.quiet {
                 let r = &summary.report;
                 let newton: usize = r.steps.iter().map(|s| s.newton_iterations).sum();
                 println!(
@@ -269,4 +267,51 @@ fn phase_summary(t: &contactlink::solve::phases::PhaseTimes, wall: f64) -> Strin
         "  time per phase (largest over ranks): {}",
         parts.join(", ")
     )
+}
+
+/// `contactlink summary OUT.h5 [--csv]`.
+fn summary(file: &str, csv: bool) -> ExitCode {
+    use contactlink::results::summary;
+    let path = std::path::Path::new(file);
+    match summary::summarize(path) {
+        Ok(rows) if csv => {
+            print!("{}", summary::csv(&rows));
+            ExitCode::SUCCESS
+        }
+        Ok(rows) => {
+            print!("{}", summary::table(path, &rows));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("contactlink: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `contactlink plot OUT.h5 [-o profile.png] [--step N]`.
+fn plot(file: &str, cli: &Cli) -> ExitCode {
+    let path = std::path::Path::new(file);
+    let output = cli
+        .run
+        .output
+        .clone()
+        .unwrap_or_else(|| path.with_extension("png"));
+    match contactlink::results::plot::plot(path, &output, cli.step) {
+        Ok(r) => {
+            let errors = r.comparison.map_or(String::new(), |c| {
+                format!(
+                    ": p0 {:+.3} %, half-width/radius {:+.3} % against the closed form",
+                    100.0 * c.p0_error(),
+                    100.0 * c.width_error()
+                )
+            });
+            println!("plot: step {} → {}{errors}", r.step, r.output.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("contactlink: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

@@ -9,7 +9,7 @@ use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
 use crate::solve::phases::Phase;
 use crate::solve::{Model, NaturalOrder, PairFields, RunReport, Simulation, StepReport, StepSink};
-use crate::verify::{HertzCheck, HertzComparison};
+use crate::verify::{HertzCheck, HertzComparison, HertzKind};
 use mpi::traits::{Communicator, CommunicatorCollectives};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -21,8 +21,29 @@ pub struct RunOptions {
     pub output: Option<PathBuf>,
     /// `--set key=value` overrides of scene keys.
     pub overrides: Vec<String>,
-    /// Print one line per step on rank 0.
+    /// Print one line per step (and per cutback) on rank 0.
     pub echo: bool,
+    /// Print nothing on success, not even the model's header line.
+    pub quiet: bool,
+}
+
+/// Where a run came from, stored in the result file (`/scene`,
+/// `/scene_overrides`) so a result can be traced to its input.
+#[derive(Debug, Clone, Default)]
+pub struct Provenance {
+    /// The scene's TOML text as loaded (before overrides).
+    pub scene: String,
+    /// The `--set key=value` overrides, in order.
+    pub overrides: Vec<String>,
+}
+
+/// What a run prints on rank 0.
+#[derive(Debug, Clone, Copy)]
+struct Printing {
+    /// The one-line model summary before the first step.
+    header: bool,
+    /// One line per step and per cutback.
+    steps: bool,
 }
 
 /// What a run produced.
@@ -39,16 +60,30 @@ pub struct RunSummary {
 /// Loads a scene by built-in name or path and builds its model.
 pub fn load_model(name_or_path: &str, overrides: &[String]) -> Result<(Model, Option<String>)> {
     let src = SceneSource::resolve(name_or_path)?;
-    let parsed = scene::parse(&src, overrides)?;
+    build_model(&src, overrides)
+}
+
+/// Builds the model of a resolved scene (and returns its [output] path).
+fn build_model(src: &SceneSource, overrides: &[String]) -> Result<(Model, Option<String>)> {
+    let parsed = scene::parse(src, overrides)?;
     let model = parsed.build(&src.origin)?;
     Ok((model, parsed.output_path().map(str::to_owned)))
 }
 
 /// Runs a scene on all ranks of the runtime.
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
-    let (model, scene_out) = load_model(name_or_path, &opts.overrides)?;
+    let src = SceneSource::resolve(name_or_path)?;
+    let (model, scene_out) = build_model(&src, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
-    run_model(rt, &model, output.as_deref(), opts.echo)
+    let provenance = Provenance {
+        scene: src.text,
+        overrides: opts.overrides.clone(),
+    };
+    let printing = Printing {
+        header: !opts.quiet,
+        steps: opts.echo && !opts.quiet,
+    };
+    run_model_with(rt, &model, output.as_deref(), printing, Some(&provenance))
 }
 
 /// Runs an already built model, writing `output` when given.
@@ -58,13 +93,33 @@ pub fn run_model(
     output: Option<&Path>,
     echo: bool,
 ) -> Result<RunSummary> {
+    let printing = Printing {
+        header: echo,
+        steps: echo,
+    };
+    run_model_with(rt, model, output, printing, None)
+}
+
+fn run_model_with(
+    rt: &Runtime,
+    model: &Model,
+    output: Option<&Path>,
+    printing: Printing,
+    provenance: Option<&Provenance>,
+) -> Result<RunSummary> {
+    let echo = printing.steps;
     if rt.rank() == 0 {
         for w in model.warnings() {
             eprintln!("contactlink: warning: {w}");
         }
     }
+    if let Some(path) = output {
+        // Before the partition and any solve: an unwritable result path
+        // would otherwise show up only after set-up.
+        check_output_writable(rt, path)?;
+    }
     let mut sim = Simulation::setup(rt, model)?;
-    if echo && rt.rank() == 0 {
+    if printing.header && rt.rank() == 0 {
         println!(
             "{}: {} cells, {} nodes, {} DOFs, {} rank(s), {} load step(s)",
             model.name,
@@ -86,10 +141,12 @@ pub fn run_model(
                 }
             }
             rt.world().barrier();
-            let file = create_result_file(rt, &sim, path)?;
+            let file = create_result_file(rt, &sim, path, provenance)?;
             let history = HistoryCsv::create(rt, &path.with_extension("csv"))?;
-            let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut hertz);
-            let mut sink = Tee(history, &mut sink);
+            // HDF5 first: its step is flushed before the CSV row appears, so
+            // a run killed at any moment has every step the CSV lists.
+            let mut sink = Tee(history, &mut hertz);
+            let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut sink);
             sim.run(rt, &mut sink, echo)?
         }
         None => sim.run(rt, &mut hertz, echo)?,
@@ -385,6 +442,7 @@ impl Hdf5Sink {
             ("pressure", v.pressure.clone()),
             ("gap", v.gap.clone()),
             ("lambda_n", v.lambda.clone()),
+            ("weight", v.weight.clone()),
         ];
         // Decided by the pair, not by this rank's points: a rank may own no
         // slave point, and every rank must write the same datasets.
@@ -488,7 +546,12 @@ impl StepSink for Hdf5Sink {
     }
 }
 
-fn create_result_file(rt: &Runtime, sim: &Simulation, path: &Path) -> Result<ResultFile> {
+fn create_result_file(
+    rt: &Runtime,
+    sim: &Simulation,
+    path: &Path,
+    provenance: Option<&Provenance>,
+) -> Result<ResultFile> {
     let model = sim.model();
     let mesh = &model.mesh;
     let (rank, size) = (rt.rank(), rt.size());
@@ -541,7 +604,45 @@ fn create_result_file(rt: &Runtime, sim: &Simulation, path: &Path) -> Result<Res
         node_sets: &mesh.node_sets,
         facet_sets: &facet_sets,
     };
-    Ok(ResultFile::create(&rt.world(), path, &header)?)
+    let mut file = ResultFile::create(&rt.world(), path, &header)?;
+    if let Some(p) = provenance {
+        let overrides = p.overrides.join("\n");
+        file.write_attributes(
+            "/",
+            &[("scene", &p.scene), ("scene_overrides", &overrides)],
+            &[],
+        )?;
+    }
+    if !model.contact.is_empty() {
+        // Pair name → slave facet set: lets a reader pick a pair's nodes out
+        // of the nodal contact_pressure field (`contactlink summary`).
+        let slaves: Vec<(&str, &str)> = model
+            .contact
+            .iter()
+            .map(|p| (p.name.as_str(), p.slave.as_str()))
+            .collect();
+        file.write_attributes("/contact_pairs", &slaves, &[])?;
+    }
+    if let Some(h) = &model.hertz {
+        write_hertz_setup(&mut file, h)?;
+    }
+    Ok(file)
+}
+
+/// `/hertz`: what `contactlink plot` needs to draw the closed-form profile
+/// (the load comes from each step's contact force).
+fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
+    let (kind, thickness) = match h.kind {
+        HertzKind::Line { thickness } => ("line", Some(thickness)),
+        HertzKind::Point => ("point", None),
+    };
+    let mut numbers = vec![
+        ("radius", h.radius),
+        ("effective_modulus", h.effective_modulus),
+    ];
+    numbers.extend(thickness.map(|t| ("thickness", t)));
+    file.write_attributes("/hertz", &[("kind", kind), ("pair", &h.pair)], &numbers)?;
+    Ok(())
 }
 
 fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
@@ -563,4 +664,58 @@ fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
         );
     }
     Ok(out)
+}
+
+/// Collective: fails on every rank with rank 0's message, naming the path,
+/// when rank 0 cannot create the result file (or its directory). Only rank 0
+/// tries, as only one process should create directories and probe files.
+fn check_output_writable(rt: &Runtime, path: &Path) -> Result<()> {
+    use mpi::traits::Root;
+    let mut message = match rt.rank() {
+        0 => probe_writable(path).err().unwrap_or_default().into_bytes(),
+        _ => Vec::new(),
+    };
+    let world = rt.world();
+    let root = world.process_at_rank(0);
+    let mut len = message.len() as u64;
+    root.broadcast_into(&mut len);
+    message.resize(len as usize, 0);
+    root.broadcast_into(&mut message[..]);
+    if message.is_empty() {
+        return Ok(());
+    }
+    let message = String::from_utf8_lossy(&message).into_owned();
+    Err(std::io::Error::other(message).into())
+}
+
+/// Whether `path` can be written: its directory is created if missing, an
+/// existing file is opened for writing (not truncated), a new one is created
+/// and removed again, so a failed run leaves no empty result file behind.
+fn probe_writable(path: &Path) -> std::result::Result<(), String> {
+    let fail = |e: std::io::Error| format!("cannot write the result file {}: {e}", path.display());
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            format!(
+                "cannot write the result file {}: cannot create its directory {}: {e}",
+                path.display(),
+                dir.display()
+            )
+        })?;
+    }
+    if path.is_dir() {
+        return Err(format!("the result file {} is a directory", path.display()));
+    }
+    if path.exists() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map_err(fail)?;
+        return Ok(());
+    }
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+        .map_err(fail)?;
+    std::fs::remove_file(path).map_err(fail)
 }

@@ -18,6 +18,9 @@ use crate::verify::{HertzCheck, HertzKind};
 use serde::Deserialize;
 use std::path::Path;
 
+mod lines;
+pub use lines::{KeyLines, Origin, Seg};
+
 /// The scenes compiled into the binary: (name, one-line description, TOML).
 pub const BUILTIN: &[(&str, &str, &str)] = &[
     (
@@ -98,6 +101,9 @@ pub struct Scene {
     pub solver: SolverSection,
     #[serde(default)]
     pub output: OutputSection,
+    /// The text and overrides the scene came from, to give errors a line.
+    #[serde(skip)]
+    pub lines: KeyLines,
 }
 
 #[derive(Debug, Deserialize)]
@@ -411,18 +417,57 @@ impl SceneSource {
 
 /// Parses a scene, applying `overrides` ("a.b=value", TOML values) first.
 pub fn parse(src: &SceneSource, overrides: &[String]) -> Result<Scene> {
+    let mut scene = parse_values(src, overrides)?;
+    scene.lines = KeyLines::new(&src.text, overrides);
+    Ok(scene)
+}
+
+fn parse_values(src: &SceneSource, overrides: &[String]) -> Result<Scene> {
     if overrides.is_empty() {
         // Straight from the text, so errors carry the line and column.
-        return toml::from_str(&src.text).map_err(|e| Error::scene(&src.origin, e.to_string()));
+        return toml::from_str(&src.text).map_err(|e| toml_error(src, &e));
     }
-    let mut doc: toml::Table =
-        toml::from_str(&src.text).map_err(|e| Error::scene(&src.origin, e.to_string()))?;
+    let mut doc: toml::Table = toml::from_str(&src.text).map_err(|e| toml_error(src, &e))?;
     for o in overrides {
         apply_override(&mut doc, o)
             .map_err(|m| Error::scene(&src.origin, format!("--set {o}: {m}")))?;
     }
-    Scene::deserialize(toml::Value::Table(doc))
-        .map_err(|e| Error::scene(&src.origin, e.to_string()))
+    Scene::deserialize(toml::Value::Table(doc)).map_err(|e| {
+        // Overridden values carry no spans. An error the file has on its own
+        // is located in the file; any other came with the overrides.
+        match toml::from_str::<Scene>(&src.text) {
+            Err(own) if own.message() == e.message() => toml_error(src, &own),
+            _ => {
+                let given: Vec<String> = overrides.iter().map(|o| format!("--set {o}")).collect();
+                let mut err = toml_error(src, &e);
+                if let Error::Scene { message, .. } = &mut err {
+                    *message = format!("{}: {message}", given.join(" "));
+                }
+                err
+            }
+        }
+    })
+}
+
+/// A syntax or schema error from toml/serde as one line, `origin:LINE:
+/// message` (toml's own rendering spans several lines with a code excerpt).
+fn toml_error(src: &SceneSource, e: &toml::de::Error) -> Error {
+    let message = match e.message().trim() {
+        "missing field `mesh`" => {
+            "no [mesh] section (the mesh generator and its parameters)".to_owned()
+        }
+        "missing field `body`" => {
+            "no [[body]] section (one per mesh body, with its material)".to_owned()
+        }
+        m => m.lines().map(str::trim).collect::<Vec<_>>().join("; "),
+    };
+    match e.span() {
+        Some(span) => Error::scene(
+            with_line(&src.origin, lines::line_of(&src.text, span.start)),
+            message,
+        ),
+        None => Error::scene(&src.origin, message),
+    }
 }
 
 fn apply_override(doc: &mut toml::Table, assignment: &str) -> std::result::Result<(), String> {
@@ -476,7 +521,70 @@ fn apply_override(doc: &mut toml::Table, assignment: &str) -> std::result::Resul
     Err("empty key".into())
 }
 
+/// A semantic scene error and the key it is about (an absolute key path;
+/// empty: the section the caller names), so the message can give its line.
+#[derive(Debug)]
+struct Bad {
+    path: Vec<Seg>,
+    message: String,
+}
+
+impl Bad {
+    fn at(path: &[Seg], message: impl Into<String>) -> Self {
+        Bad {
+            path: path.to_vec(),
+            message: message.into(),
+        }
+    }
+}
+
+impl From<String> for Bad {
+    fn from(message: String) -> Self {
+        Bad {
+            path: Vec::new(),
+            message,
+        }
+    }
+}
+
+impl From<&str> for Bad {
+    fn from(message: &str) -> Self {
+        message.to_owned().into()
+    }
+}
+
+type Checked<T> = std::result::Result<T, Bad>;
+
+/// `origin` with a line: `path:14` for a file, `..., line 14` for a built-in.
+fn with_line(origin: &str, line: usize) -> String {
+    if origin.starts_with("built-in") {
+        format!("{origin}, line {line}")
+    } else {
+        format!("{origin}:{line}")
+    }
+}
+
 impl Scene {
+    /// An error about the key at `path`: names its line in the scene file,
+    /// or the `--set` override that supplied it.
+    pub fn error_at(&self, origin: &str, path: &[Seg], message: impl Into<String>) -> Error {
+        let message = message.into();
+        match self.lines.locate(path) {
+            Origin::Line(n) => Error::scene(with_line(origin, n), message),
+            Origin::Override(o) => Error::scene(origin, format!("--set {o}: {message}")),
+            Origin::Unknown => Error::scene(origin, message),
+        }
+    }
+
+    /// Turns a [`Bad`] into an error at its key, or at `section` when it
+    /// names none.
+    fn located<'a>(&'a self, origin: &'a str, section: &'a [Seg]) -> impl Fn(Bad) -> Error + 'a {
+        move |b| {
+            let path = if b.path.is_empty() { section } else { &b.path };
+            self.error_at(origin, path, b.message)
+        }
+    }
+
     /// The output path the scene asks for, if any.
     pub fn output_path(&self) -> Option<&str> {
         self.output.path.as_deref()
@@ -484,24 +592,38 @@ impl Scene {
 
     /// Builds the mesh and checks every reference in the scene against it.
     pub fn build(&self, origin: &str) -> Result<Model> {
-        let err = |m: String| Error::scene(origin, m);
-        let mut mesh = self.build_mesh(origin)?;
-        mesh.validate()?;
+        Ok(self.build_with_report(origin)?.0)
+    }
+
+    /// [`Scene::build`], and what reading the mesh found (for `check`).
+    pub fn build_with_report(&self, origin: &str) -> Result<(Model, MeshReport)> {
+        use Seg::{Index, Key};
+        let (mut mesh, report) = self.build_mesh(origin)?;
+        mesh.validate()
+            .map_err(|e| self.error_at(origin, &[Key("mesh")], format!("[mesh]: {e}")))?;
         if let Some(d) = &self.distort {
-            mesh = generate::perturb_interior(&mesh, d.fraction, d.seed)
-                .map_err(|e| err(format!("[distort]: {e}")))?;
+            mesh = generate::perturb_interior(&mesh, d.fraction, d.seed).map_err(|e| {
+                self.error_at(
+                    origin,
+                    &[Key("distort"), Key("fraction")],
+                    format!("[distort]: {e}"),
+                )
+            })?;
         }
         let mut materials = Vec::with_capacity(mesh.bodies.len());
         for body in &mesh.bodies {
-            let section = self
-                .bodies
-                .iter()
-                .find(|b| &b.name == body)
-                .ok_or_else(|| {
-                    err(format!(
-                        "the mesh has a body '{body}' but no [[body]] gives its material"
-                    ))
-                })?;
+            let Some(i) = self.bodies.iter().position(|b| &b.name == body) else {
+                let given: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+                return Err(self.error_at(
+                    origin,
+                    &[Key("mesh")],
+                    format!(
+                        "the mesh has a body '{body}' but no [[body]] gives its material (the scene's [[body]] names: {})",
+                        given.join(", ")
+                    ),
+                ));
+            };
+            let section = &self.bodies[i];
             let m = match section.material {
                 MaterialName::LinearElastic => Material::LinearElastic {
                     youngs: section.youngs,
@@ -512,52 +634,80 @@ impl Scene {
                     poisson: section.poisson,
                 },
             };
-            m.validate()
-                .map_err(|e| err(format!("[[body]] '{}': {e}", section.name)))?;
+            m.validate().map_err(|e| {
+                // validate() checks youngs first, so any other error is about ν.
+                let (key, value) = match e {
+                    crate::fem::MaterialError::InvalidYoungs { youngs } => ("youngs", youngs),
+                    _ => ("poisson", section.poisson),
+                };
+                self.error_at(
+                    origin,
+                    &[Key("body"), Index(i), Key(key)],
+                    format!("[[body]] '{}' {key} = {value}: {e}", section.name),
+                )
+            })?;
             materials.push(m);
         }
-        for b in &self.bodies {
+        for (i, b) in self.bodies.iter().enumerate() {
             if !mesh.bodies.contains(&b.name) {
-                return Err(err(format!(
-                    "[[body]] '{}' is not a body of the mesh (bodies: {})",
-                    b.name,
-                    mesh.bodies.join(", ")
-                )));
+                return Err(self.error_at(
+                    origin,
+                    &[Key("body"), Index(i), Key("name")],
+                    format!(
+                        "[[body]] '{}' is not a body of the mesh (bodies: {})",
+                        b.name,
+                        mesh.bodies.join(", ")
+                    ),
+                ));
             }
         }
         let dirichlet = self
             .dirichlet
             .iter()
-            .map(|d| dirichlet_spec(&mesh, d).map_err(&err))
+            .enumerate()
+            .map(|(i, d)| {
+                dirichlet_spec(&mesh, d, i)
+                    .map_err(self.located(origin, &[Key("dirichlet"), Index(i)]))
+            })
             .collect::<Result<Vec<_>>>()?;
         let mut facet_loads = Vec::new();
-        for p in &self.pressure {
-            check_facet_set(&mesh, &p.set, "[[pressure]]").map_err(&err)?;
-            check_finite(p.value, "[[pressure]] value").map_err(&err)?;
-            let a = amplitude(&p.amplitude, &format!("[[pressure]] '{}'", p.set)).map_err(&err)?;
+        for (i, p) in self.pressure.iter().enumerate() {
+            let at = |key| [Key("pressure"), Index(i), Key(key)];
+            let here = |key, m: String| self.error_at(origin, &at(key), m);
+            check_facet_set(&mesh, &p.set, "[[pressure]]").map_err(|m| here("set", m))?;
+            check_finite(p.value, "[[pressure]] value").map_err(|m| here("value", m))?;
+            let a = amplitude(&p.amplitude, &format!("[[pressure]] '{}'", p.set))
+                .map_err(|m| here("amplitude", m))?;
             facet_loads.push((p.set.clone(), FacetLoad::Pressure(p.value), a));
         }
-        for t in &self.traction {
-            check_facet_set(&mesh, &t.set, "[[traction]]").map_err(&err)?;
+        for (i, t) in self.traction.iter().enumerate() {
+            let at = |key| [Key("traction"), Index(i), Key(key)];
+            let here = |key, m: String| self.error_at(origin, &at(key), m);
+            check_facet_set(&mesh, &t.set, "[[traction]]").map_err(|m| here("set", m))?;
             t.vector
                 .iter()
                 .try_for_each(|&v| check_finite(v, "[[traction]] vector"))
-                .map_err(&err)?;
-            let a = amplitude(&t.amplitude, &format!("[[traction]] '{}'", t.set)).map_err(&err)?;
+                .map_err(|m| here("vector", m))?;
+            let a = amplitude(&t.amplitude, &format!("[[traction]] '{}'", t.set))
+                .map_err(|m| here("amplitude", m))?;
             facet_loads.push((t.set.clone(), FacetLoad::Traction(t.vector), a));
         }
         let mut body_force = vec![[0.0; 3]; mesh.bodies.len()];
-        for bf in &self.body_force {
+        for (j, bf) in self.body_force.iter().enumerate() {
             let i = mesh
                 .bodies
                 .iter()
                 .position(|b| b == &bf.body)
                 .ok_or_else(|| {
-                    err(format!(
-                        "[[body_force]] body '{}' does not exist (bodies: {})",
-                        bf.body,
-                        mesh.bodies.join(", ")
-                    ))
+                    self.error_at(
+                        origin,
+                        &[Key("body_force"), Index(j), Key("body")],
+                        format!(
+                            "[[body_force]] body '{}' does not exist (bodies: {})",
+                            bf.body,
+                            mesh.bodies.join(", ")
+                        ),
+                    )
                 })?;
             for (acc, v) in body_force[i].iter_mut().zip(bf.vector) {
                 *acc += v;
@@ -567,23 +717,66 @@ impl Scene {
             .contact
             .iter()
             .enumerate()
-            .map(|(i, c)| contact_spec(&mesh, c, i).map_err(&err))
+            .map(|(i, c)| {
+                contact_spec(&mesh, c, i).map_err(self.located(origin, &[Key("contact"), Index(i)]))
+            })
             .collect::<Result<Vec<_>>>()?;
         let mut names: Vec<&str> = contact.iter().map(|c| c.name.as_str()).collect();
         names.sort_unstable();
         if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-            return Err(err(format!("two [[contact]] pairs are named '{}'", w[0])));
+            let second = self
+                .contact
+                .iter()
+                .enumerate()
+                .filter(|(i, c)| c.name.clone().unwrap_or_else(|| format!("pair{i}")) == w[0]);
+            let i = second.map(|(i, _)| i).nth(1).unwrap_or(0);
+            return Err(self.error_at(
+                origin,
+                &[Key("contact"), Index(i), Key("name")],
+                format!("two [[contact]] pairs are named '{}'", w[0]),
+            ));
         }
         let hertz = match &self.hertz {
-            Some(h) => Some(hertz_check(&mesh, &materials, &contact, h).map_err(&err)?),
+            Some(h) => Some(
+                hertz_check(&mesh, &materials, &contact, h)
+                    .map_err(|m| self.error_at(origin, &[Key("hertz")], m))?,
+            ),
             None => None,
         };
         if self.steps.count == 0 {
-            return Err(err("[steps] count must be at least 1".into()));
+            return Err(self.error_at(
+                origin,
+                &[Key("steps"), Key("count")],
+                "[steps] count must be at least 1",
+            ));
         }
-        let solver = self.solver_settings().map_err(&err)?;
-        let dynamics = self.dynamics_spec(&mesh).map_err(&err)?;
-        Ok(Model {
+        let solver = self
+            .solver_settings()
+            .map_err(|m| self.error_at(origin, &[Key("solver")], m))?;
+        let dynamics = self
+            .dynamics_spec(&mesh)
+            .map_err(self.located(origin, &[Key("dynamics")]))?;
+        // A static body that nothing holds has rigid-body modes: the linear
+        // solver would fail (or return garbage) in the first step. Contact
+        // may hold a body, and a mass matrix makes any body's operator regular.
+        if dynamics.is_none() {
+            if let Some(b) = unheld_body(&mesh, &dirichlet, &contact) {
+                let name = &mesh.bodies[b];
+                let i = self
+                    .bodies
+                    .iter()
+                    .position(|s| &s.name == name)
+                    .unwrap_or(0);
+                return Err(self.error_at(
+                    origin,
+                    &[Key("body"), Index(i), Key("name")],
+                    format!(
+                        "body '{name}' has no [[dirichlet]] condition and no contact pair: nothing holds it, so its stiffness is singular (fix some of its nodes, give it a contact partner, or add [dynamics])"
+                    ),
+                ));
+            }
+        }
+        let model = Model {
             name: self.title.clone().unwrap_or_else(|| origin.to_owned()),
             mesh,
             materials,
@@ -596,37 +789,49 @@ impl Scene {
             steps: self.steps.count,
             solver,
             dynamics,
-        })
+        };
+        Ok((model, report))
     }
 
     /// The dynamics settings, checked: a time step, valid Newmark parameters
     /// and a density for every body. Densities or initial velocities in a
     /// static scene are an error too (they would silently do nothing).
-    fn dynamics_spec(&self, mesh: &Mesh) -> std::result::Result<Option<DynamicsSpec>, String> {
+    fn dynamics_spec(&self, mesh: &Mesh) -> Checked<Option<DynamicsSpec>> {
+        use Seg::{Index, Key};
         let Some(d) = &self.dynamics else {
-            if let Some(b) = self
+            if let Some((i, b)) = self
                 .bodies
                 .iter()
-                .find(|b| b.density.is_some() || b.initial_velocity.is_some())
+                .enumerate()
+                .find(|(_, b)| b.density.is_some() || b.initial_velocity.is_some())
             {
-                return Err(format!(
+                let key = if b.density.is_some() {
+                    "density"
+                } else {
+                    "initial_velocity"
+                };
+                return Err(Bad::at(&[Key("body"), Index(i), Key(key)], format!(
                     "[[body]] '{}' has a density or initial_velocity but the scene has no [dynamics] section",
                     b.name
-                ));
+                )));
             }
             return Ok(None);
         };
         if !(d.time_step > 0.0 && d.time_step.is_finite()) {
-            return Err(format!(
-                "[dynamics] time_step must be positive (got {})",
-                d.time_step
+            return Err(Bad::at(
+                &[Key("dynamics"), Key("time_step")],
+                format!(
+                    "[dynamics] time_step must be positive (got {})",
+                    d.time_step
+                ),
             ));
         }
         match d.method.as_deref() {
             None | Some("newmark") => {}
             Some(other) => {
-                return Err(format!(
-                    "[dynamics] method '{other}' is not known (use \"newmark\")"
+                return Err(Bad::at(
+                    &[Key("dynamics"), Key("method")],
+                    format!("[dynamics] method '{other}' is not known (use \"newmark\")"),
                 ))
             }
         }
@@ -642,18 +847,29 @@ impl Scene {
         let mut density = Vec::with_capacity(mesh.bodies.len());
         let mut velocity = Vec::with_capacity(mesh.bodies.len());
         for body in &mesh.bodies {
-            let b = self.bodies.iter().find(|b| &b.name == body);
+            let i = self
+                .bodies
+                .iter()
+                .position(|b| &b.name == body)
+                .unwrap_or(0);
+            let key = |k| [Key("body"), Index(i), Key(k)];
+            let b = self.bodies.get(i).filter(|b| &b.name == body);
             let rho = b.and_then(|b| b.density).ok_or_else(|| {
-                format!("[[body]] '{body}' needs a density: the scene has [dynamics]")
+                Bad::at(
+                    &key("density"),
+                    format!("[[body]] '{body}' needs a density: the scene has [dynamics]"),
+                )
             })?;
             if !(rho > 0.0 && rho.is_finite()) {
-                return Err(format!(
-                    "[[body]] '{body}': density must be positive (got {rho})"
+                return Err(Bad::at(
+                    &key("density"),
+                    format!("[[body]] '{body}': density must be positive (got {rho})"),
                 ));
             }
             let v0 = b.and_then(|b| b.initial_velocity).unwrap_or([0.0; 3]);
             v0.iter()
-                .try_for_each(|&v| check_finite(v, "[[body]] initial_velocity"))?;
+                .try_for_each(|&v| check_finite(v, "[[body]] initial_velocity"))
+                .map_err(|m| Bad::at(&key("initial_velocity"), m))?;
             density.push(rho);
             velocity.push(v0);
         }
@@ -690,7 +906,8 @@ impl Scene {
         })
     }
 
-    fn build_mesh(&self, origin: &str) -> Result<Mesh> {
+    fn build_mesh(&self, origin: &str) -> Result<(Mesh, MeshReport)> {
+        let mut report = MeshReport::default();
         let mesh = match &self.mesh {
             MeshSection::Box(b) => generate::graded_box(&BoxSpec {
                 body: b.body.clone(),
@@ -752,13 +969,53 @@ impl Scene {
                     Some(dir) => dir.to_path_buf(),
                     None => Default::default(),
                 };
-                crate::mesh::read_gmsh(&base.join(&g.file))
-                    .map_err(|e| Error::scene(origin, format!("[mesh] gmsh: {e}")))?
-                    .0
+                let (mesh, gmsh) = crate::mesh::read_gmsh(&base.join(&g.file)).map_err(|e| {
+                    let at = [Seg::Key("mesh"), Seg::Key("file")];
+                    self.error_at(origin, &at, format!("[mesh] gmsh: {e}"))
+                })?;
+                report.gmsh = Some(gmsh);
+                mesh
             }
         };
-        Ok(mesh)
+        Ok((mesh, report))
     }
+}
+
+/// What reading the mesh found besides the mesh (for `check` to print).
+#[derive(Debug, Clone, Default)]
+pub struct MeshReport {
+    /// The Gmsh reader's report (reoriented cells, skipped sections), for a
+    /// `generator = "gmsh"` mesh.
+    pub gmsh: Option<crate::mesh::GmshReport>,
+}
+
+/// The first body (index) that no Dirichlet condition touches and no contact
+/// pair names as slave or master.
+fn unheld_body(mesh: &Mesh, dirichlet: &[DirichletSpec], contact: &[PairSpec]) -> Option<usize> {
+    let mut held = vec![false; mesh.bodies.len()];
+    let mut node_body = vec![usize::MAX; mesh.num_nodes()];
+    for c in 0..mesh.num_cells() {
+        for &n in mesh.cell(c) {
+            node_body[n] = mesh.cell_body[c] as usize;
+        }
+    }
+    for d in dirichlet.iter().filter(|d| !d.components.is_empty()) {
+        for &n in &d.nodes {
+            if let Some(h) = held.get_mut(node_body[n]) {
+                *h = true;
+            }
+        }
+    }
+    for p in contact {
+        let mut sets = vec![p.slave.as_str()];
+        if let MasterSpec::Surface { set } = &p.master {
+            sets.push(set);
+        }
+        for b in sets.into_iter().filter_map(|s| body_of_set(mesh, s)) {
+            held[b] = true;
+        }
+    }
+    held.iter().position(|h| !h)
 }
 
 fn check_finite(v: f64, what: &str) -> std::result::Result<(), String> {
@@ -780,15 +1037,19 @@ fn check_facet_set(mesh: &Mesh, set: &str, section: &str) -> std::result::Result
     ))
 }
 
-fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<DirichletSpec, String> {
+fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection, index: usize) -> Checked<DirichletSpec> {
+    let key = |k| [Seg::Key("dirichlet"), Seg::Index(index), Seg::Key(k)];
     let nodes = match mesh.node_sets.get(&d.set) {
         Some(n) => n.clone(),
         None => {
             let known: Vec<&str> = mesh.node_sets.keys().map(String::as_str).collect();
-            return Err(format!(
-                "[[dirichlet]] set '{}' is not a node set of the mesh (node sets: {})",
-                d.set,
-                known.join(", ")
+            return Err(Bad::at(
+                &key("set"),
+                format!(
+                    "[[dirichlet]] set '{}' is not a node set of the mesh (node sets: {})",
+                    d.set,
+                    known.join(", ")
+                ),
             ));
         }
     };
@@ -803,16 +1064,22 @@ fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<Diri
             "y" => 1,
             "z" => 2,
             other => {
-                return Err(format!(
-                    "[[dirichlet]] set '{}': component '{other}' is not one of x, y, z",
-                    d.set
+                return Err(Bad::at(
+                    &key("components"),
+                    format!(
+                        "[[dirichlet]] set '{}': component '{other}' is not one of x, y, z",
+                        d.set
+                    ),
                 ))
             }
         };
         if components.contains(&c) {
-            return Err(format!(
-                "[[dirichlet]] set '{}': component '{n}' listed twice",
-                d.set
+            return Err(Bad::at(
+                &key("components"),
+                format!(
+                    "[[dirichlet]] set '{}': component '{n}' listed twice",
+                    d.set
+                ),
             ));
         }
         components.push(c);
@@ -822,21 +1089,25 @@ fn dirichlet_spec(mesh: &Mesh, d: &DirichletSection) -> std::result::Result<Diri
         .clone()
         .unwrap_or_else(|| vec![0.0; components.len()]);
     if values.len() != components.len() {
-        return Err(format!(
-            "[[dirichlet]] set '{}': {} values for {} components ({})",
-            d.set,
-            values.len(),
-            components.len(),
-            names.join(", ")
+        return Err(Bad::at(
+            &key("value"),
+            format!(
+                "[[dirichlet]] set '{}': {} values for {} components ({})",
+                d.set,
+                values.len(),
+                components.len(),
+                names.join(", ")
+            ),
         ));
     }
     let mut full = [0.0; 3];
     for (&c, &v) in components.iter().zip(&values) {
-        check_finite(v, "[[dirichlet]] value")?;
+        check_finite(v, "[[dirichlet]] value").map_err(|m| Bad::at(&key("value"), m))?;
         full[c] = v;
     }
     let mut spec = DirichletSpec::uniform(&d.set, nodes, components, full);
-    spec.amplitude = amplitude(&d.amplitude, &format!("[[dirichlet]] set '{}'", d.set))?;
+    spec.amplitude = amplitude(&d.amplitude, &format!("[[dirichlet]] set '{}'", d.set))
+        .map_err(|m| Bad::at(&key("amplitude"), m))?;
     Ok(spec)
 }
 
@@ -851,57 +1122,72 @@ fn amplitude(
     }
 }
 
-fn contact_spec(
-    mesh: &Mesh,
-    c: &ContactSection,
-    index: usize,
-) -> std::result::Result<PairSpec, String> {
+fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSpec> {
+    let key = |k| [Seg::Key("contact"), Seg::Index(index), Seg::Key(k)];
     let name = c.name.clone().unwrap_or_else(|| format!("pair{index}"));
     let at = format!("[[contact]] '{name}'");
-    check_facet_set(mesh, &c.slave, &format!("{at} slave"))?;
+    check_facet_set(mesh, &c.slave, &format!("{at} slave"))
+        .map_err(|m| Bad::at(&key("slave"), m))?;
     let master = match (&c.master, &c.rigid) {
         (Some(m), None) => {
-            check_facet_set(mesh, m, &format!("{at} master"))?;
+            check_facet_set(mesh, m, &format!("{at} master"))
+                .map_err(|e| Bad::at(&key("master"), e))?;
             if m == &c.slave {
-                return Err(format!("{at}: slave and master are the same facet set '{m}'; a surface cannot contact itself here"));
+                return Err(Bad::at(&key("master"), format!("{at}: slave and master are the same facet set '{m}'; a surface cannot contact itself here")));
             }
+            check_different_bodies(mesh, &c.slave, m)
+                .map_err(|e| Bad::at(&key("master"), format!("{at}: {e}")))?;
             MasterSpec::Surface { set: m.clone() }
         }
         (None, Some(r)) => {
-            r.validate().map_err(|e| format!("{at}: {e}"))?;
+            r.validate()
+                .map_err(|e| Bad::at(&key("rigid"), format!("{at}: {e}")))?;
             MasterSpec::Rigid(*r)
         }
         (Some(_), Some(_)) => {
-            return Err(format!(
+            return Err(Bad::at(
+                &key("rigid"),
+                format!(
                 "{at}: give either master (a facet set) or rigid (an analytic surface), not both"
+            ),
             ))
         }
-        (None, None) => return Err(format!("{at}: needs a master facet set or a rigid surface")),
+        (None, None) => {
+            return Err(format!("{at}: needs a master facet set or a rigid surface").into())
+        }
     };
     if c.motion.is_some() && !master.is_rigid() {
-        return Err(format!("{at}: motion applies to rigid masters only; move a deformable master with [[dirichlet]] values"));
+        return Err(Bad::at(&key("motion"), format!("{at}: motion applies to rigid masters only; move a deformable master with [[dirichlet]] values")));
     }
     let mut spec = PairSpec::new(&name, &c.slave, master);
     spec.motion = c.motion.unwrap_or([0.0; 3]);
     if c.motion_amplitude.is_some() && c.motion.is_none() {
-        return Err(format!("{at}: motion_amplitude is set but motion is not"));
+        return Err(Bad::at(
+            &key("motion_amplitude"),
+            format!("{at}: motion_amplitude is set but motion is not"),
+        ));
     }
-    spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))?;
+    spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))
+        .map_err(|m| Bad::at(&key("motion_amplitude"), m))?;
     spec.quadrature = match c.quadrature.as_deref() {
         None | Some("gauss") => SlaveQuadrature::Gauss,
         Some("nodal") => SlaveQuadrature::Nodal,
         Some("centroid") => SlaveQuadrature::Centroid,
         Some(other) => {
-            return Err(format!(
-                "{at}: quadrature '{other}' is not \"nodal\" or \"gauss\""
+            return Err(Bad::at(
+                &key("quadrature"),
+                format!("{at}: quadrature '{other}' is not \"gauss\", \"centroid\" or \"nodal\""),
             ))
         }
     };
-    let positive = |v: f64, key: &str| {
+    let positive = |v: f64, k: &'static str| {
         if v > 0.0 && v.is_finite() {
             Ok(v)
         } else {
-            Err(format!("{at}: {key} must be positive (got {v})"))
+            Err(Bad::at(
+                &key(k),
+                format!("{at}: {k} must be positive (got {v})"),
+            ))
         }
     };
     spec.penalty = c.penalty.map(|p| positive(p, "penalty")).transpose()?;
@@ -919,12 +1205,16 @@ fn contact_spec(
         .transpose()?;
     spec.max_uzawa = c.max_uzawa.unwrap_or(spec.max_uzawa);
     if spec.max_uzawa == 0 {
-        return Err(format!("{at}: max_uzawa must be at least 1"));
+        return Err(Bad::at(
+            &key("max_uzawa"),
+            format!("{at}: max_uzawa must be at least 1"),
+        ));
     }
     if let Some(mu) = c.friction {
         if !(mu >= 0.0 && mu.is_finite()) {
-            return Err(format!(
-                "{at}: friction (the coefficient μ) must be zero or positive (got {mu})"
+            return Err(Bad::at(
+                &key("friction"),
+                format!("{at}: friction (the coefficient μ) must be zero or positive (got {mu})"),
             ));
         }
     }
@@ -933,8 +1223,9 @@ fn contact_spec(
         .map(|p| positive(p, "tangential_penalty"))
         .transpose()?;
     if tangential_penalty.is_some() && c.friction.is_none() {
-        return Err(format!(
-            "{at}: tangential_penalty is set but friction is not; give friction = μ"
+        return Err(Bad::at(
+            &key("tangential_penalty"),
+            format!("{at}: tangential_penalty is set but friction is not; give friction = μ"),
         ));
     }
     spec.friction = c.friction.map(|mu| crate::contact::pair::FrictionSpec {
@@ -942,6 +1233,32 @@ fn contact_spec(
         penalty: tangential_penalty,
     });
     Ok(spec)
+}
+
+/// Self-contact (slave and master on one body) is not supported: the search
+/// would pair every slave point with its own neighbourhood at zero gap.
+fn check_different_bodies(
+    mesh: &Mesh,
+    slave: &str,
+    master: &str,
+) -> std::result::Result<(), String> {
+    let bodies_of = |set: &str| -> Vec<usize> {
+        let mut b: Vec<usize> = mesh.facet_sets[set]
+            .iter()
+            .map(|f| mesh.cell_body[f.cell] as usize)
+            .collect();
+        b.sort_unstable();
+        b.dedup();
+        b
+    };
+    let (s, m) = (bodies_of(slave), bodies_of(master));
+    match s.iter().find(|b| m.contains(b)) {
+        Some(&b) => Err(format!(
+            "slave '{slave}' and master '{master}' both lie on body '{}'; self-contact is not supported (pair surfaces of two different bodies)",
+            mesh.bodies[b]
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The body a facet set lies on (its first facet's cell).

@@ -54,6 +54,10 @@ pub struct PointValues {
     pub pressure: Vec<f64>,
     pub gap: Vec<f64>,
     pub lambda: Vec<f64>,
+    /// Each point's area weight (reference configuration, the same weight
+    /// the contact force Σ pN·w uses), so readers can integrate pressures
+    /// and measure the contact area Σ w over points with pN > 0.
+    pub weight: Vec<f64>,
     /// Friction (empty for a frictionless pair): tangential traction on the
     /// slave, slip increment of the step, state (0 open, 1 stick, 2 slip).
     pub traction: Vec<[f64; 3]>,
@@ -813,6 +817,7 @@ impl ContactPair {
             pressure: vec![0.0; nq],
             gap: vec![self.search_distance; nq],
             lambda: self.multipliers.lambda.clone(),
+            weight: self.slave.qp_weight.clone(),
             traction: Vec::new(),
             slip: Vec::new(),
             state: Vec::new(),

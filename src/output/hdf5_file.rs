@@ -928,6 +928,55 @@ impl ResultFile {
             .map(|_| ())
     }
 
+    /// Collective. Writes string and f64 attributes on `group` (`"/"` for the
+    /// file's root; a top-level group is created when missing). Every rank
+    /// passes the same values. For run metadata that belongs to no step: the
+    /// scene text and the closed-form setup a post-processor needs.
+    pub fn write_attributes(
+        &mut self,
+        group: &str,
+        strings: &[(&str, &str)],
+        numbers: &[(&str, f64)],
+    ) -> Result<(), OutputError> {
+        let c = self.coll();
+        let p = c.path;
+        let name = group.trim_start_matches('/');
+        let local = if name.is_empty() {
+            Ok(())
+        } else {
+            check_name(p, group, name)
+        };
+        c.agree(group, local)?;
+        let mut f = Fingerprint::new();
+        f.str(group);
+        for (k, v) in strings {
+            f.str(k);
+            f.str(v);
+        }
+        for (k, v) in numbers {
+            f.str(k);
+            f.f64s(&[*v]);
+        }
+        c.same_everywhere(group, f.0)?;
+        let root: &Group = &self.file;
+        let g = if name.is_empty() {
+            root.clone()
+        } else {
+            c.open_or_create_group(root, group, name)?
+        };
+        let res = (|| {
+            for (k, v) in strings {
+                attr_string(p, &g, group, k, v)?;
+            }
+            for (k, v) in numbers {
+                attr_scalar(&g, k, v)
+                    .map_err(|e| OutputError::hdf5(p, group, "write attribute of", e))?;
+            }
+            Ok(())
+        })();
+        c.agree(group, res)
+    }
+
     /// Collective, no side effects: checks that the step exists, that
     /// `rel_path` is a valid relative HDF5 path, and that all ranks make the
     /// same call (`extra` adds the call's shape or data to the fingerprint).
@@ -1095,6 +1144,58 @@ pub fn list_steps(path: &Path) -> Result<Vec<usize>, OutputError> {
         .collect::<Result<Vec<_>, _>>()?;
     steps.sort_unstable();
     Ok(steps)
+}
+
+/// Opens attribute `name` of group `object` (`"/"` for the root); None when
+/// the group or the attribute does not exist (optional run metadata).
+fn optional_attr(
+    path: &Path,
+    object: &str,
+    name: &str,
+) -> Result<Option<hdf5::Attribute>, OutputError> {
+    let file = open(path)?;
+    let inner = object.trim_start_matches('/');
+    if !inner.is_empty() && !file.link_exists(inner) {
+        return Ok(None);
+    }
+    let g = file
+        .group(object)
+        .map_err(|e| OutputError::hdf5(path, object, "open", e))?;
+    let names = g
+        .attr_names()
+        .map_err(|e| OutputError::hdf5(path, object, "list attributes of", e))?;
+    if !names.iter().any(|n| n == name) {
+        return Ok(None);
+    }
+    g.attr(name)
+        .map(Some)
+        .map_err(|e| OutputError::hdf5(path, object, "read attributes of", e))
+}
+
+/// A string attribute of a group (see [`ResultFile::write_attributes`]),
+/// None when absent.
+pub fn read_string_attr(
+    path: &Path,
+    object: &str,
+    name: &str,
+) -> Result<Option<String>, OutputError> {
+    optional_attr(path, object, name)?
+        .map(|a| {
+            a.read_scalar::<VarLenUnicode>()
+                .map(|s| s.as_str().to_owned())
+                .map_err(|e| OutputError::hdf5(path, object, "read attributes of", e))
+        })
+        .transpose()
+}
+
+/// An f64 attribute of a group, None when absent.
+pub fn read_f64_attr(path: &Path, object: &str, name: &str) -> Result<Option<f64>, OutputError> {
+    optional_attr(path, object, name)?
+        .map(|a| {
+            a.read_scalar::<f64>()
+                .map_err(|e| OutputError::hdf5(path, object, "read attributes of", e))
+        })
+        .transpose()
 }
 
 /// The attributes of `/steps/<NNNNNN>` as a [`StepInfo`].

@@ -63,7 +63,10 @@ pub mod xdmf;
 
 use std::path::{Path, PathBuf};
 
-pub use hdf5_file::{list_steps, read_dataset, read_nodal, read_step_attrs, ResultFile};
+pub use hdf5_file::{
+    list_steps, read_dataset, read_f64_attr, read_nodal, read_step_attrs, read_string_attr,
+    ResultFile,
+};
 
 /// One rank's contiguous block `[start, start + data.len() / cols)` of the rows
 /// of a `(global_rows, cols)` array, row-major.

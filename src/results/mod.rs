@@ -1,0 +1,158 @@
+//! Reading a finished run back: `contactlink summary` (a table of the steps
+//! and each contact pair's force, area and peak pressure) and
+//! `contactlink plot` (the Hertz pressure profile against the closed form).
+//! Serial and read-only: any process can run them on a closed result file.
+pub mod plot;
+pub mod summary;
+
+use crate::output::{list_steps, read_nodal, step_group_name, OutputError};
+use std::path::{Path, PathBuf};
+
+/// Why a result file could not be summarised or plotted. Each message is one
+/// line naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ResultsError {
+    #[error("{}: {message}", .path.display())]
+    File { path: PathBuf, message: String },
+    /// A sentence that names the file itself.
+    #[error("{0}")]
+    Sentence(String),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+impl ResultsError {
+    pub fn file(path: &Path, message: impl Into<String>) -> Self {
+        ResultsError::File {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Checks that `path` is a contactlink result file with at least one step
+/// and returns its step indices (ascending). The checks come first so a
+/// wrong argument gets a plain sentence instead of an HDF5 error stack.
+pub fn open_steps(path: &Path) -> Result<Vec<usize>, ResultsError> {
+    if !path.exists() {
+        return Err(ResultsError::file(path, "no such file"));
+    }
+    let file = hdf5::File::open(path)
+        .map_err(|_| ResultsError::file(path, "not an HDF5 file (or not readable)"))?;
+    if !(file.link_exists("mesh") && file.link_exists("steps")) {
+        return Err(ResultsError::file(
+            path,
+            "not a contactlink result file (no /mesh and /steps groups)",
+        ));
+    }
+    drop(file);
+    let steps = list_steps(path)?;
+    if steps.is_empty() {
+        return Err(ResultsError::file(
+            path,
+            "holds no steps (the run stopped before its first step converged)",
+        ));
+    }
+    Ok(steps)
+}
+
+/// The contact pairs written at `step` (the members of
+/// `/steps/<step>/contact`), sorted; none when the model has no contact.
+pub fn pair_names(path: &Path, step: usize) -> Result<Vec<String>, ResultsError> {
+    let object = format!("/steps/{}/contact", step_group_name(step));
+    let file = hdf5::File::open(path).map_err(|source| OutputError::Open {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if !file.link_exists(&object) {
+        return Ok(Vec::new());
+    }
+    let mut names = file
+        .group(&object)
+        .and_then(|g| g.member_names())
+        .map_err(|e| OutputError::hdf5(path, &object, "list", e))?;
+    names.sort();
+    Ok(names)
+}
+
+/// One contact pair's point arrays at one step.
+pub struct PairPoints {
+    /// Current positions of the slave quadrature points.
+    pub points: Vec<[f64; 3]>,
+    pub pressure: Vec<f64>,
+    /// Area weights; None in files written before the weight was stored.
+    pub weight: Option<Vec<f64>>,
+    /// Total contact force on the slave surface.
+    pub force: [f64; 3],
+}
+
+impl PairPoints {
+    pub fn read(path: &Path, step: usize, pair: &str) -> Result<Self, ResultsError> {
+        let rel = |name: &str| format!("contact/{pair}/{name}");
+        let (flat, rows, cols) = read_nodal(path, step, &rel("points"))?;
+        let (pressure, prow, _) = read_nodal(path, step, &rel("pressure"))?;
+        let (force, _, _) = read_nodal(path, step, &rel("force"))?;
+        let weight = if has_dataset(path, step, &rel("weight")) {
+            let (w, wrows, _) = read_nodal(path, step, &rel("weight"))?;
+            Some((w, wrows))
+        } else {
+            None
+        };
+        let inconsistent = cols != 3
+            || prow != rows
+            || force.len() != 3
+            || weight.as_ref().is_some_and(|(_, r)| *r != rows);
+        if inconsistent {
+            return Err(ResultsError::file(
+                path,
+                format!(
+                    "step {step}, pair '{pair}': points, pressure, weight and force have inconsistent shapes"
+                ),
+            ));
+        }
+        Ok(PairPoints {
+            points: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            pressure,
+            weight: weight.map(|(w, _)| w),
+            force: [force[0], force[1], force[2]],
+        })
+    }
+
+    /// Points carrying pressure (pN > 0): the contact zone.
+    pub fn is_active(&self, i: usize) -> bool {
+        self.pressure.get(i).is_some_and(|&p| p > 0.0)
+    }
+}
+
+/// The nodal contact pressure of `step` (one value per mesh node); None
+/// when the step has none (a model without contact).
+pub fn nodal_pressure(path: &Path, step: usize) -> Result<Option<Vec<f64>>, ResultsError> {
+    if !has_dataset(path, step, "contact_pressure") {
+        return Ok(None);
+    }
+    Ok(Some(read_nodal(path, step, "contact_pressure")?.0))
+}
+
+/// The nodes of a pair's slave surface (sorted, unique), from the
+/// `/contact_pairs` map to its facet set; None in files without the map.
+pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<usize>>, ResultsError> {
+    let Some(set) = crate::output::read_string_attr(path, "/contact_pairs", pair)? else {
+        return Ok(None);
+    };
+    let object = format!("/mesh/facet_sets/{set}/nodes");
+    let (ids, _) = crate::output::read_dataset::<i64>(path, &object)?;
+    let mut nodes = ids
+        .into_iter()
+        .map(usize::try_from)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| ResultsError::file(path, format!("{object} holds a negative node id")))?;
+    nodes.sort_unstable();
+    nodes.dedup();
+    Ok(Some(nodes))
+}
+
+/// Whether `/steps/<step>/<rel>` exists (optional datasets).
+fn has_dataset(path: &Path, step: usize, rel: &str) -> bool {
+    let object = format!("/steps/{}/{rel}", step_group_name(step));
+    hdf5::File::open(path).is_ok_and(|f| f.link_exists(&object))
+}

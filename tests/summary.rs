@@ -1,0 +1,231 @@
+//! `contactlink summary` and `contactlink plot` on a real run: a coarse
+//! Hertz line contact on 2 ranks. The summary must reproduce what the run
+//! itself printed (force, normal force, active points, peak pressure) and
+//! the contact area must match the Hertz width 2·b·thickness.
+mod common;
+use common::*;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The coarse Hertz line contact, with per-step lines (-v) to compare with.
+fn hertz_run(dir: &Path) -> (std::path::PathBuf, String) {
+    let out = dir.join("hc.h5");
+    let o = mpirun(
+        2,
+        &[
+            "run",
+            "hertz-cylinder",
+            "-v",
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            "mesh.fine_size=0.4",
+        ],
+    );
+    let t = text(&o);
+    assert!(o.status.success(), "hertz-cylinder failed:\n{t}");
+    (out, t)
+}
+
+/// The last line of the run's output containing `marker`.
+fn last_line<'a>(text: &'a str, marker: &str) -> &'a str {
+    text.lines()
+        .rev()
+        .find(|l| l.contains(marker))
+        .unwrap_or_else(|| panic!("no line with {marker:?} in:\n{text}"))
+}
+
+/// The number right after `key` in `line` ("normal 5.26e1," → 52.6).
+fn number_after(line: &str, key: &str) -> f64 {
+    let at = line
+        .find(key)
+        .unwrap_or_else(|| panic!("{key:?} in {line:?}"));
+    let token: String = line[at + key.len()..]
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || "+-.e".contains(*c))
+        .collect();
+    token
+        .parse()
+        .unwrap_or_else(|_| panic!("{key:?} in {line:?}"))
+}
+
+/// The number right before `key` ("20 active points" → 20).
+fn number_before(line: &str, key: &str) -> f64 {
+    let at = line
+        .find(key)
+        .unwrap_or_else(|| panic!("{key:?} in {line:?}"));
+    let token = line[..at].split_whitespace().next_back().unwrap_or("");
+    token
+        .parse()
+        .unwrap_or_else(|_| panic!("{key:?} in {line:?}"))
+}
+
+fn csv_rows(text: &str) -> Vec<HashMap<String, String>> {
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().expect("CSV header").split(',').collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .zip(l.split(','))
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * b.abs()
+}
+
+#[test]
+fn summary_and_plot_of_a_hertz_run() {
+    let dir = scratch("summary-hertz");
+    let (h5, run) = hertz_run(&dir);
+    let file = h5.to_str().unwrap();
+
+    let o = run_cmd(&["summary", file, "--csv"]);
+    let csv = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", text(&o));
+    let rows = csv_rows(&csv);
+    assert_eq!(rows.len(), 2, "{csv}");
+    let last = rows.last().unwrap();
+    let col = |k: &str| -> f64 {
+        last[&format!("hertz.{k}")]
+            .parse()
+            .unwrap_or_else(|_| panic!("hertz.{k} in {csv}"))
+    };
+    println!("{csv}");
+
+    // The run's own last-step line (7 significant digits): force [x, y, z],
+    // normal, active points.
+    let step = last_line(&run, "contact hertz:");
+    let inner = &step[step.find('[').unwrap() + 1..step.find(']').unwrap()];
+    let force: Vec<f64> = inner
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    assert!(
+        close(col("fz"), force[2], 1e-6),
+        "fz {} vs run {force:?}",
+        col("fz")
+    );
+    let normal = number_after(step, "normal");
+    assert!(
+        close(col("normal"), normal, 1e-6),
+        "normal {} vs run {normal}",
+        col("normal")
+    );
+    assert_eq!(col("active"), number_before(step, "active points"));
+
+    // "Hertz: load P; p0 computed p, analytic p0 (e %); half-width/radius
+    // computed w, analytic b (e %)".
+    let hertz = last_line(&run, "Hertz:");
+    let (p0_part, width_part) = hertz.split_once("half-width").expect("Hertz line");
+    let p0 = number_after(p0_part, "p0 computed");
+    let b_exact = number_after(width_part, "analytic");
+    // Peak nodal pressure against the p0 the run fitted to the same nodes.
+    assert!(
+        close(col("max_pressure"), p0, 0.05),
+        "max p {} vs p0 {p0}",
+        col("max_pressure")
+    );
+    // Area against the closed-form width 2·b·thickness (thickness 1); the
+    // quadrature points are 0.2 apart, so the measured width is quantised.
+    assert!(
+        close(col("area"), 2.0 * b_exact, 0.10),
+        "area {} vs 2b = {}",
+        col("area"),
+        2.0 * b_exact
+    );
+
+    // The table: the file named once, one row per step.
+    let o = run_cmd(&["summary", file]);
+    let table = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success() && table.starts_with(file), "{table}");
+    assert_eq!(table.lines().count(), 2 + 2, "{table}");
+
+    // The plot: a PNG (its eight magic bytes) next to the file by default.
+    let png = dir.join("profile.png");
+    let o = run_cmd(&["plot", file, "-o", png.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let bytes = std::fs::read(&png).expect("plot wrote no PNG");
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    assert!(bytes.len() > 10_000, "suspiciously small PNG");
+    let o = run_cmd(&["plot", file, "--step", "1"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(h5.with_extension("png").exists());
+    let o = run_cmd(&["plot", file, "--step", "7"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+}
+
+/// `contactlink ARGS` without mpirun: summary and plot are serial.
+fn run_cmd(args: &[&str]) -> std::process::Output {
+    run(args)
+}
+
+/// One line naming the file, exit code 1, no panic.
+fn assert_clean_failure(args: &[&str], file: &str, expect: &str) {
+    let o = run_cmd(args);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{args:?}:\n{t}");
+    assert!(!t.contains("panicked"), "{t}");
+    assert_eq!(t.trim_end().lines().count(), 1, "not one line:\n{t}");
+    assert!(t.contains(file) && t.contains(expect), "{args:?}: {t}");
+}
+
+#[test]
+fn bad_result_files_are_one_line_errors() {
+    let dir = scratch("summary-bad");
+    let missing = dir.join("missing.h5");
+    let missing = missing.to_str().unwrap();
+    assert_clean_failure(&["summary", missing], missing, "no such file");
+    assert_clean_failure(&["plot", missing], missing, "no such file");
+    let junk = write(&dir, "junk.h5", "not HDF5");
+    let junk = junk.to_str().unwrap();
+    assert_clean_failure(&["summary", junk, "--csv"], junk, "not an HDF5 file");
+
+    // A contactlink file without a Hertz setup: plot says what it draws.
+    let out = dir.join("cube.h5");
+    let o = run_cmd(&[
+        "run",
+        "block-compress",
+        "--set",
+        "mesh.divisions=[2,2,2]",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).is_empty(), "-q printed:\n{}", text(&o));
+    let out = out.to_str().unwrap();
+    assert_clean_failure(
+        &["plot", out],
+        out,
+        "has no Hertz setup; plot draws the Hertz pressure profile only",
+    );
+    let o = run_cmd(&["summary", out]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("contact pair(s): none"));
+}
+
+#[test]
+fn per_step_lines_need_a_terminal_or_verbose() {
+    // The test's pipe is no terminal: the summary prints, the steps do not.
+    let dir = scratch("summary-quiet");
+    let out = dir.join("b.h5");
+    let args = [
+        "run",
+        "block-compress",
+        "--set",
+        "mesh.divisions=[2,2,2]",
+        "-o",
+    ];
+    let o = mpirun(2, &[&args[..], &[out.to_str().unwrap()]].concat());
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("done:") && t.contains("output:"), "{t}");
+    assert!(!t.contains("step    1"), "per-step lines without -v:\n{t}");
+    let o = mpirun(2, &[&args[..], &[out.to_str().unwrap(), "-v"]].concat());
+    assert!(text(&o).contains("step    1"), "{}", text(&o));
+}
