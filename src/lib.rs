@@ -23,6 +23,7 @@ pub mod output;
 pub mod partition;
 pub mod petsc;
 pub mod pipeline;
+pub mod restart;
 pub mod runtime;
 pub mod scene;
 pub mod solve;

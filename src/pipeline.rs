@@ -23,6 +23,8 @@ pub struct RunOptions {
     pub overrides: Vec<String>,
     /// Print one line per step on rank 0.
     pub echo: bool,
+    /// Continue from the last converged step of this result file.
+    pub restart: Option<PathBuf>,
 }
 
 /// What a run produced.
@@ -48,7 +50,30 @@ pub fn load_model(name_or_path: &str, overrides: &[String]) -> Result<(Model, Op
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
     let (model, scene_out) = load_model(name_or_path, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
-    run_model(rt, &model, output.as_deref(), opts.echo)
+    let restart = match &opts.restart {
+        Some(from) => Some(read_restart(from, output.as_deref(), &model)?),
+        None => None,
+    };
+    run_model_from(rt, &model, output.as_deref(), opts.echo, restart.as_ref())
+}
+
+/// The state to continue from, read before anything is solved or written.
+fn read_restart(
+    from: &Path,
+    output: Option<&Path>,
+    model: &Model,
+) -> Result<crate::restart::RestartState> {
+    let same = |out: &Path| match (out.canonicalize(), from.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => out == from,
+    };
+    if output.is_some_and(same) {
+        return Err(crate::Error::Restart(format!(
+            "{}: the continued run would overwrite the file it continues from; give another output file with -o",
+            from.display()
+        )));
+    }
+    crate::restart::read(from, model)
 }
 
 /// Runs an already built model, writing `output` when given.
@@ -57,6 +82,17 @@ pub fn run_model(
     model: &Model,
     output: Option<&Path>,
     echo: bool,
+) -> Result<RunSummary> {
+    run_model_from(rt, model, output, echo, None)
+}
+
+/// [`run_model`], from the start or from a restart state.
+pub fn run_model_from(
+    rt: &Runtime,
+    model: &Model,
+    output: Option<&Path>,
+    echo: bool,
+    restart: Option<&crate::restart::RestartState>,
 ) -> Result<RunSummary> {
     if rt.rank() == 0 {
         for w in model.warnings() {
@@ -90,9 +126,9 @@ pub fn run_model(
             let history = HistoryCsv::create(rt, &path.with_extension("csv"))?;
             let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut hertz);
             let mut sink = Tee(history, &mut sink);
-            sim.run(rt, &mut sink, echo)?
+            sim.run(rt, &mut sink, echo, restart)?
         }
-        None => sim.run(rt, &mut hertz, echo)?,
+        None => sim.run(rt, &mut hertz, echo, restart)?,
     };
     Ok(RunSummary {
         model_name: model.name.clone(),
@@ -393,6 +429,20 @@ impl Hdf5Sink {
             vectors.push(("slip", flat(&v.slip)));
             // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
             scalars.push(("state", v.state.iter().map(|&s| f64::from(s)).collect()));
+            // The friction history, so `run --restart` continues exactly.
+            let records = &v.records;
+            vectors.push((
+                "lambda_t",
+                flat(&records.iter().map(|r| r.lambda).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                "slip_origin",
+                flat(&records.iter().map(|r| r.origin).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                "history_ids",
+                flat(&records.iter().map(|r| r.ids).collect::<Vec<_>>()),
+            ));
         }
         let order = &mut self.pairs[i];
         let rows = order.rows;

@@ -367,6 +367,8 @@ pub struct SolverSection {
     pub reuse_linear_stiffness: Option<bool>,
     pub reuse_pattern: Option<bool>,
     pub lag_preconditioner: Option<bool>,
+    /// Start a step from the last two converged steps extrapolated (default false).
+    pub extrapolate: Option<bool>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -687,6 +689,7 @@ impl Scene {
                 pattern: s.reuse_pattern.unwrap_or(d.reuse.pattern),
                 preconditioner: s.lag_preconditioner.unwrap_or(d.reuse.preconditioner),
             },
+            extrapolate: s.extrapolate.unwrap_or(d.extrapolate),
         })
     }
 
