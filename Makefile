@@ -62,12 +62,15 @@ bench: deps
 	echo "contact search against slave points (serial)"; \
 	$$bin | tee bench-results/search.csv
 
-# Run time against error for the Hertz line contact: mesh size × penalty ×
-# Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto front in
-# bench-results/ (about 5 minutes on 2 cores).
+# Run time against error for the Hertz line and point contacts: mesh size ×
+# penalty × Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto
+# front in bench-results/ (about 5 minutes for the line contact, 15 for the
+# point contact on 2 cores).
 work-precision: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/work_precision.py --scene hertz-cylinder --np $(NP) --repeats 3
+	$(PYTHON) scripts/work_precision.py --scene hertz-sphere --np $(NP) --repeats 3 \
+	  --sizes 0.7,0.5 --penalties 0.1,1,10 --tols 1e-2,1e-3
 
 # Strong (152k DOFs, 1/2 ranks, 4 oversubscribed for correctness) and weak
 # scaling of the Hertz line contact, with the halo volume (about 4 minutes).

@@ -4,6 +4,7 @@
 usage: work_precision.py --scene hertz-cylinder [--np 2] [--repeats 3]
                          [--sizes 0.4,0.2,0.1] [--penalties 0.1,1,10]
                          [--tols 1e-2,1e-3,1e-4] [--out bench-results]
+                         [--bin target/release/contactlink]
 
 Every configuration (contact-zone element size h, penalty as a multiple of
 the default 10·E/h, Uzawa tolerance for both penetration and multiplier
@@ -33,9 +34,9 @@ DONE = re.compile(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs")
 HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
 
 
-def run_once(scene, np_, args, h5):
+def run_once(binary, scene, np_, args, h5):
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           "target/release/contactlink", "run", scene, "-o", h5] + args
+           binary, "run", scene, "-o", h5] + args
     env = dict(os.environ, OMPI_MCA_btl="self,vader",
                OMPI_MCA_btl_vader_single_copy_mechanism="none",
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -73,6 +74,8 @@ def main():
     ap.add_argument("--penalties", default="0.1,1,10")
     ap.add_argument("--tols", default="1e-2,1e-3,1e-4")
     ap.add_argument("--out", default="bench-results")
+    ap.add_argument("--bin", default="target/release/contactlink",
+                    help="the contactlink binary (a copy lets a sweep run while you rebuild)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     rows = []
@@ -87,7 +90,7 @@ def main():
                         "--set", "solver.direct_max_dofs=200000"]
                 runs = []
                 for i in range(a.repeats):
-                    r, out = run_once(a.scene, a.np, args, f"{a.out}/wp-run.h5")
+                    r, out = run_once(a.bin, a.scene, a.np, args, f"{a.out}/wp-{a.scene}-run.h5")
                     if r is None:
                         print(f"h={h} penalty×{k} tol={tol}: failed\n{out[-400:]}",
                               file=sys.stderr)

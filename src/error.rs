@@ -34,6 +34,9 @@ pub enum Error {
         cutbacks: usize,
         reason: String,
     },
+    /// A result file that cannot be continued from (`run --restart`).
+    #[error("restart: {0}")]
+    Restart(String),
     #[error("{0}")]
     Io(#[from] std::io::Error),
     /// A broken internal invariant (a bug, not bad input).

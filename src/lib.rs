@@ -24,6 +24,7 @@ pub mod output;
 pub mod partition;
 pub mod petsc;
 pub mod pipeline;
+pub mod restart;
 pub mod results;
 pub mod runtime;
 pub mod scene;

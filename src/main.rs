@@ -11,7 +11,7 @@ const USAGE: &str = "\
 contactlink — parallel 3D contact mechanics on PETSc
 
 usage:
-  contactlink run SCENE [-o OUT.h5] [--set key=value]... [-v | -q] [PETSc options]
+  contactlink run SCENE [-o OUT.h5] [--set key=value]... [--restart FROM.h5] [-v | -q] [PETSc options]
   contactlink check SCENE [--set key=value]...
   contactlink summary OUT.h5 [--csv]
   contactlink plot OUT.h5 [-o profile.png] [--step N]
@@ -20,6 +20,9 @@ usage:
 
 SCENE is a scene file (TOML) or the name of a built-in scene (see `contactlink scenes`).
 Run under MPI with e.g. `mpirun -n 2 contactlink run block-compress -o out.h5`.
+--restart FROM.h5 continues a run of the same scene from the last converged step in
+FROM.h5 (multipliers and friction history included) and writes the remaining steps to
+OUT.h5 (which must be another file), numbered on from there.
 Any other option starting with '-' goes to PETSc (e.g. -ksp_type gmres -snes_monitor);
 PETSC_OPTIONS in the environment is read too. Options given here override the scene's
 [solver] petsc_options and the program's defaults.
@@ -83,6 +86,10 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
                     .parse()
                     .map_err(|_| format!("--step {n}: expected a step number"))?;
                 cli.step = Some(n);
+            }
+            "--restart" => {
+                let p = it.next().ok_or("--restart needs a result file")?;
+                cli.run.restart = Some(PathBuf::from(p));
             }
             s if s.starts_with('-') && s.len() > 1 => {
                 cli.petsc.push(s.to_owned());

@@ -23,6 +23,8 @@ pub struct RunOptions {
     pub overrides: Vec<String>,
     /// Print one line per step (and per cutback) on rank 0.
     pub echo: bool,
+    /// Continue from the last converged step of this result file.
+    pub restart: Option<PathBuf>,
     /// Print nothing on success, not even the model's header line.
     pub quiet: bool,
 }
@@ -75,6 +77,10 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
     let src = SceneSource::resolve(name_or_path)?;
     let (model, scene_out) = build_model(&src, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
+    let restart = match &opts.restart {
+        Some(from) => Some(read_restart(from, output.as_deref(), &model)?),
+        None => None,
+    };
     let provenance = Provenance {
         scene: src.text,
         overrides: opts.overrides.clone(),
@@ -83,7 +89,33 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
         header: !opts.quiet,
         steps: opts.echo && !opts.quiet,
     };
-    run_model_with(rt, &model, output.as_deref(), printing, Some(&provenance))
+    run_model_with(
+        rt,
+        &model,
+        output.as_deref(),
+        printing,
+        Some(&provenance),
+        restart.as_ref(),
+    )
+}
+
+/// The state to continue from, read before anything is solved or written.
+fn read_restart(
+    from: &Path,
+    output: Option<&Path>,
+    model: &Model,
+) -> Result<crate::restart::RestartState> {
+    let same = |out: &Path| match (out.canonicalize(), from.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => out == from,
+    };
+    if output.is_some_and(same) {
+        return Err(crate::Error::Restart(format!(
+            "{}: the continued run would overwrite the file it continues from; give another output file with -o",
+            from.display()
+        )));
+    }
+    crate::restart::read(from, model)
 }
 
 /// Runs an already built model, writing `output` when given.
@@ -97,7 +129,7 @@ pub fn run_model(
         header: echo,
         steps: echo,
     };
-    run_model_with(rt, model, output, printing, None)
+    run_model_with(rt, model, output, printing, None, None)
 }
 
 fn run_model_with(
@@ -106,6 +138,7 @@ fn run_model_with(
     output: Option<&Path>,
     printing: Printing,
     provenance: Option<&Provenance>,
+    restart: Option<&crate::restart::RestartState>,
 ) -> Result<RunSummary> {
     let echo = printing.steps;
     if rt.rank() == 0 {
@@ -147,9 +180,9 @@ fn run_model_with(
             // a run killed at any moment has every step the CSV lists.
             let mut sink = Tee(history, &mut hertz);
             let mut sink = Tee(Hdf5Sink::new(file, &sim)?, &mut sink);
-            sim.run(rt, &mut sink, echo)?
+            sim.run(rt, &mut sink, echo, restart)?
         }
-        None => sim.run(rt, &mut hertz, echo)?,
+        None => sim.run(rt, &mut hertz, echo, restart)?,
     };
     Ok(RunSummary {
         model_name: model.name.clone(),
@@ -451,6 +484,20 @@ impl Hdf5Sink {
             vectors.push(("slip", flat(&v.slip)));
             // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
             scalars.push(("state", v.state.iter().map(|&s| f64::from(s)).collect()));
+            // The friction history, so `run --restart` continues exactly.
+            let records = &v.records;
+            vectors.push((
+                "lambda_t",
+                flat(&records.iter().map(|r| r.lambda).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                "slip_origin",
+                flat(&records.iter().map(|r| r.origin).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                "history_ids",
+                flat(&records.iter().map(|r| r.ids).collect::<Vec<_>>()),
+            ));
         }
         let order = &mut self.pairs[i];
         let rows = order.rows;

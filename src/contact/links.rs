@@ -3,7 +3,9 @@
 //! residual and tangent, and the Uzawa update of their multipliers.
 use super::dual::{dot, norm, sub};
 use super::link::{self, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
-use super::multipliers::{updated_multiplier, Multipliers, PointFriction, PointState};
+use super::multipliers::{
+    updated_multiplier, FrictionRecord, Multipliers, PointFriction, PointState,
+};
 use super::pair::{MasterSpec, PairSpec, RigidSurface};
 use super::search::{self, SearchIndex};
 use super::surfaces::{MasterSurface, SlaveSurface};
@@ -63,8 +65,25 @@ pub struct PointValues {
     pub traction: Vec<[f64; 3]>,
     pub slip: Vec<[f64; 3]>,
     pub state: Vec<i8>,
+    /// Friction history a restart needs (empty for a frictionless pair).
+    pub records: Vec<FrictionRecord>,
     /// Owned slave nodes: reference position and nodal contact pressure.
     pub nodes: Vec<([f64; 3], f64)>,
+}
+
+/// One pair's state as a result file stores it, whole-pair arrays in output
+/// row order: what [`ContactPair::restart_from`] takes over.
+#[derive(Debug, Clone, Default)]
+pub struct RestartRows {
+    pub lambda: Vec<f64>,
+    pub friction: Option<FrictionRows>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct FrictionRows {
+    pub records: Vec<FrictionRecord>,
+    pub state: Vec<f64>,
+    pub traction: Vec<[f64; 3]>,
 }
 
 /// A pair's contact force on the slave surface (this rank's part, or the
@@ -723,6 +742,47 @@ impl ContactPair {
         Ok(())
     }
 
+    /// Takes over a converged step's multipliers and friction history from a
+    /// result file, given as whole-pair arrays in output row order (set
+    /// facet × quadrature point), then commits them as the step end did.
+    pub fn restart_from(&mut self, rows: &RestartRows) -> Result<()> {
+        let nqp = self.slave.nqp;
+        let row_of = |i: usize| self.slave.facets[i / nqp].set_index * nqp + i % nqp;
+        let n = self.slave.num_qps();
+        let lambda = (0..n)
+            .map(|i| rows.lambda.get(row_of(i)).copied())
+            .collect::<Option<Vec<f64>>>()
+            .filter(|l| l.iter().all(|v| v.is_finite() && *v >= 0.0))
+            .ok_or_else(|| self.restart_error("lambda_n"))?;
+        let friction = match (&self.multipliers.tangential, &rows.friction) {
+            (None, _) => None,
+            (Some(_), None) => return Err(self.restart_error("friction history")),
+            (Some(_), Some(f)) => Some(
+                (0..n)
+                    .map(|i| {
+                        let r = row_of(i);
+                        PointFriction::from_record(
+                            f.records.get(r)?,
+                            *f.state.get(r)?,
+                            *f.traction.get(r)?,
+                        )
+                    })
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or_else(|| self.restart_error("friction history"))?,
+            ),
+        };
+        self.restore(PairSnapshot { lambda, friction })?;
+        self.commit()
+    }
+
+    fn restart_error(&self, what: &str) -> Error {
+        Error::Restart(format!(
+            "contact pair '{}': the file's {what} does not fit this pair's {} slave points",
+            self.spec.name,
+            self.slave.global_facets * self.slave.nqp
+        ))
+    }
+
     /// The multipliers and friction state, to restore on a cutback.
     pub fn snapshot(&self) -> PairSnapshot {
         PairSnapshot {
@@ -821,12 +881,14 @@ impl ContactPair {
             traction: Vec::new(),
             slip: Vec::new(),
             state: Vec::new(),
+            records: Vec::new(),
             nodes: self.node_values()?,
         };
         if let Some(t) = &self.multipliers.tangential {
             values.traction = t.points.iter().map(|p| p.traction).collect();
             values.slip = t.points.iter().map(|p| p.slip).collect();
             values.state = t.points.iter().map(|p| p.state as i8).collect();
+            values.records = t.points.iter().map(PointFriction::record).collect();
         }
         let mut force = PairForce::default();
         for (l, s) in self.links.iter().zip(&states) {

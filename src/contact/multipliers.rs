@@ -66,6 +66,66 @@ pub struct PointFriction {
     pub slip: [f64; 3],
 }
 
+/// What a result file keeps of a point's friction state so that a restart
+/// continues exactly: λT and where the next step's slip is measured from
+/// (the uncommitted `next_origin`; `commit` runs again after reading).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrictionRecord {
+    pub lambda: [f64; 3],
+    pub origin: [f64; 3],
+    /// `lambda_facet`, 1 if there is an origin (else 0), the origin's facet;
+    /// stored as f64 like every step array (exact below 2⁵³).
+    pub ids: [f64; 3],
+}
+
+impl PointFriction {
+    pub fn record(&self) -> FrictionRecord {
+        let (origin, has, facet) = match self.next_origin {
+            Some((o, f)) => (o, 1.0, f64::from(f)),
+            None => ([0.0; 3], 0.0, 0.0),
+        };
+        FrictionRecord {
+            lambda: self.lambda,
+            origin,
+            ids: [f64::from(self.lambda_facet), has, facet],
+        }
+    }
+
+    /// The state a record, the stored `state` (0, 1, 2) and traction
+    /// describe (the traction feeds the next Uzawa test's force change);
+    /// `None` when the numbers cannot have come from
+    /// [`PointFriction::record`].
+    pub fn from_record(r: &FrictionRecord, state: f64, traction: [f64; 3]) -> Option<Self> {
+        // Exact small integers only: anything else was not written by `record`.
+        let id = |v: f64| u32::try_from(v as i64).ok().filter(|&i| f64::from(i) == v);
+        let state = [PointState::Open, PointState::Stick, PointState::Slip]
+            .into_iter()
+            .find(|s| f64::from(*s as u8) == state)?;
+        let next_origin = if r.ids[1] == 0.0 {
+            None
+        } else if r.ids[1] == 1.0 {
+            Some((r.origin, id(r.ids[2])?))
+        } else {
+            return None;
+        };
+        let finite = r
+            .lambda
+            .iter()
+            .chain(&r.origin)
+            .chain(&traction)
+            .all(|v| v.is_finite());
+        finite.then_some(PointFriction {
+            lambda: r.lambda,
+            lambda_facet: id(r.ids[0])?,
+            origin: None,
+            next_origin,
+            state,
+            traction,
+            slip: [0.0; 3],
+        })
+    }
+}
+
 /// Values per point in the friction halo: traction (3), λT (3), origin (3),
 /// state (1).
 const FRICTION_WIDTH: usize = 10;
@@ -354,6 +414,32 @@ fn contiguous_numbering(owner: &[usize], nranks: usize) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn friction_record_round_trips() {
+        let p = PointFriction {
+            lambda: [0.5, -0.25, 0.0],
+            lambda_facet: 17,
+            origin: Some(([0.1, 0.2, 0.0], 3)),
+            next_origin: Some(([0.3, -0.4, 0.0], 18)),
+            state: PointState::Slip,
+            traction: [1.0, 2.0, 3.0],
+            slip: [0.0; 3],
+        };
+        let back = PointFriction::from_record(&p.record(), 2.0, p.traction).unwrap();
+        assert_eq!(back.lambda, p.lambda);
+        assert_eq!(back.lambda_facet, 17);
+        assert_eq!(back.next_origin, p.next_origin);
+        assert_eq!(back.state, PointState::Slip);
+        assert_eq!(back.traction, p.traction);
+        let open = PointFriction::default();
+        let back = PointFriction::from_record(&open.record(), 0.0, [0.0; 3]).unwrap();
+        assert_eq!(back.next_origin, None);
+        let mut bad = p.record();
+        bad.ids[0] = 1.5;
+        assert!(PointFriction::from_record(&bad, 2.0, p.traction).is_none());
+        assert!(PointFriction::from_record(&p.record(), 7.0, p.traction).is_none());
+    }
 
     #[test]
     fn update_rule_is_the_positive_part() {

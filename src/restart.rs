@@ -1,0 +1,174 @@
+//! `run --restart OUT.h5`: the last converged step of a result file read back
+//! (displacement, every pair's λN and friction history) so that a run
+//! continues from it and ends where an uninterrupted run ends.
+//!
+//! Every rank reads the file on its own (serial HDF5, read-only): the arrays
+//! are in natural order, and each rank picks its own rows. The file must come
+//! from the same scene: same mesh (node count and coordinates, cell count),
+//! same contact pairs; anything else is an error naming the file and what
+//! differs, raised before any solve.
+use crate::contact::links::{FrictionRows, RestartRows};
+use crate::contact::multipliers::FrictionRecord;
+use crate::error::{Error, Result};
+use crate::output::{list_steps, read_dataset, read_nodal, read_step_attrs, OutputError};
+use crate::solve::Model;
+use std::path::{Path, PathBuf};
+
+/// What a run continues from.
+#[derive(Debug, Clone)]
+pub struct RestartState {
+    pub path: PathBuf,
+    /// Index of the step continued from; the next one written is `step + 1`.
+    pub step: usize,
+    pub load_factor: f64,
+    /// Natural node order, 3 per node.
+    pub displacement: Vec<f64>,
+    /// Per contact pair of the model, in the model's order.
+    pub pairs: Vec<RestartRows>,
+}
+
+/// Reads the last step of `path` for `model`.
+pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
+    let fail = |message: String| Error::Restart(format!("{}: {message}", path.display()));
+    let h5 = |e: OutputError| fail(e.to_string());
+    if model.dynamics.is_some() {
+        return Err(fail(
+            "continuing a dynamic scene is not supported (the file holds no accelerations)".into(),
+        ));
+    }
+    check_mesh(path, model).map_err(fail)?;
+    let step = *list_steps(path)
+        .map_err(h5)?
+        .last()
+        .ok_or_else(|| fail("the file holds no converged step to continue from".into()))?;
+    let info = read_step_attrs(path, step).map_err(h5)?;
+    if info.load_factor >= 1.0 - 1e-12 {
+        return Err(fail(format!(
+            "step {step} already reached the full load (load factor {}); nothing to continue",
+            info.load_factor
+        )));
+    }
+    let n = model.mesh.num_nodes();
+    let displacement = read_columns(path, step, "displacement", n, 3)?;
+    let pairs = model
+        .contact
+        .iter()
+        .map(|p| read_pair(path, step, &p.name, p.active_friction().is_some()))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(RestartState {
+        path: path.to_path_buf(),
+        step,
+        load_factor: info.load_factor,
+        displacement,
+        pairs,
+    })
+}
+
+/// The file's mesh must be the model's: same cells and nodes, same places.
+fn check_mesh(path: &Path, model: &Model) -> std::result::Result<(), String> {
+    let mesh = &model.mesh;
+    let (nodes, shape) = read_dataset::<f64>(path, "/mesh/nodes").map_err(|e| e.to_string())?;
+    if shape != [mesh.num_nodes(), 3] {
+        return Err(format!(
+            "written for another mesh: {} nodes, this scene has {}",
+            shape.first().copied().unwrap_or(0),
+            mesh.num_nodes()
+        ));
+    }
+    let (_, cells) = read_dataset::<i64>(path, "/mesh/cells").map_err(|e| e.to_string())?;
+    if cells.first() != Some(&mesh.num_cells()) {
+        return Err(format!(
+            "written for another mesh: {} cells, this scene has {}",
+            cells.first().copied().unwrap_or(0),
+            mesh.num_cells()
+        ));
+    }
+    let scale = mesh
+        .bounding_box()
+        .map_or(1.0, |b| b.diagonal())
+        .max(f64::MIN_POSITIVE);
+    let moved = mesh
+        .nodes
+        .iter()
+        .flatten()
+        .zip(&nodes)
+        .position(|(a, b)| (a - b).abs() > 1e-12 * scale);
+    match moved {
+        Some(i) => Err(format!(
+            "written for another mesh: node {} is elsewhere (another scene, or other --set mesh values?)",
+            i / 3
+        )),
+        None => Ok(()),
+    }
+}
+
+fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<RestartRows> {
+    let dir = format!("contact/{name}");
+    let lambda = read_any_rows(path, step, &format!("{dir}/lambda_n"), 1)?;
+    let friction = if friction {
+        let rows = lambda.len();
+        let triples = |field: &str| -> Result<Vec<[f64; 3]>> {
+            let v = read_columns(path, step, &format!("{dir}/{field}"), rows, 3)?;
+            Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+        };
+        let (lambda_t, origin, ids) = (
+            triples("lambda_t")?,
+            triples("slip_origin")?,
+            triples("history_ids")?,
+        );
+        let records = lambda_t
+            .into_iter()
+            .zip(origin)
+            .zip(ids)
+            .map(|((lambda, origin), ids)| FrictionRecord {
+                lambda,
+                origin,
+                ids,
+            })
+            .collect();
+        Some(FrictionRows {
+            records,
+            state: read_columns(path, step, &format!("{dir}/state"), rows, 1)?,
+            traction: triples("traction_t")?,
+        })
+    } else {
+        None
+    };
+    Ok(RestartRows { lambda, friction })
+}
+
+/// `/steps/<step>/<name>` with `cols` columns, any number of rows.
+fn read_any_rows(path: &Path, step: usize, name: &str, cols: usize) -> Result<Vec<f64>> {
+    let (data, _, c) = read_nodal(path, step, name).map_err(|e| {
+        Error::Restart(format!(
+            "{}: {e} (a file written before restarts existed, or by another scene?)",
+            path.display()
+        ))
+    })?;
+    if c != cols {
+        return Err(Error::Restart(format!(
+            "{}: step {step} {name} has {c} columns, expected {cols}",
+            path.display()
+        )));
+    }
+    Ok(data)
+}
+
+/// As [`read_any_rows`], with the row count checked too.
+fn read_columns(
+    path: &Path,
+    step: usize,
+    name: &str,
+    rows: usize,
+    cols: usize,
+) -> Result<Vec<f64>> {
+    let data = read_any_rows(path, step, name, cols)?;
+    if data.len() != rows * cols {
+        return Err(Error::Restart(format!(
+            "{}: step {step} {name} has {} rows, expected {rows}",
+            path.display(),
+            data.len() / cols
+        )));
+    }
+    Ok(data)
+}

@@ -1,0 +1,129 @@
+//! `run --restart`: a run cut short and continued from its last converged
+//! step ends where the uninterrupted run ends (multipliers and friction
+//! history included), and files that cannot be continued from are refused
+//! with the reason.
+mod common;
+use common::*;
+use contactlink::output::{list_steps, read_nodal};
+use std::path::{Path, PathBuf};
+
+fn run_ok(ranks: usize, args: &[&str]) -> String {
+    let o = mpirun(ranks, args);
+    let t = text(&o);
+    assert!(o.status.success(), "{args:?} on {ranks} ranks failed:\n{t}");
+    t
+}
+
+/// A copy of `full` holding only its first `keep` steps: what a run killed
+/// after step `keep` leaves behind.
+fn cut_after(full: &Path, keep: usize, name: &str) -> PathBuf {
+    let cut = full.with_file_name(name);
+    std::fs::copy(full, &cut).expect("copy result file");
+    let file = hdf5::File::open_rw(&cut).expect("open copy");
+    let steps = file.group("steps").expect("/steps");
+    for step in list_steps(full)
+        .expect("steps")
+        .into_iter()
+        .filter(|&s| s > keep)
+    {
+        steps.unlink(&format!("{step:06}")).expect("unlink step");
+    }
+    cut
+}
+
+fn field(path: &Path, step: usize, name: &str) -> Vec<f64> {
+    read_nodal(path, step, name).expect(name).0
+}
+
+/// Runs `scene` whole, cuts the file after `keep` steps, continues from it
+/// on `ranks` ranks and compares the last steps.
+fn continued_run_matches(scene: &str, extra: &[&str], keep: usize, ranks: usize, pair: &str) {
+    let dir = scratch(&format!("restart-{scene}-{ranks}"));
+    let full = dir.join("full.h5");
+    let mut args = vec!["run", scene, "-q", "-o", full.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    run_ok(1, &args);
+    let steps = list_steps(&full).unwrap();
+    let last = *steps.last().unwrap();
+    assert!(
+        last > keep,
+        "{scene}: {last} steps, cannot cut after {keep}"
+    );
+
+    let cut = cut_after(&full, keep, "cut.h5");
+    let cont = dir.join("continued.h5");
+    let mut args = vec!["run", scene, "-q", "-o", cont.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend_from_slice(&["--restart", cut.to_str().unwrap()]);
+    run_ok(ranks, &args);
+
+    // The continued file numbers its steps on from the restart step.
+    let cont_steps = list_steps(&cont).unwrap();
+    assert_eq!(cont_steps.first(), Some(&(keep + 1)), "{scene}");
+    assert_eq!(cont_steps.last(), Some(&last), "{scene}");
+    for name in ["displacement", "reaction"] {
+        let d = relative_difference(&field(&full, last, name), &field(&cont, last, name));
+        assert!(d < 1e-9, "{scene}: final {name} differs by {d:e}");
+    }
+    let force = |p: &Path| field(p, last, &format!("contact/{pair}/force"));
+    let d = relative_difference(&force(&full), &force(&cont));
+    assert!(d < 1e-9, "{scene}: final contact force differs by {d:e}");
+    eprintln!(
+        "{scene}: continued after step {keep} of {last} on {ranks} rank(s): final fields match"
+    );
+}
+
+#[test]
+fn frictional_block_slide_continues_exactly() {
+    // Cut in the sliding phase: λT and the slip origins must carry over.
+    continued_run_matches("block-slide", &[], 14, 1, "floor");
+    continued_run_matches("block-slide", &[], 14, 2, "floor");
+}
+
+#[test]
+fn hertz_cylinder_continues_exactly() {
+    let extra = ["--set", "mesh.fine_size=0.4", "--set", "steps.count=4"];
+    continued_run_matches("hertz-cylinder", &extra, 2, 2, "hertz");
+}
+
+#[test]
+fn files_that_cannot_be_continued_are_refused() {
+    let dir = scratch("restart-refused");
+    let full = dir.join("full.h5");
+    let f = full.to_str().unwrap();
+    run_ok(1, &["run", "patch-test", "-q", "-o", f]);
+
+    let refused = |args: &[&str], why: &str| {
+        let o = run(args);
+        let t = text(&o);
+        assert!(!o.status.success(), "{args:?} should fail");
+        assert!(t.contains(why), "{args:?}: expected '{why}' in:\n{t}");
+        assert!(!t.contains("panicked"), "{t}");
+    };
+    let other = dir.join("other.h5");
+    let o = other.to_str().unwrap();
+    refused(
+        &["run", "patch-test", "-q", "-o", o, "--restart", f],
+        "already reached the full load",
+    );
+    refused(
+        &["run", "patch-test", "-q", "-o", f, "--restart", f],
+        "would overwrite the file it continues from",
+    );
+    refused(
+        &["run", "block-on-plane", "-q", "-o", o, "--restart", f],
+        "written for another mesh",
+    );
+    refused(
+        &[
+            "run",
+            "patch-test",
+            "-q",
+            "-o",
+            o,
+            "--restart",
+            "/nonexistent/x.h5",
+        ],
+        "/nonexistent/x.h5",
+    );
+}
