@@ -524,7 +524,7 @@ fn check_prints_sizes_conditions_and_pairs() {
         "dirichlet block.bottom: 158 nodes, components x y z",
         "contact hertz: slave cylinder.curved (86 facets), master block.top (78 facets), frictionless",
         "quasi-static",
-        "steps 2, output out/hertz-cylinder.h5",
+        "steps 1, output out/hertz-cylinder.h5",
     ] {
         assert!(t.contains(needle), "no {needle:?} in:\n{t}");
     }
