@@ -20,6 +20,9 @@ fn hertz_run(dir: &Path) -> (std::path::PathBuf, String) {
             out.to_str().unwrap(),
             "--set",
             "mesh.fine_size=0.4",
+            // Two steps, so the summary has more than one row.
+            "--set",
+            "steps.count=2",
         ],
     );
     let t = text(&o);
