@@ -432,7 +432,10 @@ impl SearchIndex {
         let Some(range) = self.grid.cell_range(lo, hi) else {
             return;
         };
-        self.grid.for_each_cell(range, |cell| {
+        // Only cells within r: a facet box within r of x has its point
+        // nearest x in one of them (the cube of the range is about twice
+        // the ball, and a curved master fills many of its cells).
+        self.grid.for_each_cell_within(range, x, r, |cell| {
             for &f in self.cell_facets.row(cell) {
                 self.consider(surface, f, self.facet_lower_bound2(f, x), x, sel);
             }
@@ -947,6 +950,36 @@ impl Grid {
             let g = (lo[a] - x[a]).max(x[a] - hi[a]).max(0.0);
             g * g
         })
+    }
+
+    /// [`Grid::for_each_cell`] restricted to the cells within distance `r`
+    /// of `x` (with the grid's rounding slack), skipping whole rows at once.
+    fn for_each_cell_within(
+        &self,
+        range: [[usize; 2]; 3],
+        x: [f64; 3],
+        r: f64,
+        mut f: impl FnMut(usize),
+    ) {
+        let reach = r + GRID_PAD_REL * self.cell;
+        let r2 = reach * reach;
+        for l in range[2][0]..=range[2][1] {
+            let gap_z = self.gap2(2, l, x[2]);
+            if gap_z > r2 {
+                continue;
+            }
+            for j in range[1][0]..=range[1][1] {
+                let gap_yz = gap_z + self.gap2(1, j, x[1]);
+                if gap_yz > r2 {
+                    continue;
+                }
+                for i in range[0][0]..=range[0][1] {
+                    if gap_yz + self.gap2(0, i, x[0]) <= r2 {
+                        f(self.index([i, j, l]));
+                    }
+                }
+            }
+        }
     }
 
     fn for_each_cell(&self, range: [[usize; 2]; 3], mut f: impl FnMut(usize)) {
