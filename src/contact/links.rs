@@ -819,6 +819,22 @@ impl ContactPair {
         self.spec.motion.map(|c| c * a)
     }
 
+    /// Multiplies the normal penalty by `factor`, and the tangential one
+    /// when it follows the normal one (no `tangential_penalty` given). The
+    /// multipliers are kept: the augmented Lagrangian converges to the same
+    /// solution for any penalty, only faster for a larger one.
+    pub fn raise_penalty(&mut self, factor: f64) {
+        self.penalty *= factor;
+        self.facet_penalty.iter_mut().for_each(|p| *p *= factor);
+        let follows = self
+            .spec
+            .active_friction()
+            .is_some_and(|f| f.penalty.is_none());
+        if let (true, Some(f)) = (follows, &mut self.friction) {
+            f.penalty.iter_mut().for_each(|p| *p *= factor);
+        }
+    }
+
     /// This rank's points in contact (λN > 0) and, of those, sliding.
     pub fn multiplier_states(&self) -> (usize, usize) {
         let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();

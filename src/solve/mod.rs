@@ -770,12 +770,16 @@ fn uzawa_loop(
     let mut linear = 0usize;
     let mut history = Vec::new();
     let mut k = 0;
+    let mut raises = 0;
+    // Uzawa iterations over every round (k counts within one).
+    let mut total = 0;
     // What the links carried into this step (the last converged step's
     // multipliers), replaced after every Uzawa update: reported if Newton
     // fails for good.
     let mut last_links = link_summaries(world, mech.contact);
     loop {
         k += 1;
+        total += 1;
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
         snes.set_lag_preconditioner(
@@ -814,15 +818,30 @@ fn uzawa_loop(
             .map(|p| p.spec.name.clone())
             .zip(stats.iter().copied())
             .collect();
-        let converged = mech.contact.iter().zip(&stats).all(|(p, s)| {
-            s.max_penetration <= p.spec.penetration_tol
-                && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
-        });
+        let converged = mech
+            .contact
+            .iter()
+            .zip(&stats)
+            .all(|(p, s)| pair_converged(p, s));
         if converged {
             outcome.iterations = newton;
             outcome.linear_iterations = linear;
             outcome.history = history;
-            return Ok(Ok((outcome, k, stats)));
+            return Ok(Ok((outcome, total, stats)));
+        }
+        if k >= max_uzawa && raises < PENALTY_RAISES {
+            // Converging too slowly (soft bodies, long sliding): the
+            // augmented Lagrangian keeps its solution for any penalty and
+            // converges faster with a larger one, so raise it for the pairs
+            // still outside their tolerances and give Uzawa another round.
+            raises += 1;
+            for (p, s) in mech.contact.iter_mut().zip(&stats) {
+                if !pair_converged(p, s) {
+                    p.raise_penalty(PENALTY_RAISE);
+                }
+            }
+            k = 0;
+            continue;
         }
         if k >= max_uzawa {
             let worst = stats
@@ -837,11 +856,23 @@ fn uzawa_loop(
                     sliding: a.sliding + s.sliding,
                 });
             return Ok(Err(StepFailure::Uzawa {
-                iterations: k,
+                iterations: total,
                 stats: worst,
             }));
         }
     }
+}
+
+/// How often, and by how much, a step may raise a slow pair's penalty
+/// before the Uzawa loop gives up (the raised penalty stays for the run).
+const PENALTY_RAISES: usize = 2;
+const PENALTY_RAISE: f64 = 10.0;
+
+/// The Uzawa test of one pair: penetration and multiplier change within the
+/// pair's tolerances.
+fn pair_converged(p: &ContactPair, s: &UzawaStats) -> bool {
+    s.max_penetration <= p.spec.penetration_tol
+        && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
 }
 
 /// Per pair: points in contact and sliding under the current multipliers
@@ -885,7 +916,8 @@ fn failure_text(f: &StepFailure) -> String {
             text
         }
         StepFailure::Uzawa { iterations, stats } => format!(
-            "Uzawa loop did not converge in {iterations} iterations (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
+            "Uzawa loop did not converge in {iterations} iterations, the last ones with the penalty raised {}× (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
+            PENALTY_RAISE.powi(PENALTY_RAISES as i32),
             stats.max_penetration, stats.max_change, stats.max_force
         ),
     }
