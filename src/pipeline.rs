@@ -526,6 +526,12 @@ impl Hdf5Sink {
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
         self.file
             .write_step_small(step, &format!("contact/{name}/force"), &force)?;
+        // The pair's penalty (raised when Uzawa was slow), for a restart.
+        self.file.write_step_small(
+            step,
+            &format!("contact/{name}/penalty"),
+            &[fields.pair.penalty],
+        )?;
         Ok(())
     }
 }

@@ -134,7 +134,15 @@ fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<Res
     } else {
         None
     };
-    Ok(RestartRows { lambda, friction })
+    // Files from before penalties were written have none: keep the scene's.
+    let penalty = read_nodal(path, step, &format!("{dir}/penalty"))
+        .ok()
+        .and_then(|(v, _, _)| v.first().copied());
+    Ok(RestartRows {
+        penalty,
+        lambda,
+        friction,
+    })
 }
 
 /// `/steps/<step>/<name>` with `cols` columns, any number of rows.

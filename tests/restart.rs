@@ -87,6 +87,21 @@ fn hertz_cylinder_continues_exactly() {
 }
 
 #[test]
+fn a_raised_penalty_carries_over() {
+    // Two Uzawa iterations allowed: the first step raises the penalty ×10,
+    // and the continued run must go on with the raised one.
+    let extra = [
+        "--set",
+        "mesh.fine_size=0.4",
+        "--set",
+        "steps.count=4",
+        "--set",
+        "contact.max_uzawa=2",
+    ];
+    continued_run_matches("hertz-cylinder", &extra, 2, 1, "hertz");
+}
+
+#[test]
 fn files_that_cannot_be_continued_are_refused() {
     let dir = scratch("restart-refused");
     let full = dir.join("full.h5");

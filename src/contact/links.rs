@@ -75,6 +75,8 @@ pub struct PointValues {
 /// row order: what [`ContactPair::restart_from`] takes over.
 #[derive(Debug, Clone, Default)]
 pub struct RestartRows {
+    /// The pair's penalty at that step (None in files that lack it).
+    pub penalty: Option<f64>,
     pub lambda: Vec<f64>,
     pub friction: Option<FrictionRows>,
 }
@@ -771,6 +773,10 @@ impl ContactPair {
                     .ok_or_else(|| self.restart_error("friction history"))?,
             ),
         };
+        if let Some(p) = rows.penalty.filter(|p| p.is_finite() && *p > 0.0) {
+            // Raised during the first run: continue with the same penalty.
+            self.raise_penalty(p / self.penalty);
+        }
         self.restore(PairSnapshot { lambda, friction })?;
         self.commit()
     }
