@@ -280,3 +280,24 @@ fn a_frictionless_static_scene_carries_no_friction_or_dynamics_data() {
     );
     assert!((n0 - n1).abs() < 1e-6 * n0, "{n0} vs {n1}");
 }
+
+#[test]
+fn extrapolating_predictor_changes_iterations_not_the_answer() {
+    let dir = scratch("friction-extrapolate");
+    let (on, off) = (dir.join("on.h5"), dir.join("off.h5"));
+    run_scene(1, "block-slide", &on, &["--set", "solver.extrapolate=true"]);
+    run_scene(1, "block-slide", &off, &[]);
+    let (a, b) = (history(&on), history(&off));
+    assert_eq!(a.len(), b.len());
+    let newton = |rows: &[HashMap<String, f64>]| rows.iter().map(|r| r["newton"]).sum::<f64>();
+    assert!(
+        newton(&a) < newton(&b),
+        "extrapolation should save Newton iterations on block-slide ({} vs {})",
+        newton(&a),
+        newton(&b)
+    );
+    for k in ["floor.fx", "floor.fz", "floor.normal", "floor.tangential"] {
+        let (x, y) = (a.last().unwrap()[k], b.last().unwrap()[k]);
+        assert!((x - y).abs() <= 1e-9 * y.abs().max(1.0), "{k}: {x} vs {y}");
+    }
+}

@@ -655,9 +655,9 @@ struct StepContext<'s> {
 /// The initial guess of a load step: the last converged state, or the last
 /// two extrapolated linearly in the load factor.
 struct Predictor {
-    /// The converged state before the last one, and its load factor.
+    /// The converged state before the last one, and its load factor
+    /// (None: no extrapolation).
     older: Option<(Vector, f64)>,
-    enabled: bool,
 }
 
 impl Predictor {
@@ -667,7 +667,7 @@ impl Predictor {
         } else {
             None
         };
-        Ok(Predictor { older, enabled })
+        Ok(Predictor { older })
     }
 
     /// x ← x + (to − from)/(from − f_older)·(x − x_older), once two converged
@@ -690,7 +690,7 @@ impl Predictor {
 
     /// A step from `x_start` (converged at load `f_start`) has converged.
     fn accept(&mut self, x_start: &Vector, f_start: f64) -> Result<()> {
-        if let (true, Some((older, f_older))) = (self.enabled, self.older.as_mut()) {
+        if let Some((older, f_older)) = self.older.as_mut() {
             older.copy_from(x_start)?;
             *f_older = f_start;
         }
