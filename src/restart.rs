@@ -10,7 +10,7 @@
 use crate::contact::links::{FrictionRows, RestartRows};
 use crate::contact::multipliers::FrictionRecord;
 use crate::error::{Error, Result};
-use crate::output::{list_steps, read_dataset, read_nodal, read_step_attrs, OutputError};
+use crate::output::{read_dataset, read_nodal, read_step_attrs, OutputError};
 use crate::solve::Model;
 use std::path::{Path, PathBuf};
 
@@ -36,9 +36,11 @@ pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
             "continuing a dynamic scene is not supported (the file holds no accelerations)".into(),
         ));
     }
+    // The same checks as `summary`: a missing file, not a result file, or
+    // one without a converged step each get one plain sentence.
+    let steps = crate::results::open_steps(path).map_err(|e| Error::Restart(e.to_string()))?;
     check_mesh(path, model).map_err(fail)?;
-    let step = *list_steps(path)
-        .map_err(h5)?
+    let step = *steps
         .last()
         .ok_or_else(|| fail("the file holds no converged step to continue from".into()))?;
     let info = read_step_attrs(path, step).map_err(h5)?;

@@ -680,11 +680,10 @@ impl Predictor {
         if span.is_nan() || span <= 0.0 {
             return Ok(());
         }
+        // x + r (x − x_older) = (1 + r) x − r x_older, without a work vector.
         let ratio = (to - from) / span;
-        let mut delta = x.duplicate()?;
-        delta.copy_from(x)?;
-        delta.axpy(-1.0, older)?;
-        x.axpy(ratio, &delta)?;
+        x.scale(1.0 + ratio)?;
+        x.axpy(-ratio, older)?;
         Ok(())
     }
 
