@@ -67,7 +67,10 @@ fn run(rt: &Runtime, path: &Path) -> Result<bool, String> {
     if rt.rank() == 0 {
         println!(
             "gmsh_mesh: {}: {} {} cells, {} nodes, bodies {}; {} cell(s) reoriented, {} unused node(s) dropped",
-            path.display(),
+            // The default file relative to the crate, as the docs name it.
+            path.strip_prefix(env!("CARGO_MANIFEST_DIR"))
+                .unwrap_or(path)
+                .display(),
             mesh.num_cells(),
             mesh.cell_type.name(),
             mesh.num_nodes(),

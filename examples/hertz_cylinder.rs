@@ -96,7 +96,7 @@ fn run(rt: &Runtime, fine_size: f64, output: Option<PathBuf>) -> Result<bool, St
     let ok = hertz.p0_error().abs() <= TOLERANCE && hertz.width_error().abs() <= TOLERANCE;
     if rt.rank() == 0 {
         println!(
-            "hertz_cylinder: fine size {fine_size}, {} cells, {} ranks, load P = {:.4} per unit length",
+            "hertz_cylinder: fine size {fine_size}, {} cells, {} rank(s), load P = {:.4} per unit length",
             summary.cells,
             rt.size(),
             hertz.load
