@@ -1125,7 +1125,7 @@ fn amplitude(
     }
 }
 
-/// Gauss points on quadrilateral slave facets (the seed's choice); on
+/// Gauss points on quadrilateral slave facets (docs/formulation.md §2.4); on
 /// triangles, the slave nodes. Three Gauss points per triangle put about six
 /// constraints on every slave node of a tet mesh, more than linear tets can
 /// meet: the Uzawa loop then stalls just above its tolerance (sphere-block:

@@ -1,4 +1,4 @@
-//! Contact: the ContactLink3D condition (DESIGN.md §2–§3).
+//! Contact: the ContactLink3D condition (docs/formulation.md §2–§5, §9).
 //!
 //! - `pair`: what a scene says about a pair;
 //! - `surfaces`: the slave and master sides as one rank sees them;

@@ -154,7 +154,7 @@ impl MasterSpec {
 /// Where a slave facet's contact links sit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SlaveQuadrature {
-    /// At the facet's Gauss points (2×2 / 3-point), as the seed does. There are
+    /// At the facet's Gauss points (2×2 / 3-point; docs/formulation.md §2.4). There are
     /// more points than slave nodes, so where the Uzawa loop enforces the
     /// constraint exactly the multipliers are not unique; the loop therefore
     /// judges convergence by the nodal contact forces, which are.

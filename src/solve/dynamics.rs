@@ -5,8 +5,8 @@
 //!
 //! Friction in dynamics measures slip from the relative velocity, which the
 //! integrator makes affine in `u` (`v = γ/(βΔt) u + …`): the links get that
-//! map ([`SlipRateMap`]) and their tangent then carries the seed's damping
-//! contribution `γ/(βΔt) ∂f/∂v`.
+//! map ([`SlipRateMap`]) and their tangent then carries the friction damping
+//! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
 use super::newmark::{Coefficients, Newmark};
 use crate::assembly::BulkAssembler;
 use crate::contact::links::SlipRateMap;

@@ -753,7 +753,7 @@ fn prepare_time_step(
 
 type StepResult = std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), StepFailure>;
 
-/// The seed's Uzawa loop for one load step: Newton with λ fixed, then
+/// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
 /// λ ← ⟨λ − εN gN⟩ at every link, until the penetration and the multiplier
 /// change meet the tolerances on every rank (or there is no contact).
 /// Newton iterations are summed over the Uzawa iterations.

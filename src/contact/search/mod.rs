@@ -1,7 +1,7 @@
 //! Contact search: which master facet, and which point on it, a slave point
-//! sees (DESIGN §2 "Search", seed "Contact Search").
+//! sees (docs/formulation.md §9).
 //!
-//! Two stages, as in the seed:
+//! Two stages:
 //!
 //! - **outer search**: the master node closest to the slave point, from a
 //!   uniform bucket grid over the master nodes. It is exact: grid shells are

@@ -283,7 +283,7 @@ fn closest_node_equals_brute_force_on_random_clouds() {
 
 #[test]
 fn closest_node_ties_go_to_smaller_id() {
-    // Node 4 duplicates node 1; a query midway between nodes 0 and 1.
+    // Node 4 sits on node 1; a query midway between nodes 0 and 1.
     let mesh: Mesh = (
         vec![
             [0.0, 0.0, 0.0],
