@@ -24,10 +24,11 @@ use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
-use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, Vector};
+use crate::parallel::{self, fault, fault::FaultPhase};
+use crate::petsc::snes::CallbackError;
+use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, SnesReason, Vector};
 use crate::restart::RestartState;
 use crate::runtime::Runtime;
-use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use phases::{Phase, PhaseTimes};
 use std::time::Instant;
@@ -285,11 +286,17 @@ pub struct Simulation<'m> {
     jac: Matrix,
 }
 
-/// Why a load increment failed.
+/// Why a load increment failed (the same on every rank).
 enum StepFailure {
-    /// Newton failed; with the link states of the last Uzawa update before
-    /// it (empty when it failed in the step's first solve).
-    Newton(SnesOutcome, Vec<(String, UzawaStats)>),
+    /// The step's first residual, before Newton, failed on some rank.
+    Residual(String),
+    /// Newton failed; with the link states at the failing iterate, and for
+    /// a failed linear solve the rank whose Jacobian rows are not finite.
+    Newton {
+        outcome: SnesOutcome,
+        links: Vec<(String, LinkSummary)>,
+        jacobian: Option<String>,
+    },
     Uzawa {
         iterations: usize,
         stats: UzawaStats,
@@ -340,11 +347,13 @@ impl<'m> Simulation<'m> {
         // Phases booked here; the callbacks book theirs in `mech.times`.
         let mut times = PhaseTimes::default();
         // Frictionless contact keeps the tangent symmetric (it is the Hessian
-        // of a potential); friction and follower loads do not.
+        // of a potential); friction and follower loads do not. A follower
+        // load's facets may sit on some ranks only: the choice is agreed, or
+        // the ranks would factor one matrix as LU and LDLᵀ at once.
         let friction = self.contact.iter().any(ContactPair::has_friction);
-        let symmetric = !self.loads.has_follower()
-            && !friction
-            && model.materials.iter().all(Material::tangent_is_symmetric);
+        let follower = parallel::any_rank(&world, self.loads.has_follower());
+        let symmetric =
+            !follower && !friction && model.materials.iter().all(Material::tangent_is_symmetric);
         let tangent = TangentKind {
             symmetric,
             linear_bulk: model.materials.iter().all(Material::is_linear),
@@ -434,14 +443,17 @@ impl<'m> Simulation<'m> {
             let step_start_times = add_times(&times, &mech.times);
             if !mech.contact.is_empty() {
                 let mark = PhaseMark::new(&mech);
-                let changed = stages.scope(Phase::ContactSearch, || {
+                let searched = stages.scope(Phase::ContactSearch, || {
                     mech.with_state(&x, |u, pairs| {
-                        Ok(pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c))
+                        let changed = pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c);
+                        fault::check(FaultPhase::Search)?;
+                        Ok(changed)
                     })
-                })?;
+                });
+                let changed = parallel::agree(&world, searched)?;
                 mark.book(Phase::ContactSearch, &mut times, &mech);
                 let rebuild = !model.solver.reuse.pattern || pattern_builds == 0;
-                if any_rank(&world, changed) || rebuild {
+                if parallel::any_rank(&world, changed) || rebuild {
                     // A new coupling pattern is contact assembly's cost.
                     *jac = stages.time(Phase::ContactAssembly, &mut times, || {
                         build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)
@@ -449,29 +461,46 @@ impl<'m> Simulation<'m> {
                     pattern_builds += 1;
                 }
             }
+            // The step's first residual (the step's own force scale when no
+            // atol is given) fails like any other: into the cutback path.
+            let mut first = Ok(());
             if model.solver.atol.is_none() && !user_atol {
                 // The step's own force scale: the residual once the new loads
                 // and prescribed displacements are in place.
-                let r0 = mech.residual_norm(&x, &mut r)?;
-                snes.set_tolerances(
-                    (model.solver.rtol * r0).max(atol_floor),
-                    model.solver.rtol,
-                    0.0,
-                    model.solver.max_newton,
-                )?;
+                match mech.residual_norm(&x, &mut r) {
+                    Ok(r0) => snes.set_tolerances(
+                        (model.solver.rtol * r0).max(atol_floor),
+                        model.solver.rtol,
+                        0.0,
+                        model.solver.max_newton,
+                    )?,
+                    Err(CallbackError::Domain(why)) => first = Err(StepFailure::Residual(why)),
+                    Err(CallbackError::Fatal(why)) => {
+                        return Err(Error::Petsc(petsc::PetscError {
+                            call: "first residual of a step",
+                            code: -1,
+                            message: why,
+                        }))
+                    }
+                }
             }
-            let attempt = stage_solve.scope(|| {
-                let mut ctx = StepContext {
-                    snes: &mut snes,
-                    x: &mut x,
-                    r: &mut r,
-                    jac,
-                    stages: &stages,
-                    times: &mut times,
-                    reuse_preconditioner: model.solver.reuse.preconditioner,
-                };
-                uzawa_loop(&world, &mut ctx, &mut mech, target)
-            });
+            let attempt = first.map_or_else(
+                |f| Ok(Err(f)),
+                |()| {
+                    stage_solve.scope(|| {
+                        let mut ctx = StepContext {
+                            snes: &mut snes,
+                            x: &mut x,
+                            r: &mut r,
+                            jac,
+                            stages: &stages,
+                            times: &mut times,
+                            reuse_preconditioner: model.solver.reuse.preconditioner,
+                        };
+                        uzawa_loop(&world, &mut ctx, &mut mech, target)
+                    })
+                },
+            );
             let (outcome, uzawa_iterations, stats) = match attempt? {
                 Ok(done_step) => done_step,
                 Err(failure) => {
@@ -513,16 +542,17 @@ impl<'m> Simulation<'m> {
             };
             let output_mark = PhaseMark::new(&mech);
             // In dynamics the support also carries the inertia of its rows.
-            mech.raw_residual(&x, &mut reaction)?;
+            parallel::agree(&world, mech.raw_residual(&x, &mut reaction))?;
             let reactions = reaction_totals(&world, dirichlet, &reaction, dofs.owned_dof_start())?;
             zero_unconstrained(&mut reaction, dirichlet)?;
-            let (fields, forces) = mech.with_state(&x, |u, pairs| {
+            let values = mech.with_state(&x, |u, pairs| {
                 let values = pairs
                     .iter_mut()
                     .map(|p| p.point_values(u, target))
                     .collect::<Result<Vec<_>>>()?;
                 Ok(values.into_iter().unzip::<_, PairForce, Vec<_>, Vec<_>>())
-            })?;
+            });
+            let (fields, forces) = parallel::agree(&world, values)?;
             let contact_reports = contact_reports(&world, mech.contact, &forces, &stats);
             let nodal_pressure = nodal_pressure(dofs, mech.contact)?;
             let report = StepReport {
@@ -582,14 +612,15 @@ impl<'m> Simulation<'m> {
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
             pattern_builds,
             phases: max_over_ranks(&world, add_times(&times, &mech.times)),
-            halo_displacements: sum_over_ranks(&world, dofs.ghost_dofs().len()),
-            halo_multipliers: sum_over_ranks(
+            halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
+            halo_multipliers: parallel::sum_usize(
                 &world,
-                mech.contact
+                [mech
+                    .contact
                     .iter()
                     .map(|p| p.multipliers.ghost_values())
-                    .sum(),
-            ),
+                    .sum()],
+            )[0],
         })
     }
 }
@@ -629,16 +660,8 @@ fn add_times(a: &PhaseTimes, b: &PhaseTimes) -> PhaseTimes {
     t
 }
 
-fn sum_over_ranks(world: &impl Communicator, n: usize) -> usize {
-    let mut total = 0u64;
-    world.all_reduce_into(&(n as u64), &mut total, SystemOperation::sum());
-    total as usize
-}
-
 fn max_over_ranks(world: &impl Communicator, t: PhaseTimes) -> PhaseTimes {
-    let mut out = PhaseTimes::default();
-    world.all_reduce_into(&t.0[..], &mut out.0[..], SystemOperation::max());
-    out
+    PhaseTimes(parallel::max(world, t.0))
 }
 
 /// The solver state one Uzawa loop works on.
@@ -787,10 +810,6 @@ fn uzawa_loop(
     let mut raises = 0;
     // Uzawa iterations over every round (k counts within one).
     let mut total = 0;
-    // What the links carried into this step (the last converged step's
-    // multipliers), replaced after every Uzawa update: reported if Newton
-    // fails for good.
-    let mut last_links = link_summaries(world, mech.contact);
     loop {
         k += 1;
         total += 1;
@@ -810,28 +829,25 @@ fn uzawa_loop(
         linear += outcome.linear_iterations;
         history.extend_from_slice(&outcome.history);
         if !outcome.converged {
-            return Ok(Err(StepFailure::Newton(outcome, last_links)));
+            return Ok(Err(newton_failure(world, mech, x, jac, factor, outcome)?));
         }
         if mech.contact.is_empty() {
             return Ok(Ok((outcome, 0, Vec::new())));
         }
         let mark = PhaseMark::new(mech);
-        let local: Vec<UzawaStats> = stages.scope(Phase::UzawaUpdate, || {
+        let updated = stages.scope(Phase::UzawaUpdate, || {
             mech.with_state(x, |u, pairs| {
-                pairs
+                let stats = pairs
                     .iter_mut()
                     .map(|p| p.uzawa_update(u, factor))
-                    .collect()
+                    .collect::<Result<Vec<UzawaStats>>>()?;
+                fault::check(FaultPhase::UzawaUpdate)?;
+                Ok(stats)
             })
-        })?;
+        });
+        let local = parallel::agree(world, updated)?;
         mark.book(Phase::UzawaUpdate, times, mech);
         let stats = reduce_stats(world, &local);
-        last_links = mech
-            .contact
-            .iter()
-            .map(|p| p.spec.name.clone())
-            .zip(stats.iter().copied())
-            .collect();
         let converged = mech
             .contact
             .iter()
@@ -889,43 +905,116 @@ fn pair_converged(p: &ContactPair, s: &UzawaStats) -> bool {
         && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
 }
 
-/// Per pair: points in contact and sliding under the current multipliers
-/// (totals over ranks).
-fn link_summaries(world: &impl Communicator, pairs: &[ContactPair]) -> Vec<(String, UzawaStats)> {
-    pairs
+/// One pair's links at an iterate: points pressed together (gap < 0 or a
+/// positive multiplier), sliding, and the deepest penetration (totals and
+/// maxima over ranks).
+#[derive(Debug, Clone, Copy, Default)]
+struct LinkSummary {
+    pressed: usize,
+    sliding: usize,
+    max_penetration: f64,
+}
+
+/// Collective, on a failed Newton solve (the same on every rank): the link
+/// states at the failing iterate, and for a failed linear solve the lowest
+/// rank whose Jacobian rows hold non-finite values.
+fn newton_failure(
+    world: &impl Communicator,
+    mech: &mut Mechanics,
+    x: &Vector,
+    jac: &Matrix,
+    factor: f64,
+    outcome: SnesOutcome,
+) -> Result<StepFailure> {
+    let jacobian = if outcome.reason == SnesReason::LinearSolve {
+        let row = jac.first_nonfinite_owned_row()?;
+        let local = row.map(|r| (0, format!("the Jacobian holds NaN or Inf in row {r}")));
+        parallel::agree_failure(world, local).map(|f| format!("rank {}: {}", f.rank, f.message))
+    } else {
+        None
+    };
+    // A NaN iterate has no meaningful link states (and no gap to compute).
+    let links = if x.norm2()?.is_finite() {
+        links_at(world, mech, x, factor)?
+    } else {
+        Vec::new()
+    };
+    Ok(StepFailure::Newton {
+        outcome,
+        links,
+        jacobian,
+    })
+}
+
+/// Collective: [`LinkSummary`] of every pair at the iterate `x`.
+fn links_at(
+    world: &impl Communicator,
+    mech: &mut Mechanics,
+    x: &Vector,
+    factor: f64,
+) -> Result<Vec<(String, LinkSummary)>> {
+    let local = mech.with_state(x, |u, pairs| {
+        pairs
+            .iter_mut()
+            .map(|p| {
+                let (v, _) = p.point_values(u, factor)?;
+                let pressed = v
+                    .gap
+                    .iter()
+                    .zip(&v.lambda)
+                    .filter(|(g, l)| **g < 0.0 || **l > 0.0)
+                    .count();
+                let sliding = v.state.iter().filter(|s| **s == 2).count();
+                let depth = v.gap.iter().fold(0.0f64, |m, g| m.max(-g));
+                Ok((pressed, sliding, depth))
+            })
+            .collect::<Result<Vec<_>>>()
+    });
+    let local = parallel::agree(world, local)?;
+    Ok(mech
+        .contact
         .iter()
-        .map(|p| {
-            let (active, sliding) = p.multiplier_states();
-            let mine = [active as u64, sliding as u64];
-            let mut total = [0u64; 2];
-            world.all_reduce_into(&mine[..], &mut total[..], SystemOperation::sum());
-            let stats = UzawaStats {
-                active: total[0] as usize,
-                sliding: total[1] as usize,
-                // Not measured until the step's first Uzawa update.
-                max_penetration: f64::NAN,
-                ..UzawaStats::default()
+        .zip(local)
+        .map(|(p, (pressed, sliding, depth))| {
+            let [pressed, sliding] = parallel::sum_usize(world, [pressed, sliding]);
+            let [max_penetration] = parallel::max(world, [depth]);
+            let summary = LinkSummary {
+                pressed,
+                sliding,
+                max_penetration,
             };
-            (p.spec.name.clone(), stats)
+            (p.spec.name.clone(), summary)
         })
-        .collect()
+        .collect())
 }
 
 fn failure_text(f: &StepFailure) -> String {
     match f {
-        StepFailure::Newton(o, links) => {
-            let mut text = match &o.domain_error {
-                Some(d) => format!("{} ({d})", o.reason_text),
-                None => format!("{} after {} iterations, |R| = {:.3e}", o.reason_text, o.iterations, o.residual_norm),
+        StepFailure::Residual(why) => format!("the step's first residual failed: {why}"),
+        StepFailure::Newton {
+            outcome: o,
+            links,
+            jacobian,
+        } => {
+            let mut text = match (&o.domain_error, o.reason) {
+                (Some(d), _) => format!("Newton iteration {}: {d}", o.iterations),
+                (None, SnesReason::LinearSolve) => format!(
+                    "the linear solve failed in Newton iteration {}: {} after {} iterations",
+                    o.iterations, o.ksp_reason, o.ksp_iterations
+                ),
+                (None, reason) => format!(
+                    "{reason} after {} iterations, |R| = {:.3e}",
+                    o.iterations, o.residual_norm
+                ),
             };
+            if let Some(j) = jacobian {
+                text += &format!(" ({j})");
+            }
             for (name, s) in links {
                 text += &format!(
-                    "; links of pair '{name}' at the last multiplier update: {} in contact, {} sliding, {} sticking",
-                    s.active, s.sliding, s.active - s.sliding.min(s.active)
+                    "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, max penetration {:.3e}",
+                    s.pressed, s.sliding, s.max_penetration
                 );
-                if s.max_penetration.is_finite() {
-                    text += &format!(", max penetration {:.3e} h", s.max_penetration);
-                }
             }
             text
         }
@@ -937,36 +1026,28 @@ fn failure_text(f: &StepFailure) -> String {
     }
 }
 
-/// True on every rank if `flag` is true on any.
-fn any_rank(world: &impl Communicator, flag: bool) -> bool {
-    let mine = i32::from(flag);
-    let mut any = 0;
-    world.all_reduce_into(&mine, &mut any, SystemOperation::max());
-    any == 1
-}
-
+/// Collective: each pair's Uzawa figures over all ranks.
 fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaStats> {
     local
         .iter()
         .map(|s| {
-            let maxes = [
-                s.max_penetration,
-                s.max_change,
-                s.max_force,
-                s.max_multiplier,
-            ];
-            let mut g = [0.0; 4];
-            world.all_reduce_into(&maxes[..], &mut g[..], SystemOperation::max());
-            let counts = [s.active as u64, s.sliding as u64];
-            let mut total = [0u64; 2];
-            world.all_reduce_into(&counts[..], &mut total[..], SystemOperation::sum());
+            let [max_penetration, max_change, max_force, max_multiplier] = parallel::max(
+                world,
+                [
+                    s.max_penetration,
+                    s.max_change,
+                    s.max_force,
+                    s.max_multiplier,
+                ],
+            );
+            let [active, sliding] = parallel::sum_usize(world, [s.active, s.sliding]);
             UzawaStats {
-                max_penetration: g[0],
-                max_change: g[1],
-                max_force: g[2],
-                max_multiplier: g[3],
-                active: total[0] as usize,
-                sliding: total[1] as usize,
+                max_penetration,
+                max_change,
+                max_force,
+                max_multiplier,
+                active,
+                sliding,
             }
         })
         .collect()
@@ -983,9 +1064,7 @@ fn contact_reports(
         .zip(forces)
         .enumerate()
         .map(|(i, (p, f))| {
-            let mut total = [0.0; 5];
-            world.all_reduce_into(&f.to_array()[..], &mut total[..], SystemOperation::sum());
-            let total = PairForce::from_array(total);
+            let total = PairForce::from_array(parallel::sum(world, f.to_array()));
             let s = stats.get(i).copied().unwrap_or_default();
             ContactReport {
                 name: p.spec.name.clone(),
@@ -1051,7 +1130,7 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         }
     }
     let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
-    let bulk = collective(
+    let bulk = parallel::agree(
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
     )?;
@@ -1065,14 +1144,14 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         })?;
         facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
     }
-    let loads = SurfaceLoads::new(mesh, &dofs, &facet_loads)?;
-    let dirichlet = collective(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
+    let loads = parallel::agree(&world, SurfaceLoads::new(mesh, &dofs, &facet_loads))?;
+    let dirichlet = parallel::agree(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
     let softest = model
         .materials
         .iter()
         .map(Material::youngs)
         .fold(f64::INFINITY, f64::min);
-    let contact = collective(
+    let contact = parallel::agree(
         &world,
         model
             .contact
@@ -1106,32 +1185,10 @@ fn broadcast_partition(
     } else {
         Ok(Vec::new())
     };
-    let mut ok = i32::from(mine.is_ok());
-    world.process_at_rank(0).broadcast_into(&mut ok);
-    if ok == 0 {
-        return Err(mine
-            .err()
-            .unwrap_or_else(|| Error::Partition("rank 0 could not partition the mesh".into())));
-    }
-    let mut part = mine.unwrap_or_else(|_| Vec::new());
+    let mut part = parallel::agree(world, mine)?;
     part.resize(mesh.num_cells(), 0);
     world.process_at_rank(0).broadcast_into(&mut part[..]);
     Ok(part)
-}
-
-/// Makes a per-rank result collective: if any rank failed, every rank returns
-/// an error (the failing rank its own), so no rank waits in a later collective.
-pub fn collective<T>(world: &impl Communicator, r: Result<T>) -> Result<T> {
-    let mine = r.is_ok() as i32;
-    let mut all = 0i32;
-    world.all_reduce_into(&mine, &mut all, SystemOperation::min());
-    match r {
-        Ok(v) if all == 1 => Ok(v),
-        Ok(_) => Err(Error::Mpi(
-            "another rank failed during set-up (its message is printed by that rank)".into(),
-        )),
-        Err(e) => Err(e),
-    }
 }
 
 fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
@@ -1168,9 +1225,10 @@ fn reaction_totals(
     start: usize,
 ) -> Result<Vec<(String, [f64; 3])>> {
     let local = raw.with_array(|a| dirichlet.reaction_sums(a, start))?;
-    let flat: Vec<f64> = local.iter().flat_map(|s| s.iter().copied()).collect();
-    let mut total = vec![0.0; flat.len()];
-    world.all_reduce_into(&flat[..], &mut total[..], SystemOperation::sum());
+    let total: Vec<f64> = local
+        .iter()
+        .flat_map(|s| parallel::sum(world, *s))
+        .collect();
     Ok(dirichlet
         .set_names
         .iter()
