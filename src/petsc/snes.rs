@@ -50,6 +50,8 @@ struct Context<'a> {
     problem: &'a mut dyn NonlinearProblem,
     fatal: Option<String>,
     domain: Option<String>,
+    /// The Jacobian callback ended the solve with a domain error.
+    jacobian_stopped: bool,
 }
 
 pub struct Snes {
@@ -64,15 +66,6 @@ impl Snes {
         // SAFETY: PETSc is initialised; out-pointer valid.
         unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
         let snes = Snes { raw };
-        // A Jacobian domain error (set by the callbacks on every rank alike)
-        // stops the solve instead of solving with a broken matrix.
-        // SAFETY: valid snes.
-        unsafe {
-            petsc_call!(SNESSetCheckJacobianDomainError(
-                snes.raw,
-                sys::PetscBool_PETSC_TRUE
-            ))?
-        };
         Ok(snes)
     }
 
@@ -104,6 +97,21 @@ impl Snes {
         }
     }
 
+    /// Drops the preconditioner's factors, symbolic ones included: after a
+    /// failed factorisation (MUMPS keeps a failed analysis and skips every
+    /// later numeric factorisation of the same pattern) the next solve
+    /// starts afresh. Collective.
+    pub fn reset_preconditioner(&mut self) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut pc: sys::PC = std::ptr::null_mut();
+        // SAFETY: valid snes; the KSP and PC handles are borrowed from it.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetPC(ksp, &mut pc))?;
+            petsc_call!(PCReset(pc))
+        }
+    }
+
     /// Applies the options database (after the program's defaults are set).
     pub fn set_from_options(&mut self) -> Result<()> {
         // SAFETY: valid snes.
@@ -128,6 +136,7 @@ impl Snes {
             problem,
             fatal: None,
             domain: None,
+            jacobian_stopped: false,
         };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
         const HIST: usize = 200;
@@ -178,9 +187,13 @@ impl Snes {
                 message: msg,
             });
         }
-        solved?;
         detached?;
         let mut outcome = read?;
+        if ctx.jacobian_stopped {
+            outcome.reason = SnesReason::JacobianDomain;
+        } else {
+            solved?;
+        }
         outcome.domain_error = ctx.domain.take();
         outcome.converged = outcome.reason.converged() && outcome.domain_error.is_none();
         Ok(outcome)
@@ -257,18 +270,24 @@ fn run_callback(
             // The problem agreed the failure over all ranks before returning
             // it, so every rank flags the same domain error here.
             ctx.domain = Some(msg);
-            // SAFETY: valid snes handed to the callback by PETSc.
-            let flagged = unsafe {
-                match kind {
-                    Kind::Residual => petsc_call!(SNESSetFunctionDomainError(snes)),
-                    Kind::Jacobian => petsc_call!(SNESSetJacobianDomainError(snes)),
+            match kind {
+                Kind::Residual => {
+                    // SAFETY: valid snes handed to the callback by PETSc.
+                    match unsafe { petsc_call!(SNESSetFunctionDomainError(snes)) } {
+                        Ok(()) => 0,
+                        Err(e) => {
+                            ctx.fatal = Some(e.to_string());
+                            sys::PETSC_ERR_USER
+                        }
+                    }
                 }
-            };
-            match flagged {
-                Ok(()) => 0,
-                Err(e) => {
-                    ctx.fatal = Some(e.to_string());
-                    sys::PETSC_ERR_USER
+                // PETSc 3.18 keeps a Jacobian domain flag set into the next
+                // solve (and checks it only on request), so the Jacobian
+                // stops the solve with an error code instead, on every
+                // rank alike; `solve` reads it back as this domain error.
+                Kind::Jacobian => {
+                    ctx.jacobian_stopped = true;
+                    sys::PETSC_ERR_NOT_CONVERGED
                 }
             }
         }

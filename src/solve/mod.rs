@@ -303,6 +303,12 @@ enum StepFailure {
     },
 }
 
+impl StepFailure {
+    fn linear_solve_failed(&self) -> bool {
+        matches!(self, StepFailure::Newton { outcome, .. } if outcome.reason == SnesReason::LinearSolve)
+    }
+}
+
 impl<'m> Simulation<'m> {
     /// Partitions (METIS on rank 0, broadcast), numbers the DOFs, precomputes
     /// element data, resolves contact pairs and allocates the Jacobian.
@@ -504,13 +510,28 @@ impl<'m> Simulation<'m> {
             let (outcome, uzawa_iterations, stats) = match attempt? {
                 Ok(done_step) => done_step,
                 Err(failure) => {
+                    if failure.linear_solve_failed() {
+                        snes.reset_preconditioner()?;
+                    }
                     x.copy_from(&x_prev)?;
                     for (p, snap) in mech.contact.iter_mut().zip(contact_prev) {
                         p.restore(snap)?;
                     }
                     cutbacks_here += 1;
-                    let why = failure_text(&failure);
-                    if cutbacks_here > model.solver.max_cutbacks {
+                    let mut why = failure_text(&failure);
+                    // The count restarts after every converged step, so a
+                    // load path stuck at a limit point would creep on with
+                    // ever smaller increments: they never go below the
+                    // scene's increment halved max_cutbacks times.
+                    let smallest = base * 0.5f64.powi(model.solver.max_cutbacks as i32);
+                    let too_small = increment * 0.5 < smallest * (1.0 - 1e-9);
+                    if too_small && cutbacks_here <= model.solver.max_cutbacks {
+                        why += &format!(
+                            "; the next increment would be below the smallest allowed ({smallest:.3e}: the scene's increment halved max_cutbacks = {} times)",
+                            model.solver.max_cutbacks
+                        );
+                    }
+                    if cutbacks_here > model.solver.max_cutbacks || too_small {
                         return Err(Error::NoConvergence {
                             step: first_step + steps.len() + 1,
                             load_factor: target,
