@@ -729,21 +729,14 @@ fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
 /// when rank 0 cannot create the result file (or its directory). Only rank 0
 /// tries, as only one process should create directories and probe files.
 fn check_output_writable(rt: &Runtime, path: &Path) -> Result<()> {
-    use mpi::traits::Root;
-    let mut message = match rt.rank() {
-        0 => probe_writable(path).err().unwrap_or_default().into_bytes(),
-        _ => Vec::new(),
+    let mine = match rt.rank() {
+        0 => probe_writable(path).err().unwrap_or_default(),
+        _ => String::new(),
     };
-    let world = rt.world();
-    let root = world.process_at_rank(0);
-    let mut len = message.len() as u64;
-    root.broadcast_into(&mut len);
-    message.resize(len as usize, 0);
-    root.broadcast_into(&mut message[..]);
+    let message = crate::parallel::broadcast_text(&rt.world(), 0, &mine);
     if message.is_empty() {
         return Ok(());
     }
-    let message = String::from_utf8_lossy(&message).into_owned();
     Err(std::io::Error::other(message).into())
 }
 

@@ -187,7 +187,8 @@ mod tests {
 
     #[test]
     fn every_defined_code_has_its_own_name() {
-        for code in -11..=5 {
+        // 1 is not a SNES reason in PETSc 3.18.
+        for code in (-11..=5).filter(|c| *c != 1) {
             let r = SnesReason::from_raw(code);
             assert!(!matches!(r, SnesReason::Other(_)), "SNES code {code}");
             assert!(!r.to_string().contains("unknown"));

@@ -409,7 +409,7 @@ impl<'m> Simulation<'m> {
         x.set_all(0.0)?;
         let (first_step, mut done) = match restart {
             Some(state) => {
-                take_over(state, dofs, &mut x, mech.contact)?;
+                parallel::agree(&world, take_over(state, dofs, &mut x, mech.contact))?;
                 (state.step, state.load_factor)
             }
             None => (0, 0.0),
@@ -514,9 +514,12 @@ impl<'m> Simulation<'m> {
                         snes.reset_preconditioner()?;
                     }
                     x.copy_from(&x_prev)?;
-                    for (p, snap) in mech.contact.iter_mut().zip(contact_prev) {
-                        p.restore(snap)?;
-                    }
+                    let restored = mech
+                        .contact
+                        .iter_mut()
+                        .zip(contact_prev)
+                        .try_for_each(|(p, snap)| p.restore(snap));
+                    parallel::agree(&world, restored)?;
                     cutbacks_here += 1;
                     let mut why = failure_text(&failure);
                     // The count restarts after every converged step, so a
@@ -551,7 +554,8 @@ impl<'m> Simulation<'m> {
             let dynamics_report = match (&mut stepper, &coefficients) {
                 (Some(s), Some(c)) => {
                     s.advance(&x, c)?;
-                    let strain = mech.with_state(&x, |u, _| bulk.strain_energy(u))?;
+                    let strain =
+                        parallel::agree(&world, mech.with_state(&x, |u, _| bulk.strain_energy(u)))?;
                     let time = done * s.t_end;
                     let inertia = mech
                         .inertia
@@ -575,7 +579,7 @@ impl<'m> Simulation<'m> {
             });
             let (fields, forces) = parallel::agree(&world, values)?;
             let contact_reports = contact_reports(&world, mech.contact, &forces, &stats);
-            let nodal_pressure = nodal_pressure(dofs, mech.contact)?;
+            let nodal_pressure = parallel::agree(&world, nodal_pressure(dofs, mech.contact))?;
             let report = StepReport {
                 index: first_step + steps.len() + 1,
                 load_factor: done,
@@ -615,9 +619,8 @@ impl<'m> Simulation<'m> {
             })?;
             drop(pair_fields);
             output_mark.book(Phase::Output, &mut times, &mech);
-            for pair in mech.contact.iter_mut() {
-                pair.commit()?;
-            }
+            let committed = mech.contact.iter_mut().try_for_each(|p| p.commit());
+            parallel::agree(&world, committed)?;
             steps.push(report);
             cutbacks_here = 0;
             // Grow back towards the scene's increment after a successful cut step.
