@@ -140,8 +140,8 @@ pub(super) fn failure_text(f: &StepFailure) -> String {
             }
             for (name, s) in links {
                 text += &format!(
-                    "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, max penetration {:.3e}",
-                    s.pressed, s.sliding, s.max_penetration
+                    "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, {} sticking, max penetration {:.3e}",
+                    s.pressed, s.sliding, s.pressed - s.sliding.min(s.pressed), s.max_penetration
                 );
             }
             text
