@@ -149,7 +149,7 @@ pub fn arm(rank: usize) -> Result<()> {
             return Ok(());
         }
     };
-    let fault = Fault::parse(&text).map_err(Error::Mpi)?;
+    let fault = Fault::parse(&text).map_err(|e| Error::Io(std::io::Error::other(e)))?;
     let _ = ARMED.set(Some(Armed {
         fault,
         rank,
