@@ -14,7 +14,6 @@ use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
-use mpi::collective::SystemOperation;
 use mpi::traits::*;
 
 /// What a scene says about dynamics.
@@ -208,8 +207,7 @@ impl TimeStepper {
             p[3] = strain_local;
             p
         })?;
-        let mut total = [0.0; 4];
-        world.all_reduce_into(&local[..], &mut total[..], SystemOperation::sum());
+        let total = crate::parallel::sum(world, local);
         Ok(DynamicsReport {
             time,
             kinetic,
