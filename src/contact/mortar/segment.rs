@@ -1,0 +1,224 @@
+//! Dual shape functions on a slave facet and the mortar integrals of one
+//! slave–master segment.
+//!
+//! Dual (biorthogonal) shape functions `Φ_j = Σ_k A_jk N_k` satisfy
+//! `∫ Φ_j N_k dA = δ_jk ∫ N_k dA` over the slave facet, which gives
+//! `A = D M⁻¹` with `D = diag(∫ N_j dA)` and `M_jk = ∫ N_j N_k dA`, computed
+//! per facet from its CURRENT geometry (so `A` depends on the slave nodes and
+//! its derivative enters the tangent). Since `M·1 = diag(D)`, `Σ_j Φ_j = 1`:
+//! a uniform multiplier field is represented exactly.
+//!
+//! On a segment (the overlap of the slave facet with one master facet in the
+//! slave's auxiliary plane) the kernel integrates
+//! - the weighted gap `g̃_j = ∫ Φ_j g dA` with `g = ν·(x² − x¹)`, `ν` the
+//!   auxiliary plane's normal (outward of the slave), `> 0` apart;
+//! - the mortar matrices `D_jk = ∫ Φ_j N¹_k dA` and `M_jl = ∫ Φ_j N²_l dA`,
+//!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
+//!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
+//!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
+use super::geometry::{overlap, shape_values};
+use crate::contact::dual::{self, Scalar, Vec3};
+use crate::fem::shape::facet_shape;
+use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+
+/// A quadrature rule as (point, weight) pairs.
+pub type Rule = Vec<([f64; 2], f64)>;
+
+/// The rules the mortar kernels integrate with: on the whole slave facet (for
+/// `D` and `M` of the dual basis) and on the triangles of a segment.
+#[derive(Debug, Clone)]
+pub struct MortarRules {
+    pub quad_facet: Rule,
+    pub tri_facet: Rule,
+    pub triangle: Rule,
+}
+
+fn pairs(rule: &QuadRule) -> Rule {
+    rule.points
+        .iter()
+        .zip(&rule.weights)
+        .map(|(p, w)| ([p[0], p[1]], *w))
+        .collect()
+}
+
+impl Default for MortarRules {
+    /// 3×3 Gauss on quads (exact for `N_j N_k J`, biquadratic × bilinear),
+    /// the degree-4 six-point rule on triangles (segments and tri facets).
+    fn default() -> Self {
+        MortarRules {
+            quad_facet: pairs(&QuadRule::quad_3x3()),
+            tri_facet: pairs(&QuadRule::tri_6()),
+            triangle: pairs(&QuadRule::tri_6()),
+        }
+    }
+}
+
+impl MortarRules {
+    pub fn facet(&self, facet: FacetType) -> &Rule {
+        match facet {
+            FacetType::Quad4 => &self.quad_facet,
+            FacetType::Tri3 => &self.tri_facet,
+        }
+    }
+}
+
+/// Dual-basis coefficients `A` (row `j` gives `Φ_j`) of a slave facet at its
+/// current positions `x`. `None` for a degenerate facet.
+pub fn dual_coefficients<T: Scalar>(
+    facet: FacetType,
+    x: &[Vec3<T>],
+    rules: &MortarRules,
+) -> Option<[[T; MAX_FACET_NODES]; MAX_FACET_NODES]> {
+    let n = facet.nodes();
+    let zero = T::from_f64(0.0);
+    let mut m = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    let mut d = [zero; MAX_FACET_NODES];
+    for (zeta, w) in rules.facet(facet) {
+        let s = facet_shape(facet, *zeta);
+        let (mut t1, mut t2) = (
+            dual::constant3::<T>([0.0; 3]),
+            dual::constant3::<T>([0.0; 3]),
+        );
+        for (a, xa) in x.iter().enumerate().take(n) {
+            t1 = dual::axpy(&t1, s.dn[a][0], xa);
+            t2 = dual::axpy(&t2, s.dn[a][1], xa);
+        }
+        let jw = dual::norm(&dual::cross(&t1, &t2)) * *w;
+        for ((dj, mj), nj) in d.iter_mut().zip(m.iter_mut()).zip(&s.n).take(n) {
+            *dj = *dj + jw * *nj;
+            for (mjk, nk) in mj.iter_mut().zip(&s.n).take(n) {
+                *mjk = *mjk + jw * (nj * nk);
+            }
+        }
+    }
+    let inv = invert(m, n)?;
+    let mut a = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    for j in 0..n {
+        for k in 0..n {
+            a[j][k] = d[j] * inv[j][k];
+        }
+    }
+    Some(a)
+}
+
+/// Gauss–Jordan inverse of the leading `n × n` block with partial pivoting
+/// (pivots chosen on the f64 values); `None` if singular.
+fn invert<T: Scalar>(
+    mut m: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    n: usize,
+) -> Option<[[T; MAX_FACET_NODES]; MAX_FACET_NODES]> {
+    let zero = T::from_f64(0.0);
+    let mut inv = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    for (i, row) in inv.iter_mut().enumerate().take(n) {
+        row[i] = T::from_f64(1.0);
+    }
+    let size = (0..n).map(|i| m[i][i].re().abs()).fold(0.0, f64::max);
+    for col in 0..n {
+        let pivot =
+            (col..n).max_by(|&a, &b| m[a][col].re().abs().total_cmp(&m[b][col].re().abs()))?;
+        let magnitude = m[pivot][col].re().abs();
+        if magnitude.is_nan() || magnitude <= 1e-13 * size {
+            return None;
+        }
+        m.swap(col, pivot);
+        inv.swap(col, pivot);
+        let p = m[col][col].recip();
+        for k in 0..n {
+            m[col][k] = m[col][k] * p;
+            inv[col][k] = inv[col][k] * p;
+        }
+        for row in 0..n {
+            if row == col {
+                continue;
+            }
+            let f = m[row][col];
+            for k in 0..n {
+                m[row][k] = m[row][k] - f * m[col][k];
+                inv[row][k] = inv[row][k] - f * inv[col][k];
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// `Φ_j(ζ)` from the coefficients and the standard shape values.
+pub fn dual_values<T: Scalar>(
+    a: &[[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    n: &[T; MAX_FACET_NODES],
+    nodes: usize,
+) -> [T; MAX_FACET_NODES] {
+    let mut phi = [T::from_f64(0.0); MAX_FACET_NODES];
+    for j in 0..nodes {
+        for k in 0..nodes {
+            phi[j] = phi[j] + a[j][k] * n[k];
+        }
+    }
+    phi
+}
+
+/// The mortar integrals of one segment (rows `j`: slave facet nodes).
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentTerms<T> {
+    /// `∫ Φ_j g dA`.
+    pub weighted_gap: [T; MAX_FACET_NODES],
+    /// `D_jk = ∫ Φ_j N¹_k dA`.
+    pub d: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    /// `M_jl = ∫ Φ_j N²_l dA`.
+    pub m: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    /// The auxiliary plane's unit normal (outward of the slave).
+    pub normal: Vec3<T>,
+    /// The segment's area in the auxiliary plane.
+    pub area: T,
+}
+
+fn point_on<T: Scalar>(n: &[T; MAX_FACET_NODES], x: &[Vec3<T>], nodes: usize) -> Vec3<T> {
+    let mut p = dual::constant3::<T>([0.0; 3]);
+    for (na, xa) in n.iter().zip(x).take(nodes) {
+        p = dual::add(&p, &dual::scale(xa, *na));
+    }
+    p
+}
+
+/// The integrals of the segment between slave facet `xs` (with its dual
+/// coefficients `a`) and master facet `xm`; `None` when they do not overlap.
+pub fn segment_terms<T: Scalar>(
+    slave_type: FacetType,
+    xs: &[Vec3<T>],
+    master_type: FacetType,
+    xm: &[Vec3<T>],
+    a: &[[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    rules: &MortarRules,
+) -> Option<SegmentTerms<T>> {
+    let ov = overlap(slave_type, xs, master_type, xm)?;
+    let (ns, nm) = (slave_type.nodes(), master_type.nodes());
+    let zero = T::from_f64(0.0);
+    let mut terms = SegmentTerms {
+        weighted_gap: [zero; MAX_FACET_NODES],
+        d: [[zero; MAX_FACET_NODES]; MAX_FACET_NODES],
+        m: [[zero; MAX_FACET_NODES]; MAX_FACET_NODES],
+        normal: ov.plane.normal,
+        area: zero,
+    };
+    let normal = ov.plane.normal;
+    let mapped = ov.for_each_point(slave_type, master_type, &rules.triangle, |q| {
+        let n1 = shape_values(slave_type, &q.zeta);
+        let n2 = shape_values(master_type, &q.xi);
+        let phi = dual_values(a, &n1, ns);
+        let gap = dual::dot(
+            &normal,
+            &dual::sub(&point_on(&n2, xm, nm), &point_on(&n1, xs, ns)),
+        );
+        terms.area = terms.area + q.weight;
+        for (j, phi_j) in phi.iter().enumerate().take(ns) {
+            let pw = *phi_j * q.weight;
+            terms.weighted_gap[j] = terms.weighted_gap[j] + pw * gap;
+            for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
+                *djk = *djk + pw * *nk;
+            }
+            for (mjl, nl) in terms.m[j].iter_mut().zip(&n2).take(nm) {
+                *mjl = *mjl + pw * *nl;
+            }
+        }
+    });
+    mapped.then_some(terms)
+}
