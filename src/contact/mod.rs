@@ -25,4 +25,4 @@ pub mod search;
 pub mod surfaces;
 
 pub use links::{ContactPair, UzawaStats};
-pub use pair::{FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
+pub use pair::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

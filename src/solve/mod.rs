@@ -1006,7 +1006,7 @@ fn nodal_pressure(dofs: &DofMap, pairs: &[ContactPair]) -> Result<Vec<f64>> {
     let n = dofs.num_owned_nodes();
     let (mut num, mut den) = (vec![0.0; n], vec![0.0; n]);
     for p in pairs {
-        p.multipliers.add_nodal_pressure(&mut num, &mut den)?;
+        p.add_nodal_pressure(&mut num, &mut den)?;
     }
     Ok(num
         .iter()
@@ -1047,6 +1047,12 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         if let MasterSpec::Surface { set } = &pair.master {
             master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
                 mesh, set,
+            )?);
+        }
+        if pair.formulation == crate::contact::Formulation::Mortar {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh,
+                &pair.slave,
             )?);
         }
     }

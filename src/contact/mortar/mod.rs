@@ -6,9 +6,11 @@
 //!   triangulation, quadrature points mapped back to both facets;
 //! - `segment`: dual basis of a slave facet and the integrals of one segment
 //!   (weighted gap, mortar matrices `D` and `M`);
+//! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
 //!   tangent of a set of segments.
 pub mod geometry;
+pub mod pair;
 pub mod segment;
 pub mod system;
 

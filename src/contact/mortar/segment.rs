@@ -41,14 +41,43 @@ fn pairs(rule: &QuadRule) -> Rule {
         .collect()
 }
 
+/// Collapsed (Duffy) `n × n` Gauss rule on the reference triangle, exact to
+/// degree `2n − 1`; weights sum to ½.
+fn collapsed_gauss(n: usize) -> Rule {
+    let line = QuadRule::quad_gauss(n).unwrap_or_else(|_| QuadRule::quad_4x4());
+    let m = (line.len() as f64).sqrt().round() as usize;
+    // The tensor rule's first m points run along ξ at the first η, with
+    // weights w_i w_0: they give the 1D rule.
+    let w0 = line.weights[0].sqrt();
+    let points: Vec<(f64, f64)> = (0..m)
+        .map(|i| (line.points[i][0], line.weights[i] / w0))
+        .collect();
+    let w1: f64 = points.iter().map(|p| p.1).sum();
+    let mut rule = Rule::new();
+    for &(a, wa) in &points {
+        for &(b, wb) in &points {
+            let u = 0.5 * (1.0 + a);
+            let v = 0.5 * (1.0 + b);
+            // (u, v) ∈ [0,1]² → (u, v (1 − u)), Jacobian (1 − u).
+            let w = (wa / w1) * (wb / w1) * (1.0 - u);
+            rule.push(([u, v * (1.0 - u)], w));
+        }
+    }
+    rule
+}
+
 impl Default for MortarRules {
     /// 3×3 Gauss on quads (exact for `N_j N_k J`, biquadratic × bilinear),
-    /// the degree-4 six-point rule on triangles (segments and tri facets).
+    /// the degree-4 six-point rule on tri facets. On segment triangles the
+    /// integrands `N(ζ(p))` are not polynomial where a quad facet is not a
+    /// parallelogram (the inverse bilinear map): a collapsed 4×4 Gauss rule
+    /// (degree 7) keeps their error below the patch test's 1e-6 on a
+    /// 30 %-distorted mesh, where the six-point rule left 7e-7.
     fn default() -> Self {
         MortarRules {
             quad_facet: pairs(&QuadRule::quad_3x3()),
             tri_facet: pairs(&QuadRule::tri_6()),
-            triangle: pairs(&QuadRule::tri_6()),
+            triangle: collapsed_gauss(4),
         }
     }
 }
