@@ -261,6 +261,31 @@ fn try_case(
     Ok((slave_pressures(&out, case.slave().0), force))
 }
 
+/// The mortar pair's nodal datasets at the slave nodes: λ, g̃ and the traction.
+fn mortar_fields(path: &Path, node_set: &str) -> Vec<(f64, f64, [f64; 3])> {
+    let step = last_step(path);
+    let (nodes, _) =
+        read_dataset::<i64>(path, &format!("/mesh/node_sets/{node_set}")).expect("node set");
+    let read = |name: &str| {
+        read_dataset::<f64>(path, &format!("/steps/{step:06}/contact/interface/{name}"))
+            .expect(name)
+            .0
+    };
+    let (lambda, gap, traction) = (
+        read("node_lambda"),
+        read("node_weighted_gap"),
+        read("node_traction"),
+    );
+    nodes
+        .iter()
+        .map(|&n| {
+            let n = n as usize;
+            let t = [traction[3 * n], traction[3 * n + 1], traction[3 * n + 2]];
+            (lambda[n], gap[n], t)
+        })
+        .collect()
+}
+
 fn run_case(dir: &Path, case: &Case, formulation: &str, ranks: usize) -> (Vec<f64>, Vec<f64>) {
     try_case(dir, case, formulation, ranks).unwrap_or_else(|t| panic!("{}: {t}", case.name))
 }
@@ -292,6 +317,27 @@ fn mortar_passes_the_patch_test_where_the_links_do_not() {
         worst = worst.max(dev);
     }
     assert!(worst < 1e-6, "mortar patch test deviates {worst:.2e}");
+}
+
+#[test]
+fn mortar_writes_nodal_multipliers_weighted_gaps_and_tractions() {
+    let dir = scratch("mortar-output");
+    let case = &CASES[0];
+    let (p, _) = run_case(&dir, case, "mortar", 2);
+    let tag = format!("{}-mortar-2", case.name.replace([' ', ','], "_"));
+    let fields = mortar_fields(&dir.join(format!("{tag}.h5")), case.slave().0);
+    assert_eq!(fields.len(), p.len());
+    for ((lambda, gap, t), p) in fields.iter().zip(&p) {
+        // λ is the nodal contact pressure; the upper block's bottom is
+        // pushed up (+z); the weighted gap is closed to the Uzawa tolerance
+        // (1e-9 h of a node's area, h = 0.25, area ≤ 1/16).
+        assert!((lambda - p).abs() <= 1e-12 * p, "{lambda} vs {p}");
+        assert!((t[2] - lambda).abs() <= 1e-9 * lambda && t[0].abs() + t[1].abs() < 1e-9);
+        assert!(
+            gap.abs() <= 1e-9 * 0.25 / 16.0 * 1.01,
+            "weighted gap {gap:e}"
+        );
+    }
 }
 
 #[test]

@@ -42,7 +42,8 @@ fn pairs(rule: &QuadRule) -> Rule {
 }
 
 /// Collapsed (Duffy) `n × n` Gauss rule on the reference triangle, exact to
-/// degree `2n − 1`; weights sum to ½.
+/// total degree `2n − 2` (the collapse adds a factor `1 − u`); weights sum
+/// to ½.
 fn collapsed_gauss(n: usize) -> Rule {
     let line = QuadRule::quad_gauss(n).unwrap_or_else(|_| QuadRule::quad_4x4());
     let m = (line.len() as f64).sqrt().round() as usize;
@@ -71,7 +72,7 @@ impl Default for MortarRules {
     /// the degree-4 six-point rule on tri facets. On segment triangles the
     /// integrands `N(ζ(p))` are not polynomial where a quad facet is not a
     /// parallelogram (the inverse bilinear map): a collapsed 4×4 Gauss rule
-    /// (degree 7) keeps their error below the patch test's 1e-6 on a
+    /// (degree 6) keeps their error below the patch test's 1e-6 on a
     /// 30 %-distorted mesh, where the six-point rule left 7e-7.
     fn default() -> Self {
         MortarRules {

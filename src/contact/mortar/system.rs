@@ -1,9 +1,10 @@
 //! Nodal assembly of the mortar normal contact: weighted gaps, nodal
 //! pressures, residual and consistent tangent of a set of segments.
 //!
-//! Sign and scaling. Each slave node `j` carries a nominal pressure `λ_j`
-//! (force per reference area). With `A_j = ∫ N_j dA₀` its reference nodal
-//! area, `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
+//! Sign and scaling. Each slave node `j` carries a pressure `λ_j`: the
+//! forces below are `λ_j` times integrals over the CURRENT overlap, so it is
+//! force per current area. With `A_j = ∫ N_j dA₀` its reference nodal area
+//! (a constant scale), `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
 //! converged Newton solution is `p_j = ⟨λ_j − ε_j ḡ_j⟩` (the links' own rule,
 //! [`updated_multiplier`]). The residual, added to `R = f_int − f_ext`, is
 //! the mortar force `r = −Σ_j p_j c_j` with `c_j = ∂g̃_j/∂x` at fixed `D`,

@@ -442,3 +442,20 @@ fn tangent_matches_finite_differences_of_the_residual() {
         );
     }
 }
+
+#[test]
+fn segment_triangle_rule_is_exact_to_degree_six() {
+    let rule = MortarRules::default().triangle;
+    // ∫ x^a y^b over the reference triangle = a! b! / (a + b + 2)!.
+    let factorial = |n: u32| (1..=n).map(f64::from).product::<f64>();
+    for a in 0..=6u32 {
+        for b in 0..=(6 - a) {
+            let exact = factorial(a) * factorial(b) / factorial(a + b + 2);
+            let got: f64 = rule
+                .iter()
+                .map(|(p, w)| w * p[0].powi(a as i32) * p[1].powi(b as i32))
+                .sum();
+            assert!((got - exact).abs() < 1e-15, "x^{a} y^{b}: {got} vs {exact}");
+        }
+    }
+}
