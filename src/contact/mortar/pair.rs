@@ -216,6 +216,7 @@ impl MortarPair {
             slave_type: self.facet_type,
             master_type: self.facet_type,
             positions,
+            reference: &self.x_ref,
             slave_facets: &self.slave_facets,
             master_facets: &self.master_facets,
             candidates: &self.candidates,

@@ -16,7 +16,7 @@
 //!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
 //!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
 //!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
-use super::geometry::{overlap, shape_values};
+use super::geometry::{overlap, shape_gradients, shape_values};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
@@ -197,7 +197,7 @@ pub struct SegmentTerms<T> {
     pub m: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
     /// The auxiliary plane's unit normal (outward of the slave).
     pub normal: Vec3<T>,
-    /// The segment's area in the auxiliary plane.
+    /// The segment's reference area (on the slave).
     pub area: T,
 }
 
@@ -209,11 +209,46 @@ fn point_on<T: Scalar>(n: &[T; MAX_FACET_NODES], x: &[Vec3<T>], nodes: usize) ->
     p
 }
 
-/// The integrals of the segment between slave facet `xs` (with its dual
-/// coefficients `a`) and master facet `xm`; `None` when they do not overlap.
+/// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.
+fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T; 2]) -> T {
+    let dn = shape_gradients(facet, zeta);
+    let zero = dual::constant3::<T>([0.0; 3]);
+    let (mut t1, mut t2) = (zero, zero);
+    for (d, x) in dn.iter().zip(x_ref).take(facet.nodes()) {
+        let x = dual::constant3::<T>(*x);
+        t1 = dual::add(&t1, &dual::scale(&x, d[0]));
+        t2 = dual::add(&t2, &dual::scale(&x, d[1]));
+    }
+    dual::norm(&dual::cross(&t1, &t2))
+}
+
+/// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane.
+fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: &[T; 2]) -> T {
+    let dn = shape_gradients(facet, zeta);
+    let mut j = [[T::from_f64(0.0); 2]; 2];
+    for (d, p) in dn.iter().zip(nodes).take(facet.nodes()) {
+        for (row, pr) in j.iter_mut().zip(p) {
+            row[0] = row[0] + *pr * d[0];
+            row[1] = row[1] + *pr * d[1];
+        }
+    }
+    j[0][0] * j[1][1] - j[0][1] * j[1][0]
+}
+
+/// The integrals of the segment between slave facet `xs` (reference
+/// positions `x_ref`, dual coefficients `a`) and master facet `xm`; `None`
+/// when they do not overlap.
+///
+/// The integrals are over the REFERENCE slave surface: a point's area in the
+/// auxiliary plane is scaled by `J₀(ζ) / |det ∂P/∂ζ|`, the reference
+/// facet's area element over the projected one. The multipliers are then
+/// nominal pressures (force per reference area, as the links'), the
+/// traction a body load applies is matched node by node, and `A` is that of
+/// the reference facet.
 pub fn segment_terms<T: Scalar>(
     slave_type: FacetType,
     xs: &[Vec3<T>],
+    x_ref: &[[f64; 3]],
     master_type: FacetType,
     xm: &[Vec3<T>],
     a: &[[T; MAX_FACET_NODES]; MAX_FACET_NODES],
@@ -230,7 +265,14 @@ pub fn segment_terms<T: Scalar>(
         area: zero,
     };
     let normal = ov.plane.normal;
+    let slave_nodes = ov.slave_nodes;
     let mapped = ov.for_each_point(slave_type, master_type, &rules.triangle, |q| {
+        let projected = plane_jacobian(slave_type, &slave_nodes, &q.zeta);
+        let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
+        // The projected facet is counter-clockwise or clockwise depending on
+        // its node order; the area element is the absolute value.
+        let scale = if projected.re() < 0.0 { -scale } else { scale };
+        let weight = q.weight * scale;
         let n1 = shape_values(slave_type, &q.zeta);
         let n2 = shape_values(master_type, &q.xi);
         let phi = dual_values(a, &n1, ns);
@@ -238,9 +280,9 @@ pub fn segment_terms<T: Scalar>(
             &normal,
             &dual::sub(&point_on(&n2, xm, nm), &point_on(&n1, xs, ns)),
         );
-        terms.area = terms.area + q.weight;
+        terms.area = terms.area + weight;
         for (j, phi_j) in phi.iter().enumerate().take(ns) {
-            let pw = *phi_j * q.weight;
+            let pw = *phi_j * weight;
             terms.weighted_gap[j] = terms.weighted_gap[j] + pw * gap;
             for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
                 *djk = *djk + pw * *nk;

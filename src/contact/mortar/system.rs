@@ -1,10 +1,10 @@
 //! Nodal assembly of the mortar normal contact: weighted gaps, nodal
 //! pressures, residual and consistent tangent of a set of segments.
 //!
-//! Sign and scaling. Each slave node `j` carries a pressure `λ_j`: the
-//! forces below are `λ_j` times integrals over the CURRENT overlap, so it is
-//! force per current area. With `A_j = ∫ N_j dA₀` its reference nodal area
-//! (a constant scale), `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
+//! Sign and scaling. Each slave node `j` carries a nominal pressure `λ_j`
+//! (force per reference area: the integrals are over the reference slave
+//! surface, see `segment_terms`). With `A_j = ∫ N_j dA₀` its reference nodal
+//! area, `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
 //! converged Newton solution is `p_j = ⟨λ_j − ε_j ḡ_j⟩` (the links' own rule,
 //! [`updated_multiplier`]). The residual, added to `R = f_int − f_ext`, is
 //! the mortar force `r = −Σ_j p_j c_j` with `c_j = ∂g̃_j/∂x` at fixed `D`,
@@ -36,6 +36,8 @@ pub struct Interface<'a> {
     pub master_type: FacetType,
     /// Current position of every node id used below.
     pub positions: &'a [[f64; 3]],
+    /// Reference position of every node id (slave nodes are used).
+    pub reference: &'a [[f64; 3]],
     pub slave_facets: &'a [[u32; MAX_FACET_NODES]],
     pub master_facets: &'a [[u32; MAX_FACET_NODES]],
     /// Slave–master facet pairs that may overlap (from a search).
@@ -123,12 +125,17 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
         let mnodes = &interface.master_facets[m as usize][..nm];
         let xs = seeded::<T>(interface, snodes, 0);
         let xm = seeded::<T>(interface, mnodes, MASTER_OFFSET);
-        // The dual basis depends on the slave facet only: reuse it across
-        // that facet's consecutive candidates.
+        let mut x_ref = [[0.0; 3]; MAX_FACET_NODES];
+        for (r, &n) in x_ref.iter_mut().zip(snodes) {
+            *r = interface.reference[n as usize];
+        }
+        // The dual basis is the reference facet's (constant): compute it once
+        // per slave facet, for its consecutive candidates.
         let a = match cached {
             Some((f, a)) if f == s => a,
-            _ => match dual_coefficients(interface.slave_type, &xs[..ns], rules) {
+            _ => match dual_coefficients::<f64>(interface.slave_type, &x_ref[..ns], rules) {
                 Some(a) => {
+                    let a = a.map(|row| row.map(T::from_f64));
                     cached = Some((s, a));
                     a
                 }
@@ -138,6 +145,7 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
         let terms = segment_terms(
             interface.slave_type,
             &xs[..ns],
+            &x_ref[..ns],
             interface.master_type,
             &xm[..nm],
             &a,

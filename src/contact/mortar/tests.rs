@@ -240,7 +240,7 @@ fn parallel_facets_give_gap_times_nodal_area_and_consistent_forces() {
     let (mut gap, mut d, mut m_sum) = ([0.0; 4], [0.0; 4], [0.0; 4]);
     for xm in master_grid(3, -0.2, 1.5, 0.0, &mut rng, 0.2) {
         let xm: Vec<[f64; 3]> = xm.iter().map(|p| [p[0], p[1], 0.25]).collect();
-        if let Some(t) = segment_terms(Quad4, &xs, Quad4, &xm, &a, &rules) {
+        if let Some(t) = segment_terms(Quad4, &xs, &xs, Quad4, &xm, &a, &rules) {
             for j in 0..4 {
                 gap[j] += t.weighted_gap[j];
                 d[j] += (0..4).map(|k| t.d[j][k]).sum::<f64>();
@@ -370,6 +370,7 @@ impl Case {
             slave_type: self.slave_type,
             master_type: self.master_type,
             positions,
+            reference: &self.positions,
             slave_facets: &self.slave_facets,
             master_facets: &self.master_facets,
             candidates: &self.candidates,
