@@ -942,6 +942,13 @@ impl ContactPair {
         self.friction.is_some()
     }
 
+    /// Whether the pair's tangent is symmetric: frictionless links (the
+    /// Hessian of a potential). The mortar residual is not a gradient (the
+    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric.
+    pub fn tangent_is_symmetric(&self) -> bool {
+        !self.has_friction() && self.mortar.is_none()
+    }
+
     fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
         self.follow(u_local);
         let mut buf = LinkBuffers::default();

@@ -339,11 +339,11 @@ impl<'m> Simulation<'m> {
         let stages = phases::Stages::register()?;
         // Phases booked here; the callbacks book theirs in `mech.times`.
         let mut times = PhaseTimes::default();
-        // Frictionless contact keeps the tangent symmetric (it is the Hessian
-        // of a potential); friction and follower loads do not.
-        let friction = self.contact.iter().any(ContactPair::has_friction);
+        // Frictionless links keep the tangent symmetric (it is the Hessian
+        // of a potential); friction, mortar pairs and follower loads do not.
+        let unsymmetric = self.contact.iter().any(|p| !p.tangent_is_symmetric());
         let symmetric = !self.loads.has_follower()
-            && !friction
+            && !unsymmetric
             && model.materials.iter().all(Material::tangent_is_symmetric);
         let tangent = TangentKind {
             symmetric,
