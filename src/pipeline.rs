@@ -529,6 +529,9 @@ impl Hdf5Sink {
                 },
             )?;
         }
+        if let Some(m) = &v.mortar {
+            self.write_mortar_nodes(step, name, m)?;
+        }
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
         self.file
             .write_step_small(step, &format!("contact/{name}/force"), &force)?;
@@ -538,6 +541,42 @@ impl Hdf5Sink {
             &format!("contact/{name}/penalty"),
             &[fields.pair.penalty],
         )?;
+        Ok(())
+    }
+}
+
+impl Hdf5Sink {
+    /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
+    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`.
+    fn write_mortar_nodes(
+        &mut self,
+        step: usize,
+        name: &str,
+        m: &crate::contact::mortar::pair::NodeFields,
+    ) -> Result<()> {
+        let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
+        for (label, cols, values) in [
+            ("node_lambda", 1, &m.lambda),
+            ("node_weighted_gap", 1, &m.weighted_gap),
+            ("node_traction", 3, &traction),
+        ] {
+            let order = if cols == 3 {
+                &mut self.natural
+            } else {
+                &mut self.natural_scalar
+            };
+            let (start, data) = order.block_of_owned(values)?;
+            self.file.write_step_block(
+                step,
+                &format!("contact/{name}/{label}"),
+                BlockRows {
+                    global_rows: self.nodes,
+                    start,
+                    cols,
+                    data: &data,
+                },
+            )?;
+        }
         Ok(())
     }
 }

@@ -331,14 +331,14 @@ impl<'m> Simulation<'m> {
         let stages = phases::Stages::register()?;
         // Phases booked here; the callbacks book theirs in `mech.times`.
         let mut times = PhaseTimes::default();
-        // Frictionless contact keeps the tangent symmetric (it is the Hessian
-        // of a potential); friction and follower loads do not. A follower
-        // load's facets may sit on some ranks only: the choice is agreed, or
-        // the ranks would factor one matrix as LU and LDLᵀ at once.
-        let friction = self.contact.iter().any(ContactPair::has_friction);
+        // Frictionless links keep the tangent symmetric (it is the Hessian
+        // of a potential); friction, mortar pairs and follower loads do not.
+        // A follower load's facets may sit on some ranks only: the choice is
+        // agreed, or the ranks would factor one matrix as LU and LDLᵀ at once.
+        let unsymmetric = self.contact.iter().any(|p| !p.tangent_is_symmetric());
         let follower = parallel::any_rank(&world, self.loads.has_follower());
         let symmetric =
-            !follower && !friction && model.materials.iter().all(Material::tangent_is_symmetric);
+            !follower && !unsymmetric && model.materials.iter().all(Material::tangent_is_symmetric);
         let tangent = TangentKind {
             symmetric,
             linear_bulk: model.materials.iter().all(Material::is_linear),
@@ -967,7 +967,7 @@ fn nodal_pressure(dofs: &DofMap, pairs: &[ContactPair]) -> Result<Vec<f64>> {
     let n = dofs.num_owned_nodes();
     let (mut num, mut den) = (vec![0.0; n], vec![0.0; n]);
     for p in pairs {
-        p.multipliers.add_nodal_pressure(&mut num, &mut den)?;
+        p.add_nodal_pressure(&mut num, &mut den)?;
     }
     Ok(num
         .iter()
@@ -1008,6 +1008,12 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         if let MasterSpec::Surface { set } = &pair.master {
             master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
                 mesh, set,
+            )?);
+        }
+        if pair.formulation == crate::contact::Formulation::Mortar {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh,
+                &pair.slave,
             )?);
         }
     }
