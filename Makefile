@@ -12,7 +12,7 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-mpi bench work-precision scaling hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi bench bench-peers work-precision scaling hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -61,6 +61,15 @@ bench: deps
 	test -n "$$bin" || { echo "could not find the search benchmark"; exit 1; }; \
 	echo "contact search against slave points (serial)"; \
 	$$bin | tee bench-results/search.csv
+
+# contactlink beside CalculiX (penalty surface-to-surface, one thread) on the
+# same Gmsh meshes of the graded Hertz line contact, h_c = b/5 ... b/40: DOFs,
+# wall time, Newton iterations, Hertz errors and the time ratio in one table
+# (installs gmsh and calculix-ccx if missing; about 3 minutes).
+bench-peers: build
+	@bash scripts/install-deps.sh --peers
+	@mkdir -p bench-results/peers
+	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),3)
 
 # Run time against error for the Hertz line and point contacts: mesh size ×
 # penalty × Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto
