@@ -164,6 +164,8 @@ pub struct ContactPair {
     friction: Option<PairFriction>,
     /// Set by the solver in dynamics (slip from velocities); None: quasi-static.
     pub rate: Option<SlipRateMap>,
+    /// See `tangent_signature`.
+    tangent_signature: u64,
 }
 
 const MAX_LINK_NODES: usize = 8;
@@ -228,6 +230,7 @@ impl ContactPair {
             multipliers,
             penalty,
             facet_penalty,
+            tangent_signature: 0,
             search_distance,
             links: Vec::new(),
             pattern_key: 0,
@@ -636,16 +639,33 @@ impl ContactPair {
         factor: f64,
         k: &mut dyn BlockSink,
     ) -> Result<()> {
+        // Which links are closed, on which master facets, sticking or
+        // sliding: what the tangent's structure depends on.
+        let mut signature = std::collections::hash_map::DefaultHasher::new();
         self.for_each_link(
             u_local,
             factor,
             true,
-            |_, d, _, ke, _| match ke {
-                Some(ke) => Ok(k.add_block(d, d, ke)?),
+            |_, d, _, ke, s| match ke {
+                Some(ke) => {
+                    use std::hash::Hash;
+                    d.hash(&mut signature);
+                    s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
+                    Ok(k.add_block(d, d, ke)?)
+                }
                 None => Ok(()),
             },
             dofs,
-        )
+        )?;
+        self.tangent_signature = std::hash::Hasher::finish(&signature);
+        Ok(())
+    }
+
+    /// A hash of the active set the last tangent was assembled with (this
+    /// rank's links): equal hashes mean the same closed links on the same
+    /// master facets in the same stick/slip states.
+    pub fn tangent_signature(&self) -> u64 {
+        self.tangent_signature
     }
 
     /// The Uzawa update λN ← ⟨λN − εN gN⟩ (and, with friction, λT ← tT) at

@@ -7,10 +7,12 @@
 //! SNES, and only this module calls the solver.
 pub mod boundary;
 pub mod dynamics;
+pub mod lagging;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
 pub mod phases;
+pub mod tolerance;
 
 pub use boundary::{Dirichlet, DirichletSpec};
 pub use dynamics::{DynamicsReport, DynamicsSpec};
@@ -57,6 +59,10 @@ pub struct SolverSettings {
     /// but costs them where the contact set changes between steps
     /// (hertz-cylinder 23 → 24, and a cutback with the l2 line search).
     pub extrapolate: bool,
+    /// Newton inside a non-final Uzawa iteration stops once its residual
+    /// fell by this factor (see `tolerance`); 0: every solve to the final
+    /// tolerance.
+    pub uzawa_forcing: f64,
 }
 
 /// Work a run reuses instead of redoing.
@@ -69,6 +75,10 @@ pub struct Reuse {
     /// Preconditioner (LU factors) of an Uzawa iteration's first solve kept
     /// for the following ones.
     pub preconditioner: bool,
+    /// Preconditioner rebuilt only when the contact active set changed
+    /// (within Newton too), see `lagging`; off: rebuilt every Newton
+    /// iteration of a step's first Uzawa iteration.
+    pub active_set: bool,
 }
 
 impl Default for Reuse {
@@ -77,6 +87,7 @@ impl Default for Reuse {
             linear_stiffness: true,
             pattern: true,
             preconditioner: true,
+            active_set: true,
         }
     }
 }
@@ -92,6 +103,7 @@ impl Default for SolverSettings {
             petsc_options: String::new(),
             reuse: Reuse::default(),
             extrapolate: false,
+            uzawa_forcing: tolerance::DEFAULT_FORCING,
         }
     }
 }
@@ -185,6 +197,10 @@ pub struct RunReport {
     pub displacement: Vec<f64>,
     pub bulk_tangent_assemblies: usize,
     pub pattern_builds: usize,
+    /// Preconditioner rebuilds and reuses decided by the active-set watch
+    /// (`lagging`; both 0 when it is off).
+    pub preconditioner_builds: usize,
+    pub preconditioner_reuses: usize,
     /// Seconds per phase over the run, the largest over the ranks.
     pub phases: PhaseTimes,
     /// Halo volume, summed over ranks: ghost displacement values refreshed
@@ -370,6 +386,12 @@ impl<'m> Simulation<'m> {
             model.body_force.clone(),
             model.solver.reuse.linear_stiffness,
         )?;
+        if !mech.contact.is_empty()
+            && model.solver.reuse.preconditioner
+            && model.solver.reuse.active_set
+        {
+            mech.lag = Some(lagging::PreconditionerLag::default());
+        }
         if let Some(b) = &model.body_force_fn {
             let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
             bulk.add_body_force_fn(
@@ -460,6 +482,10 @@ impl<'m> Simulation<'m> {
                     model.solver.max_newton,
                 )?;
             }
+            // A step (or its retry) starts with fresh factors.
+            if let Some(lag) = mech.lag.as_mut() {
+                lag.reset();
+            }
             let attempt = stage_solve.scope(|| {
                 let mut ctx = StepContext {
                     snes: &mut snes,
@@ -469,6 +495,7 @@ impl<'m> Simulation<'m> {
                     stages: &stages,
                     times: &mut times,
                     reuse_preconditioner: model.solver.reuse.preconditioner,
+                    forcing: model.solver.uzawa_forcing,
                 };
                 uzawa_loop(&world, &mut ctx, &mut mech, target)
             });
@@ -581,6 +608,8 @@ impl<'m> Simulation<'m> {
             displacement,
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
             pattern_builds,
+            preconditioner_builds: mech.lag.as_ref().map_or(0, |l| l.rebuilds),
+            preconditioner_reuses: mech.lag.as_ref().map_or(0, |l| l.reuses),
             phases: max_over_ranks(&world, add_times(&times, &mech.times)),
             halo_displacements: sum_over_ranks(&world, dofs.ghost_dofs().len()),
             halo_multipliers: sum_over_ranks(
@@ -650,6 +679,8 @@ struct StepContext<'s> {
     stages: &'s phases::Stages,
     times: &'s mut PhaseTimes,
     reuse_preconditioner: bool,
+    /// Newton's relative forcing in non-final Uzawa iterations.
+    forcing: f64,
 }
 
 /// The initial guess of a load step: the last converged state, or the last
@@ -763,6 +794,29 @@ fn uzawa_loop(
     mech: &mut Mechanics,
     factor: f64,
 ) -> Result<StepResult> {
+    // The options' tolerances are the final ones; non-final solves loosen
+    // them, and every way out restores them for the next step.
+    let (atol, rtol, stol, max_it) = ctx.snes.tolerances()?;
+    let tight = tolerance::NewtonTolerance { atol, rtol };
+    let forcing = if mech.contact.is_empty() {
+        0.0
+    } else {
+        ctx.forcing
+    };
+    let inner = tolerance::InnerTolerance::new(tight, forcing);
+    let result = uzawa_rounds(world, ctx, mech, factor, &inner, (stol, max_it));
+    ctx.snes.set_tolerances(atol, rtol, stol, max_it)?;
+    result
+}
+
+fn uzawa_rounds(
+    world: &impl Communicator,
+    ctx: &mut StepContext,
+    mech: &mut Mechanics,
+    factor: f64,
+    inner: &tolerance::InnerTolerance,
+    (stol, max_it): (f64, usize),
+) -> Result<StepResult> {
     let StepContext {
         snes,
         x,
@@ -771,6 +825,7 @@ fn uzawa_loop(
         stages,
         times,
         reuse_preconditioner,
+        ..
     } = ctx;
     let reuse_preconditioner = *reuse_preconditioner;
     let max_uzawa = mech
@@ -791,9 +846,12 @@ fn uzawa_loop(
     // multipliers), replaced after every Uzawa update: reported if Newton
     // fails for good.
     let mut last_links = link_summaries(world, mech.contact);
+    let mut solve_tight = !inner.is_inexact();
     loop {
         k += 1;
         total += 1;
+        let tol = inner.for_solve(solve_tight);
+        snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
         snes.set_lag_preconditioner(
@@ -837,11 +895,18 @@ fn uzawa_loop(
             .iter()
             .zip(&stats)
             .all(|(p, s)| pair_converged(p, s));
-        if converged {
-            outcome.iterations = newton;
-            outcome.linear_iterations = linear;
-            outcome.history = history;
-            return Ok(Ok((outcome, total, stats)));
+        match tolerance::round_end(converged, solve_tight) {
+            tolerance::RoundEnd::Converged => {
+                outcome.iterations = newton;
+                outcome.linear_iterations = linear;
+                outcome.history = history;
+                return Ok(Ok((outcome, total, stats)));
+            }
+            tolerance::RoundEnd::Confirm => {
+                solve_tight = true;
+                continue;
+            }
+            tolerance::RoundEnd::Continue => {}
         }
         if k >= max_uzawa && raises < PENALTY_RAISES {
             // Converging too slowly (soft bodies, long sliding): the
