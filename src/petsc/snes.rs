@@ -292,11 +292,10 @@ unsafe extern "C" fn jacobian_trampoline(
     // same matrix (set in `solve`).
     let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(a)) };
     let code = run_callback(ctx, snes, |p| p.jacobian(&xv, &mut am));
-    if code != 0 {
-        return code;
-    }
     // SNES reads its preconditioner lag after this callback returns, so a
     // lag set here decides this iteration: -2 rebuilds once, -1 reuses.
+    // The decision is collective, so it is asked for on every rank even
+    // when this rank's Jacobian failed (then only the failure is returned).
     let mut its: sys::PetscInt = 0;
     let mut ksp: sys::KSP = std::ptr::null_mut();
     // SAFETY: valid snes handed to the callback; out-pointers are locals.
@@ -306,12 +305,22 @@ unsafe extern "C" fn jacobian_trampoline(
     // SAFETY: ctx is the `Context` set in `solve`, alive for the whole SNESSolve.
     let context = unsafe { &mut *(ctx as *mut Context) };
     let last = if got { its.max(0) as usize } else { usize::MAX };
-    match context.problem.rebuild_preconditioner(last) {
+    let decision = catch_unwind(AssertUnwindSafe(|| {
+        context.problem.rebuild_preconditioner(last)
+    }));
+    if code != 0 {
+        return code;
+    }
+    match decision {
         // SAFETY: valid snes.
-        Some(rebuild) => unsafe {
+        Ok(Some(rebuild)) => unsafe {
             sys::SNESSetLagPreconditionerPersists(snes, sys::PetscBool_PETSC_TRUE);
             sys::SNESSetLagPreconditioner(snes, if rebuild { -2 } else { -1 })
         },
-        None => 0,
+        Ok(None) => 0,
+        Err(_) => {
+            context.fatal = Some("panic while deciding the preconditioner lag".into());
+            sys::PETSC_ERR_USER
+        }
     }
 }
