@@ -16,7 +16,7 @@ export OMPI_MCA_btl_vader_single_copy_mechanism := none
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
 cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
 
-.PHONY: deps build demo test test-mpi test-examples bench work-precision scaling hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -83,6 +83,15 @@ bench: deps
 	@set -e; bin=$(call cargo_exe,bench,search,bench --bench search --no-run); \
 	echo "contact search against slave points (serial)"; \
 	$$bin | tee bench-results/search.csv
+
+# contactlink beside CalculiX (penalty surface-to-surface, one thread) on the
+# same Gmsh meshes of the graded Hertz line contact, h_c = b/5 ... b/40: DOFs,
+# wall time, Newton iterations, Hertz errors and the time ratio in one table
+# (installs gmsh and calculix-ccx if missing; about 3 minutes).
+bench-peers: build
+	@bash scripts/install-deps.sh --peers
+	@mkdir -p bench-results/peers
+	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),3)
 
 # Run time against error for the Hertz line and point contacts: mesh size ×
 # penalty × Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto

@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian packages contactlink builds and runs with, only when
 # some are missing. Safe to run again: it does nothing when all are present.
+# `--peers` adds what `make bench-peers` runs beside contactlink (Gmsh and
+# CalculiX); neither is needed to build or test.
 set -euo pipefail
 packages=(
   petsc-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
   libclang-dev clang pkg-config hdf5-tools libopenblas0-serial
   python3-matplotlib python3-h5py fonts-dejavu-core
 )
+if [ "${1:-}" = "--peers" ]; then
+  packages+=(gmsh calculix-ccx)
+fi
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -216,6 +216,16 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                     r.wall_seconds
                 );
                 println!("{}", phase_summary(&r.phases, r.wall_seconds));
+                if r.preconditioner_builds > 0 {
+                    let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
+                    println!(
+                        "  solver: {} Uzawa iterations, {} linear iterations, preconditioner built {} times and kept {} times",
+                        r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
+                        linear,
+                        r.preconditioner_builds,
+                        r.preconditioner_reuses
+                    );
+                }
                 if rt.size() > 1 {
                     println!(
                         "  halo (all ranks): {} ghost displacement values per residual, {} ghost multiplier values per Uzawa update",

@@ -375,8 +375,12 @@ pub struct SolverSection {
     pub reuse_linear_stiffness: Option<bool>,
     pub reuse_pattern: Option<bool>,
     pub lag_preconditioner: Option<bool>,
+    pub lag_active_set: Option<bool>,
     /// Start a step from the last two converged steps extrapolated (default false).
     pub extrapolate: Option<bool>,
+    /// Relative residual reduction of Newton in non-final Uzawa iterations
+    /// (0: every solve to the final tolerance).
+    pub uzawa_forcing: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -906,8 +910,17 @@ impl Scene {
                 linear_stiffness: s.reuse_linear_stiffness.unwrap_or(d.reuse.linear_stiffness),
                 pattern: s.reuse_pattern.unwrap_or(d.reuse.pattern),
                 preconditioner: s.lag_preconditioner.unwrap_or(d.reuse.preconditioner),
+                active_set: s.lag_active_set.unwrap_or(d.reuse.active_set),
             },
             extrapolate: s.extrapolate.unwrap_or(d.extrapolate),
+            uzawa_forcing: match s.uzawa_forcing.unwrap_or(d.uzawa_forcing) {
+                f if (0.0..1.0).contains(&f) => f,
+                f => {
+                    return Err(format!(
+                        "[solver] uzawa_forcing must be in [0, 1) (got {f})"
+                    ))
+                }
+            },
         })
     }
 

@@ -191,6 +191,8 @@ pub struct ContactPair {
     /// the links above stay empty (the slave surface still gives the output
     /// its points).
     pub mortar: Option<MortarPair>,
+    /// See `tangent_signature`.
+    tangent_signature: u64,
 }
 
 const MAX_LINK_NODES: usize = 8;
@@ -275,6 +277,7 @@ impl ContactPair {
             multipliers,
             penalty,
             facet_penalty,
+            tangent_signature: 0,
             search_distance,
             links: Vec::new(),
             pattern_key: 0,
@@ -694,19 +697,42 @@ impl ContactPair {
         factor: f64,
         k: &mut dyn BlockSink,
     ) -> Result<()> {
+        if self.mortar.is_some() {
+            // No active-set hash for mortar pairs yet: a new signature at
+            // every tangent makes the solver rebuild its preconditioner each
+            // time, as it did before the active-set lag existed.
+            self.tangent_signature = self.tangent_signature.wrapping_add(1);
+        }
         if let Some(m) = &self.mortar {
             return m.add_tangent(dofs, u_local, k);
         }
+        // Which links are closed, on which master facets, sticking or
+        // sliding: what the tangent's structure depends on.
+        let mut signature = std::collections::hash_map::DefaultHasher::new();
         self.for_each_link(
             u_local,
             factor,
             true,
-            |_, d, _, ke, _| match ke {
-                Some(ke) => Ok(k.add_block(d, d, ke)?),
+            |_, d, _, ke, s| match ke {
+                Some(ke) => {
+                    use std::hash::Hash;
+                    d.hash(&mut signature);
+                    s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
+                    Ok(k.add_block(d, d, ke)?)
+                }
                 None => Ok(()),
             },
             dofs,
-        )
+        )?;
+        self.tangent_signature = std::hash::Hasher::finish(&signature);
+        Ok(())
+    }
+
+    /// A hash of the active set the last tangent was assembled with (this
+    /// rank's links): equal hashes mean the same closed links on the same
+    /// master facets in the same stick/slip states.
+    pub fn tangent_signature(&self) -> u64 {
+        self.tangent_signature
     }
 
     /// The Uzawa update λN ← ⟨λN − εN gN⟩ (and, with friction, λT ← tT) at

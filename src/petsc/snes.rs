@@ -25,6 +25,14 @@ pub enum CallbackError {
 pub trait NonlinearProblem {
     fn residual(&mut self, x: &Vector, r: &mut Vector) -> std::result::Result<(), CallbackError>;
     fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError>;
+
+    /// Called after each Jacobian evaluation with the iteration count of the
+    /// last linear solve: Some(true) to rebuild the preconditioner from this
+    /// Jacobian, Some(false) to keep the last one, None to leave SNES's own
+    /// lag setting alone. Must give the same answer on every rank.
+    fn rebuild_preconditioner(&mut self, _last_linear_iterations: usize) -> Option<bool> {
+        None
+    }
 }
 
 /// The result of one SNES solve.
@@ -81,6 +89,24 @@ impl Snes {
                 -1
             ))
         }
+    }
+
+    /// The current (atol, rtol, stol, max_it), as the options left them.
+    pub fn tolerances(&self) -> Result<(f64, f64, f64, usize)> {
+        let (mut atol, mut rtol, mut stol) = (0.0, 0.0, 0.0);
+        let (mut max_it, mut max_f): (sys::PetscInt, sys::PetscInt) = (0, 0);
+        // SAFETY: valid snes; every out-pointer is a live local.
+        unsafe {
+            petsc_call!(SNESGetTolerances(
+                self.raw,
+                &mut atol,
+                &mut rtol,
+                &mut stol,
+                &mut max_it,
+                &mut max_f
+            ))?
+        };
+        Ok((atol, rtol, stol, max_it.max(0) as usize))
     }
 
     /// How often the preconditioner is rebuilt within this and later solves:
@@ -323,5 +349,50 @@ unsafe extern "C" fn jacobian_trampoline(
     // SAFETY: PETSc passes valid objects for the call's duration; A and P are the
     // same matrix (set in `solve`).
     let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(a)) };
-    run_callback(ctx, snes, Kind::Jacobian, |p| p.jacobian(&xv, &mut am))
+    let code = run_callback(ctx, snes, Kind::Jacobian, |p| p.jacobian(&xv, &mut am));
+    // SNES reads its preconditioner lag after this callback returns, so a
+    // lag set here decides this iteration: -2 rebuilds once, -1 reuses.
+    // The decision is collective, so it is asked for on every rank even
+    // when the Jacobian failed (the failure was agreed by every rank, so
+    // all of them return it below).
+    let mut its: sys::PetscInt = 0;
+    let mut ksp: sys::KSP = std::ptr::null_mut();
+    // SAFETY: valid snes handed to the callback; out-pointers are locals.
+    let got = unsafe {
+        sys::SNESGetKSP(snes, &mut ksp) == 0 && sys::KSPGetIterationNumber(ksp, &mut its) == 0
+    };
+    // SAFETY: ctx is the `Context` set in `solve`, alive for the whole SNESSolve.
+    let context = unsafe { &mut *(ctx as *mut Context) };
+    let last = if got { its.max(0) as usize } else { usize::MAX };
+    let decision = catch_unwind(AssertUnwindSafe(|| {
+        context.problem.rebuild_preconditioner(last)
+    }));
+    if code != 0 {
+        return code;
+    }
+    match decision {
+        Ok(Some(rebuild)) => {
+            let lag = if rebuild { -2 } else { -1 };
+            // SAFETY: valid snes handed to the callback by PETSc.
+            let set = unsafe {
+                petsc_call!(SNESSetLagPreconditionerPersists(
+                    snes,
+                    sys::PetscBool_PETSC_TRUE
+                ))
+                .and_then(|()| petsc_call!(SNESSetLagPreconditioner(snes, lag)))
+            };
+            match set {
+                Ok(()) => 0,
+                Err(e) => {
+                    context.fatal = Some(e.to_string());
+                    sys::PETSC_ERR_USER
+                }
+            }
+        }
+        Ok(None) => 0,
+        Err(_) => {
+            context.fatal = Some("panic while deciding the preconditioner lag".into());
+            sys::PETSC_ERR_USER
+        }
+    }
 }

@@ -3,6 +3,7 @@
 //! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
 use super::dynamics::Inertia;
+use super::lagging::PreconditionerLag;
 use super::phases::{Phase, PhaseTimes, Stages};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
@@ -32,6 +33,9 @@ pub struct Mechanics<'a> {
     pub inertia: Option<Inertia>,
     /// Time spent per phase in these callbacks (this rank).
     pub times: PhaseTimes,
+    /// Rebuild the preconditioner only on active-set changes (None: SNES's
+    /// own lag setting decides).
+    pub lag: Option<PreconditionerLag>,
     stages: Stages,
     /// The callbacks agree their outcome over these ranks (PETSc's world).
     world: SimpleCommunicator,
@@ -71,6 +75,7 @@ impl<'a> Mechanics<'a> {
             factor: 0.0,
             inertia: None,
             times: PhaseTimes::default(),
+            lag: None,
             stages: Stages::register()?,
             world: SimpleCommunicator::world(),
             u,
@@ -332,5 +337,16 @@ impl NonlinearProblem for Mechanics<'_> {
     fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError> {
         let local = self.jacobian_impl(x, j);
         self.agree(local)
+    }
+
+    fn rebuild_preconditioner(&mut self, last_linear_iterations: usize) -> Option<bool> {
+        let lag = self.lag.as_mut()?;
+        let signatures: Vec<u64> = self
+            .contact
+            .iter()
+            .map(ContactPair::tangent_signature)
+            .collect();
+        let world = mpi::topology::SimpleCommunicator::world();
+        Some(lag.decide(&world, &signatures, last_linear_iterations))
     }
 }
