@@ -576,3 +576,249 @@ fn unknown_key_keeps_its_line_with_overrides_and_names_a_bad_override() {
         "{t}"
     );
 }
+
+// ---------------------------------------------------------------------------
+// Values that would reach the solver as NaN or inf, counts far beyond any
+// use, meshes too large to build, and bodies that float: each is refused by
+// `check`, at its line, before anything is solved.
+
+#[test]
+fn non_finite_body_force_names_its_line() {
+    for (i, v) in ["nan", "inf", "-inf"].iter().enumerate() {
+        let scene =
+            format!("{GOOD}\n[[body_force]]\nbody = \"block\"\nvector = [0.0, {v}, -1.0]\n");
+        check_fails_at(
+            &format!("body-force-{i}"),
+            &scene,
+            "vector = [0.0,",
+            &["[[body_force]] body 'block'", "must be a finite number"],
+        );
+    }
+}
+
+#[test]
+fn non_finite_load_and_condition_values_name_their_lines() {
+    let cases = [
+        (
+            GOOD.replace("value = 1.0", "value = nan"),
+            "value = nan",
+            "[[pressure]] value",
+        ),
+        (
+            GOOD.replace(
+                "set = \"block.bottom\"",
+                "set = \"block.bottom\"\ncomponents = [\"z\"]\nvalue = [inf]",
+            ),
+            "value = [inf]",
+            "[[dirichlet]] value",
+        ),
+        (
+            GOOD.to_string() + "\n[[traction]]\nset = \"block.xmax\"\nvector = [1.0, nan, 0.0]\n",
+            "vector = [1.0, nan",
+            "[[traction]] vector",
+        ),
+        (
+            GOOD.replace(
+                "value = 1.0",
+                "value = 1.0\namplitude = [[0.0, 0.0], [1.0, inf]]",
+            ),
+            "amplitude = ",
+            "not finite",
+        ),
+        (
+            GOOD.replace(
+                "poisson = 0.3",
+                "poisson = 0.3\ndensity = 1.0\ninitial_velocity = [nan, 0.0, 0.0]",
+            ) + "\n[dynamics]\ntime_step = 0.1\n",
+            "initial_velocity",
+            "initial_velocity must be a finite number",
+        ),
+        (
+            GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0")
+                + "\n[dynamics]\ntime_step = inf\n",
+            "time_step = inf",
+            "time_step must be positive",
+        ),
+        (
+            GOOD.replace("poisson = 0.3", "poisson = 0.3\ndensity = 1.0")
+                + "\n[dynamics]\ntime_step = 0.1\nbeta = nan\n",
+            "[dynamics]",
+            "beta",
+        ),
+    ];
+    for (i, (scene, at, expect)) in cases.iter().enumerate() {
+        check_fails_at(&format!("non-finite-{i}"), scene, at, &[expect]);
+    }
+}
+
+#[test]
+fn non_finite_rigid_surface_and_motion_name_their_lines() {
+    let rigid = |point: &str, motion: &str| {
+        format!(
+            "{GOOD}\n[[contact]]\nname = \"floor\"\nslave = \"block.bottom\"\nrigid = {{ kind = \"plane\", point = {point}, normal = [0.0, 0.0, 1.0] }}\nmotion = {motion}\n"
+        )
+    };
+    check_fails_at(
+        "rigid-point",
+        &rigid("[0.0, nan, 0.0]", "[0.0, 0.0, 0.1]"),
+        "rigid = ",
+        &["[[contact]] 'floor'", "rigid point", "finite"],
+    );
+    check_fails_at(
+        "rigid-motion",
+        &rigid("[0.0, 0.0, 0.0]", "[0.0, 0.0, inf]"),
+        "motion = ",
+        &["[[contact]] 'floor'", "motion", "finite"],
+    );
+}
+
+#[test]
+fn absurd_counts_are_refused_with_the_limit() {
+    let cases = [
+        (
+            GOOD.to_string() + "\n[steps]\ncount = 10000000\n",
+            "count = ",
+            "[steps] count = 10000000 is above the limit of 1000000",
+        ),
+        (
+            GOOD.to_string() + "\n[solver]\nmax_newton = 100000000\n",
+            "max_newton",
+            "[solver] max_newton = 100000000 is above the limit of 10000",
+        ),
+        (
+            GOOD.to_string() + "\n[solver]\nmax_cutbacks = 1000\n",
+            "max_cutbacks",
+            "[solver] max_cutbacks = 1000 is above the limit of 30",
+        ),
+        (
+            stacked(&format!("{CONTACT}max_uzawa = 5000000000")),
+            "max_uzawa",
+            "[[contact]] 'c' max_uzawa = 5000000000 is above the limit of 10000",
+        ),
+    ];
+    for (i, (scene, at, expect)) in cases.iter().enumerate() {
+        check_fails_at(&format!("count-{i}"), scene, at, &[expect]);
+    }
+}
+
+#[test]
+fn bad_petsc_options_string_names_its_line() {
+    let scene = GOOD.to_string() + "\n[solver]\npetsc_options = \"ksp_type gmres\"\n";
+    check_fails_at(
+        "petsc-options-syntax",
+        &scene,
+        "petsc_options",
+        &["[solver] petsc_options", "\"ksp_type\""],
+    );
+}
+
+/// A scene with `mesh` as its [mesh] section and one body per name.
+fn generated(mesh: &str, bodies: &[&str]) -> String {
+    let mut s = format!("[mesh]\n{mesh}\n");
+    for b in bodies {
+        s += &format!(
+            "\n[[body]]\nname = \"{b}\"\nmaterial = \"linear-elastic\"\nyoungs = 1.0\npoisson = 0.3\n"
+        );
+    }
+    s
+}
+
+#[test]
+fn too_large_generated_meshes_are_refused_before_allocating() {
+    let cases = [
+        (
+            generated(
+                "generator = \"hertz-cylinder\"\nlevel = 6",
+                &["block", "cylinder"],
+            ),
+            "level = 6",
+            "hertz_cylinder: invalid `level`: the mesh would have 25534464 hex8 cells",
+        ),
+        (
+            generated(
+                "generator = \"hertz-sphere\"\nlevel = 3",
+                &["block", "sphere"],
+            ),
+            "level = 3",
+            "hertz_sphere: invalid `level`: the mesh would have 34957312 hex8 cells",
+        ),
+        (
+            generated(
+                "generator = \"hertz-sphere\"\nfine_size = 0.01",
+                &["block", "sphere"],
+            ),
+            "fine_size",
+            "hertz_sphere: invalid `fine_size`: the mesh would have",
+        ),
+        (
+            generated(
+                "generator = \"box\"\nsize = [1.0, 1.0, 1.0]\ndivisions = [200, 200, 200]",
+                &["block"],
+            ),
+            "divisions",
+            "graded_box: invalid `divisions`: the mesh would have 8000000 hex8 cells and up to 8120601 nodes",
+        ),
+        (
+            generated(
+                "generator = \"box\"\nsize = [1.0, 1.0, 1.0]\ndivisions = [150, 150, 150]\ncell_type = \"tet4\"",
+                &["block"],
+            ),
+            "divisions",
+            "the mesh would have 20250000 tet4 cells",
+        ),
+        (
+            generated(
+                "generator = \"stacked-blocks\"\nupper_divisions = [300, 300, 100]",
+                &["lower", "upper"],
+            ),
+            "upper_divisions",
+            "stacked_blocks: invalid `upper_divisions`: the mesh would have 9000032 hex8 cells",
+        ),
+    ];
+    for (i, (scene, at, expect)) in cases.iter().enumerate() {
+        let start = std::time::Instant::now();
+        check_fails_at(
+            &format!("mesh-size-{i}"),
+            scene,
+            at,
+            &[
+                expect,
+                "above the limit of 20000000 cells and 4000000 nodes",
+            ],
+        );
+        // Refused from the node lines alone: building even a tenth of these
+        // meshes takes seconds.
+        assert!(
+            start.elapsed().as_secs_f64() < 5.0,
+            "case {i} took {:?}",
+            start.elapsed()
+        );
+    }
+}
+
+#[test]
+fn bodies_held_only_by_each_other_are_named() {
+    // Two bodies in contact and nothing else: together they float.
+    let scene = stacked(CONTACT).replace("[[dirichlet]]\nset = \"lower.bottom\"\n", "");
+    check_fails_at(
+        "held-by-each-other",
+        &scene,
+        "name = \"lower\"",
+        &[
+            "bodies 'lower', 'upper' are held only through contact with each other",
+            "singular",
+        ],
+    );
+    // Held on the master side works as well as on the slave side.
+    let dir = scratch("held-master-side");
+    let scene = stacked(CONTACT).replace("lower.bottom", "upper.top");
+    let path = write(&dir, "scene.toml", &scene);
+    let o = run(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    // A rigid surface holds its slave.
+    let floor = GOOD.replace("[[dirichlet]]\nset = \"block.bottom\"\n", "")
+        + "\n[[contact]]\nslave = \"block.bottom\"\nrigid = { kind = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }\n";
+    let path = write(&dir, "rigid.toml", &floor);
+    let o = run(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+}

@@ -77,33 +77,46 @@ pub fn insert_string(opts: &str) -> Result<()> {
     unsafe { petsc_call!(PetscOptionsInsertString(std::ptr::null_mut(), s.as_ptr())) }
 }
 
-/// Inserts "-key value" pairs from `opts` as defaults: keys the user already
-/// set (command line, PETSC_OPTIONS) keep the user's value.
-pub fn insert_string_defaults(opts: &str) -> Result<()> {
+/// Splits an option string "-key value -flag ..." into (key, value) pairs,
+/// as PETSc reads it: a word after a key is its value unless it is itself
+/// a key (a negative number is a value). Needs no PETSc, so a scene can be
+/// checked before PETSc starts.
+pub fn parse_pairs(opts: &str) -> std::result::Result<Vec<(&str, &str)>, String> {
     let words: Vec<&str> = opts.split_whitespace().collect();
+    let is_key = |w: &str| w.starts_with('-') && w.parse::<f64>().is_err();
+    let mut pairs = Vec::new();
     let mut i = 0;
     while i < words.len() {
         let key = words[i];
-        if !key.starts_with('-') {
-            return Err(PetscError {
-                call: "PetscOptions",
-                code: -1,
-                message: format!("expected an option starting with '-', found {key:?} in {opts:?}"),
-            });
+        if !is_key(key) || key.len() < 2 {
+            return Err(format!(
+                "expected an option starting with '-', found {key:?} in {opts:?}"
+            ));
         }
-        let value = words
-            .get(i + 1)
-            .filter(|w| !w.starts_with('-') || w.parse::<f64>().is_ok());
-        match value {
+        match words.get(i + 1).filter(|w| !is_key(w)) {
             Some(v) => {
-                set_default(key, v)?;
+                pairs.push((key, *v));
                 i += 2;
             }
             None => {
-                set_default(key, "")?;
+                pairs.push((key, ""));
                 i += 1;
             }
         }
+    }
+    Ok(pairs)
+}
+
+/// Inserts "-key value" pairs from `opts` as defaults: keys the user already
+/// set (command line, PETSC_OPTIONS) keep the user's value.
+pub fn insert_string_defaults(opts: &str) -> Result<()> {
+    let pairs = parse_pairs(opts).map_err(|message| PetscError {
+        call: "PetscOptions",
+        code: -1,
+        message,
+    })?;
+    for (key, value) in pairs {
+        set_default(key, value)?;
     }
     Ok(())
 }
