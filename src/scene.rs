@@ -390,6 +390,8 @@ pub struct OutputSection {
 pub struct SceneSource {
     pub origin: String,
     pub text: String,
+    /// The scene file read (none for a built-in scene).
+    pub path: Option<std::path::PathBuf>,
 }
 
 impl SceneSource {
@@ -399,6 +401,7 @@ impl SceneSource {
             return Ok(SceneSource {
                 origin: format!("built-in scene '{name}'"),
                 text: (*text).to_owned(),
+                path: None,
             });
         }
         let path = Path::new(name_or_path);
@@ -415,6 +418,7 @@ impl SceneSource {
         Ok(SceneSource {
             origin: path.display().to_string(),
             text,
+            path: Some(path.to_path_buf()),
         })
     }
 }
@@ -586,6 +590,14 @@ impl Scene {
         move |b| {
             let path = if b.path.is_empty() { section } else { &b.path };
             self.error_at(origin, path, b.message)
+        }
+    }
+
+    /// The mesh file the scene reads, if any (a Gmsh `[mesh] file`).
+    pub fn mesh_file(&self, origin: &str) -> Option<std::path::PathBuf> {
+        match &self.mesh {
+            MeshSection::Gmsh(g) => Some(gmsh_path(g, origin)),
+            _ => None,
         }
     }
 
@@ -1037,17 +1049,7 @@ impl Scene {
                 })?
             }
             MeshSection::Gmsh(g) => {
-                // `origin` is the scene's path, or names a built-in scene,
-                // which is compiled in from the crate's scenes/ directory.
-                let builtin = BUILTIN
-                    .iter()
-                    .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
-                let base = match Path::new(origin).parent() {
-                    _ if builtin => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
-                    Some(dir) => dir.to_path_buf(),
-                    None => Default::default(),
-                };
-                let (mesh, gmsh) = crate::mesh::read_gmsh(&base.join(&g.file)).map_err(|e| {
+                let (mesh, gmsh) = crate::mesh::read_gmsh(&gmsh_path(g, origin)).map_err(|e| {
                     let at = [Seg::Key("mesh"), Seg::Key("file")];
                     self.error_at(origin, &at, format!("[mesh] gmsh: {e}"))
                 })?;
@@ -1057,6 +1059,21 @@ impl Scene {
         };
         Ok((mesh, report))
     }
+}
+
+/// A Gmsh `file` as a path: relative to the scene's directory. `origin`
+/// is the scene's path, or names a built-in scene, which is compiled in
+/// from the crate's scenes/ directory.
+fn gmsh_path(g: &GmshSection, origin: &str) -> std::path::PathBuf {
+    let builtin = BUILTIN
+        .iter()
+        .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
+    let base = match Path::new(origin).parent() {
+        _ if builtin => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+        Some(dir) => dir.to_path_buf(),
+        None => Default::default(),
+    };
+    base.join(&g.file)
 }
 
 /// What reading the mesh found besides the mesh (for `check` to print).

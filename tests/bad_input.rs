@@ -822,3 +822,79 @@ fn bodies_held_only_by_each_other_are_named() {
     let o = run(&["check", path.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
 }
+
+/// `run` with `args` fails before any solve, names `expect`, and leaves every
+/// file in `keep` as it was.
+fn run_refused(args: &[&str], keep: &[&std::path::Path], expect: &str) {
+    let before: Vec<Vec<u8>> = keep.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    let o = run(args);
+    let t = text(&o);
+    assert!(!o.status.success(), "{args:?} accepted:\n{t}");
+    assert!(t.contains(expect), "{args:?}: no {expect:?} in:\n{t}");
+    assert!(!t.contains("done:"), "{args:?} solved:\n{t}");
+    for (p, b) in keep.iter().zip(before) {
+        assert_eq!(std::fs::read(p).unwrap(), b, "{} was changed", p.display());
+    }
+}
+
+#[test]
+fn output_over_an_input_is_refused() {
+    let dir = scratch("output-over-input");
+    let scene = write(&dir, "scene.toml", GOOD);
+    let s = scene.to_str().unwrap();
+    run_refused(
+        &["run", s, "-o", s],
+        &[&scene],
+        "would overwrite the scene file",
+    );
+    // Spelled differently, through a directory that does not exist yet.
+    let other = dir.join("new/../scene.toml");
+    run_refused(
+        &["run", s, "-o", other.to_str().unwrap()],
+        &[&scene],
+        "would overwrite the scene file",
+    );
+    // The scene's own [output] path; a result file named like its own
+    // XDMF sidecar.
+    let own_path = dir.join("own.toml");
+    let own = write(
+        &dir,
+        "own.toml",
+        &format!(
+            "{GOOD}\n[output]\npath = {:?}\n",
+            own_path.to_str().unwrap()
+        ),
+    );
+    run_refused(
+        &["run", own.to_str().unwrap()],
+        &[&own],
+        "would overwrite the scene file",
+    );
+    run_refused(
+        &["run", s, "-o", dir.join("scene.xmf").to_str().unwrap()],
+        &[&scene],
+        "the result file and its XDMF sidecar would be the same file",
+    );
+    // A Gmsh mesh file, and the CSV history written next to `mesh.h5`
+    // over a mesh named `mesh.csv`.
+    let msh = env!("CARGO_MANIFEST_DIR").to_string() + "/scenes/sphere-block.msh";
+    let mesh = dir.join("mesh.csv");
+    std::fs::copy(&msh, &mesh).unwrap();
+    let text = std::fs::read_to_string(
+        env!("CARGO_MANIFEST_DIR").to_string() + "/scenes/sphere-block.toml",
+    )
+    .unwrap()
+    .replace("sphere-block.msh", "mesh.csv");
+    let gmsh = write(&dir, "gmsh.toml", &text);
+    let g = gmsh.to_str().unwrap();
+    run_refused(
+        &["run", g, "-o", mesh.to_str().unwrap()],
+        &[&mesh, &gmsh],
+        "would overwrite the mesh file",
+    );
+    run_refused(
+        &["run", g, "-o", dir.join("mesh.h5").to_str().unwrap()],
+        &[&mesh, &gmsh],
+        "its CSV history",
+    );
+}

@@ -59,6 +59,7 @@
 //! instead of leaving the others blocked in the next collective call.
 
 mod hdf5_file;
+pub mod paths;
 pub mod xdmf;
 
 use std::path::{Path, PathBuf};
