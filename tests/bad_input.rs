@@ -898,3 +898,49 @@ fn output_over_an_input_is_refused() {
         "its CSV history",
     );
 }
+
+#[test]
+fn petsc_option_errors_name_the_option() {
+    let dir = scratch("petsc-options");
+    let scene = write(&dir, "scene.toml", GOOD);
+    let s = scene.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["-ksp_type", "nonsense"],
+            "option -ksp_type nonsense: Unable to find requested KSP type nonsense",
+        ),
+        (
+            &["-pc_type", "foo"],
+            "option -pc_type foo: Unable to find requested PC type foo",
+        ),
+        (
+            &["-ksp_rtol", "abc"],
+            "option -ksp_rtol abc: Input string abc has no numeric value",
+        ),
+        (
+            &["-snes_max_it", "1.5x"],
+            "option -snes_max_it 1.5x: Input string 1.5x has no integer value",
+        ),
+        // From the scene: its options outrank the program's defaults, so a
+        // bad one is used, and named.
+        (
+            &[
+                "--set",
+                "solver.petsc_options=\"-snes_linesearch_type bogus\"",
+            ],
+            "option -snes_linesearch_type bogus: Unable to find requested Line Search type bogus",
+        ),
+    ];
+    for (extra, expect) in cases {
+        let mut args = vec!["run", s, "-q"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{extra:?} accepted:\n{stderr}");
+        assert!(
+            stderr.contains(expect),
+            "{extra:?}: no {expect:?} in:\n{stderr}"
+        );
+        assert_eq!(stderr.trim().lines().count(), 1, "not one line:\n{stderr}");
+    }
+}

@@ -1,6 +1,6 @@
 //! The PETSc options database: defaults set by the program, which the command
 //! line and PETSC_OPTIONS can override.
-use super::{petsc_call, PetscError, Result};
+use super::{petsc_call, sys, PetscError, Result};
 use std::ffi::CString;
 
 fn c_string(s: &str) -> Result<CString> {
@@ -14,17 +14,31 @@ fn c_string(s: &str) -> Result<CString> {
 /// Options this program set as defaults (not the user): a later run in the
 /// same process may set them differently (e.g. direct solver for a small
 /// model, multigrid for a large one), while the user's own options stay.
-static PROGRAM_SET: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+/// Each is marked with who set it: a scene's `petsc_options` outrank the
+/// program's own defaults (but not the command line or PETSC_OPTIONS).
+static PROGRAM_SET: std::sync::Mutex<Vec<(String, Source)>> = std::sync::Mutex::new(Vec::new());
 
-/// Sets `name` (with its leading dash) to `value` unless the user set it.
+/// Who set an option in [`PROGRAM_SET`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Source {
+    Scene,
+    Program,
+}
+
+/// Sets `name` (with its leading dash) to `value` unless the user or the
+/// scene set it.
 pub fn set_default(name: &str, value: &str) -> Result<()> {
+    set_as(name, value, Source::Program)
+}
+
+fn set_as(name: &str, value: &str, source: Source) -> Result<()> {
     let mut ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
-    let is_ours = ours.iter().any(|n| n == name);
-    if !is_ours && has(name)? {
-        return Ok(());
-    }
-    if !is_ours {
-        ours.push(name.to_owned());
+    match ours.iter().find(|(n, _)| n == name).map(|(_, s)| *s) {
+        // The scene's value stands against a program default.
+        Some(Source::Scene) if source == Source::Program => return Ok(()),
+        Some(_) => {}
+        None if has(name)? => return Ok(()),
+        None => ours.push((name.to_owned(), source)),
     }
     set(name, value)
 }
@@ -32,7 +46,7 @@ pub fn set_default(name: &str, value: &str) -> Result<()> {
 /// Removes every default this program set, before a new run sets its own.
 pub fn clear_defaults() -> Result<()> {
     let mut ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
-    for name in ours.drain(..) {
+    for (name, _) in ours.drain(..) {
         let n = c_string(&name)?;
         // SAFETY: valid C string; clearing an absent option is not an error.
         unsafe { petsc_call!(PetscOptionsClearValue(std::ptr::null_mut(), n.as_ptr()))? };
@@ -107,8 +121,10 @@ pub fn parse_pairs(opts: &str) -> std::result::Result<Vec<(&str, &str)>, String>
     Ok(pairs)
 }
 
-/// Inserts "-key value" pairs from `opts` as defaults: keys the user already
-/// set (command line, PETSC_OPTIONS) keep the user's value.
+/// Inserts "-key value" pairs from `opts` (a scene's `petsc_options`) as
+/// defaults: keys the user already set (command line, PETSC_OPTIONS) keep
+/// the user's value, and the program's defaults set later do not replace
+/// these.
 pub fn insert_string_defaults(opts: &str) -> Result<()> {
     let pairs = parse_pairs(opts).map_err(|message| PetscError {
         call: "PetscOptions",
@@ -116,7 +132,153 @@ pub fn insert_string_defaults(opts: &str) -> Result<()> {
         message,
     })?;
     for (key, value) in pairs {
-        set_default(key, value)?;
+        set_as(key, value, Source::Scene)?;
     }
     Ok(())
+}
+
+/// The message PETSc gave where its last error started (the innermost
+/// call, e.g. "Unable to find requested KSP type nonsense") and its code.
+/// PETSc passes it only to the error handler; the code alone names a class
+/// ("Unknown type"), not the option or value at fault.
+static LAST_ERROR: std::sync::Mutex<Option<(sys::PetscErrorCode, String)>> =
+    std::sync::Mutex::new(None);
+
+/// PETSc error handler: keeps the message of the call where an error
+/// started and returns the code, printing nothing (as PETSc's
+/// `PetscReturnErrorHandler`); the Rust side reports the error with context.
+///
+/// # Safety
+/// Called by PETSc only, with `mess` null or a NUL-terminated string valid
+/// for the duration of the call. It never unwinds: a poisoned lock or bad
+/// UTF-8 only loses the message.
+pub(super) unsafe extern "C" fn keep_error_text(
+    _comm: sys::MPI_Comm,
+    _line: std::os::raw::c_int,
+    _func: *const std::os::raw::c_char,
+    _file: *const std::os::raw::c_char,
+    code: sys::PetscErrorCode,
+    kind: sys::PetscErrorType,
+    mess: *const std::os::raw::c_char,
+    _ctx: *mut std::os::raw::c_void,
+) -> sys::PetscErrorCode {
+    if kind == sys::PetscErrorType_PETSC_ERROR_INITIAL && !mess.is_null() {
+        // SAFETY: PETSc passes a NUL-terminated message (checked non-null).
+        let text = unsafe { std::ffi::CStr::from_ptr(mess) }
+            .to_string_lossy()
+            .trim()
+            .to_owned();
+        if let Ok(mut last) = LAST_ERROR.lock() {
+            *last = Some((code, text));
+        }
+    }
+    code
+}
+
+/// PETSc's own message for the error `code` that a call just returned, if
+/// the handler kept one for that code (taken: it is not reused).
+pub(super) fn take_error_text(code: sys::PetscErrorCode) -> Option<String> {
+    let mut last = LAST_ERROR.lock().ok()?;
+    match last.take() {
+        Some((c, text)) if c == code && !text.is_empty() => Some(text),
+        _ => None,
+    }
+}
+
+/// Every option in the database as (key, value) pairs: the command line,
+/// PETSC_OPTIONS, the scene's `petsc_options` and the program's defaults.
+fn all_options() -> Result<Vec<(String, String)>> {
+    let mut text: *mut std::os::raw::c_char = std::ptr::null_mut();
+    // SAFETY: `text` is a valid out-pointer; PETSc allocates the string.
+    unsafe { petsc_call!(PetscOptionsGetAll(std::ptr::null_mut(), &mut text))? };
+    if text.is_null() {
+        return Ok(Vec::new());
+    }
+    // SAFETY: PetscOptionsGetAll returns a NUL-terminated string.
+    let all = unsafe { std::ffi::CStr::from_ptr(text) }
+        .to_string_lossy()
+        .into_owned();
+    let here = c"options.rs";
+    // SAFETY: PetscFree(text) as the PetscFree macro expands it: one pointer,
+    // passed by address so PETSc can zero it; `text` is not used afterwards.
+    unsafe {
+        petsc_call!(PetscFreeA(
+            1,
+            line!() as std::os::raw::c_int,
+            here.as_ptr(),
+            here.as_ptr(),
+            (&mut text as *mut *mut std::os::raw::c_char).cast::<std::os::raw::c_void>()
+        ))?;
+    }
+    Ok(parse_pairs(&all)
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect())
+}
+
+/// The option a PETSc error message is about: the one whose value the
+/// message quotes as a word (PETSc names the rejected value: "Unable to
+/// find requested KSP type nonsense", "Input string abc has no numeric
+/// value"); the longest such value when several match.
+pub(super) fn option_named_by(message: &str) -> Option<(String, String)> {
+    let options = all_options().ok()?;
+    best_match(message, &options).cloned()
+}
+
+fn best_match<'a>(message: &str, options: &'a [(String, String)]) -> Option<&'a (String, String)> {
+    let words: Vec<&str> = message
+        .split(|c: char| c.is_whitespace() || matches!(c, ',' | ';' | ':' | '"' | '\'' | '(' | ')'))
+        .map(|w| w.trim_end_matches('.'))
+        .collect();
+    options
+        .iter()
+        .filter(|(_, v)| !v.is_empty() && words.contains(&v.as_str()))
+        .max_by_key(|(_, v)| v.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairs_follow_petsc_reading() {
+        assert_eq!(
+            parse_pairs("-ksp_type cg -snes_monitor -ksp_rtol 1e-8 -shift -5").unwrap(),
+            vec![
+                ("-ksp_type", "cg"),
+                ("-snes_monitor", ""),
+                ("-ksp_rtol", "1e-8"),
+                ("-shift", "-5")
+            ]
+        );
+        assert!(parse_pairs("").unwrap().is_empty());
+        let e = parse_pairs("ksp_type cg").unwrap_err();
+        assert!(e.contains("\"ksp_type\""), "{e}");
+        assert!(parse_pairs("-ksp_type cg gmres").is_err());
+    }
+
+    #[test]
+    fn the_quoted_value_names_the_option() {
+        let options: Vec<(String, String)> = [
+            ("-pc_type", "lu"),
+            ("-ksp_type", "nonsense"),
+            ("-ksp_rtol", "abc"),
+            ("-snes_monitor", ""),
+        ]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+        let named = |m: &str| best_match(m, &options).map(|(k, _)| k.as_str());
+        assert_eq!(
+            named("Unable to find requested KSP type nonsense"),
+            Some("-ksp_type")
+        );
+        assert_eq!(
+            named("Input string abc has no numeric value"),
+            Some("-ksp_rtol")
+        );
+        // "lu" inside another word is not a match.
+        assert_eq!(named("Could not locate a solver type for lumping"), None);
+    }
 }
