@@ -944,3 +944,22 @@ fn petsc_option_errors_name_the_option() {
         assert_eq!(stderr.trim().lines().count(), 1, "not one line:\n{stderr}");
     }
 }
+
+#[test]
+fn plot_over_its_result_file_is_refused() {
+    let dir = scratch("plot-over-input");
+    let out = dir.join("out.h5");
+    let o = run(&["run", "uniaxial-stretch", "-q", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let before = std::fs::read(&out).unwrap();
+    let same = dir.join("x/../out.h5");
+    let o = run(&["plot", out.to_str().unwrap(), "-o", same.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("would overwrite the result file"), "{t}");
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        before,
+        "the result file changed"
+    );
+}

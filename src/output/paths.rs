@@ -49,6 +49,20 @@ pub fn check_not_input(h5: &Path, inputs: &[Input]) -> Result<(), String> {
     Ok(())
 }
 
+/// Refuses to write `output` (one file, e.g. a plot) over the `input` it
+/// is made from.
+pub fn check_not_same(output: &Path, input: &Input) -> Result<(), String> {
+    if canonical(output) == canonical(&input.path) {
+        return Err(format!(
+            "output {} would overwrite the {} {}; give another output file with -o",
+            output.display(),
+            input.what,
+            input.path.display()
+        ));
+    }
+    Ok(())
+}
+
 /// `path` made absolute and free of links and `..`: its deepest existing
 /// ancestor canonicalized, the rest resolved by name. The rest is created
 /// as plain directories before writing (the run creates a missing output
@@ -130,6 +144,9 @@ mod tests {
         // Its own sidecar.
         let e = check_not_input(&dir.join("out.xmf"), &[]).unwrap_err();
         assert!(e.contains("the result file and its XDMF sidecar"), "{e}");
+        let plot = check_not_same(&dir.join("sub/../first.h5"), &inputs[2]).unwrap_err();
+        assert!(plot.contains("would overwrite the restart file"), "{plot}");
+        assert!(check_not_same(&dir.join("first.png"), &inputs[2]).is_ok());
         // A new file in the same directory is fine.
         assert!(check_not_input(&dir.join("out.h5"), &inputs).is_ok());
         assert!(check_not_input(Path::new("no-such-dir/out.h5"), &inputs).is_ok());
