@@ -729,7 +729,7 @@ impl Scene {
             // the first solve far from its cause.
             bf.vector
                 .iter()
-                .try_for_each(|&v| check_finite(v, "[[body_force]] vector"))
+                .try_for_each(|&v| check_finite(v, "vector"))
                 .map_err(|m| {
                     self.error_at(
                         origin,
