@@ -187,12 +187,19 @@ pub(super) fn take_error_text(code: sys::PetscErrorCode) -> Option<String> {
 
 /// Every option in the database as (key, value) pairs: the command line,
 /// PETSC_OPTIONS, the scene's `petsc_options` and the program's defaults.
-fn all_options() -> Result<Vec<(String, String)>> {
+/// Called while an error is being reported, so its own failures are not
+/// reported through [`super::check`] (which would call it again): the raw
+/// codes are checked here, and a failure gives no options.
+fn all_options() -> Option<Vec<(String, String)>> {
     let mut text: *mut std::os::raw::c_char = std::ptr::null_mut();
     // SAFETY: `text` is a valid out-pointer; PETSc allocates the string.
-    unsafe { petsc_call!(PetscOptionsGetAll(std::ptr::null_mut(), &mut text))? };
+    let code = unsafe { sys::PetscOptionsGetAll(std::ptr::null_mut(), &mut text) };
+    if code != 0 {
+        let _ = take_error_text(code);
+        return None;
+    }
     if text.is_null() {
-        return Ok(Vec::new());
+        return None;
     }
     // SAFETY: PetscOptionsGetAll returns a NUL-terminated string.
     let all = unsafe { std::ffi::CStr::from_ptr(text) }
@@ -201,20 +208,27 @@ fn all_options() -> Result<Vec<(String, String)>> {
     let here = c"options.rs";
     // SAFETY: PetscFree(text) as the PetscFree macro expands it: one pointer,
     // passed by address so PETSc can zero it; `text` is not used afterwards.
-    unsafe {
-        petsc_call!(PetscFreeA(
+    let freed = unsafe {
+        sys::PetscFreeA(
             1,
             line!() as std::os::raw::c_int,
             here.as_ptr(),
             here.as_ptr(),
-            (&mut text as *mut *mut std::os::raw::c_char).cast::<std::os::raw::c_void>()
-        ))?;
+            (&mut text as *mut *mut std::os::raw::c_char).cast::<std::os::raw::c_void>(),
+        )
+    };
+    if freed != 0 {
+        // A failed free only leaks the string; its message is not about
+        // the error being reported.
+        let _ = take_error_text(freed);
     }
-    Ok(parse_pairs(&all)
-        .unwrap_or_default()
-        .into_iter()
-        .map(|(k, v)| (k.to_owned(), v.to_owned()))
-        .collect())
+    Some(
+        parse_pairs(&all)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(k, v)| (k.to_owned(), v.to_owned()))
+            .collect(),
+    )
 }
 
 /// The option a PETSc error message is about: the one whose value the
@@ -222,7 +236,7 @@ fn all_options() -> Result<Vec<(String, String)>> {
 /// find requested KSP type nonsense", "Input string abc has no numeric
 /// value"); the longest such value when several match.
 pub(super) fn option_named_by(message: &str) -> Option<(String, String)> {
-    let options = all_options().ok()?;
+    let options = all_options()?;
     best_match(message, &options).cloned()
 }
 
