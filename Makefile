@@ -12,7 +12,11 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_btl := self,vader
 export OMPI_MCA_btl_vader_single_copy_mechanism := none
 
-.PHONY: deps build demo test test-mpi bench work-precision scaling hertz-study ironing friction-figures lint fmt clean
+# The executable cargo built for target KIND NAME, from cargo's JSON messages
+# (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
+cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
+
+.PHONY: deps build demo test test-mpi test-examples bench work-precision scaling hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -26,39 +30,57 @@ demo: build
 	@echo "demo: results in out/demo.h5 (open out/demo.xmf in ParaView; h5ls -r out/demo.h5 lists it)"
 
 # Every test: unit, verification and end-to-end (serial and mpirun -n 1/2/3),
-# then the MPI harness under 2 and 3 ranks.
+# then the MPI harness under 2 and 3 ranks, then the examples.
 test: deps
-	$(CARGO) build --release --bins
+	$(CARGO) build --release --bins --examples
 	$(CARGO) test --release
 	$(MAKE) --no-print-directory test-mpi
+	$(MAKE) --no-print-directory test-examples
 
 test-mpi:
-	@bin=$$($(CARGO) test --release --test mpi --no-run 2>&1 | grep -o 'target/release/deps/mpi-[0-9a-f]*' | head -1); \
-	test -n "$$bin" || { echo "could not find the mpi test harness"; exit 1; }; \
+	@set -e; bin=$(call cargo_exe,test,mpi,test --release --test mpi --no-run); \
 	for n in 2 3; do \
 	  echo "mpi-tests on $$n ranks"; \
-	  $(MPIRUN) -n $$n $$bin || exit 1; \
+	  $(MPIRUN) -n $$n $$bin; \
 	done
+
+# The examples of examples/, each serially (no mpirun) and on 2 ranks; each
+# checks its own answer and exits with status 1 when it is wrong. Then the
+# Python example plots the Hertz pressure profile the Rust one wrote.
+test-examples:
+	@mkdir -p out/examples
+	@set -e; \
+	hertz=$(call cargo_exe,example,hertz_cylinder,build --release --example hertz_cylinder); \
+	slide=$(call cargo_exe,example,block_slide,build --release --example block_slide); \
+	gmsh=$(call cargo_exe,example,gmsh_mesh,build --release --example gmsh_mesh); \
+	echo "== example hertz_cylinder, serial, then 2 ranks"; \
+	$$hertz 0.25 out/examples/hertz_cylinder-1.h5; \
+	$(MPIRUN) -n 2 $$hertz 0.25 out/examples/hertz_cylinder-2.h5; \
+	echo "== example block_slide, serial, then 2 ranks"; \
+	$$slide 20 out/examples/block_slide-1.h5; \
+	$(MPIRUN) -n 2 $$slide 20 out/examples/block_slide-2.h5; \
+	echo "== example gmsh_mesh, serial, then 2 ranks"; \
+	$$gmsh; \
+	$(MPIRUN) -n 2 $$gmsh; \
+	echo "== example plot_pressure.py"; \
+	MPLBACKEND=Agg $(PYTHON) examples/plot_pressure.py out/examples/hertz_cylinder-2.h5
 
 # Assembly throughput and solve time against DOFs; one contact solve against one
 # plain elastic solve of the same mesh; what each reuse saves; 1 vs 2 ranks
 # (CSV in bench-results/).
 bench: deps
 	@mkdir -p bench-results
-	@bin=$$($(CARGO) bench --bench assembly --no-run 2>&1 | grep -o 'target/release/deps/assembly-[0-9a-f]*' | head -1); \
-	test -n "$$bin" || { echo "could not find the assembly benchmark"; exit 1; }; \
+	@set -e; bin=$(call cargo_exe,bench,assembly,bench --bench assembly --no-run); \
 	for n in 1 2; do \
 	  echo "assembly benchmark on $$n rank(s)"; \
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/assembly-$$n.csv || exit 1; \
 	done
-	@bin=$$($(CARGO) bench --bench solve_costs --no-run 2>&1 | grep -o 'target/release/deps/solve_costs-[0-9a-f]*' | head -1); \
-	test -n "$$bin" || { echo "could not find the solve-costs benchmark"; exit 1; }; \
+	@set -e; bin=$(call cargo_exe,bench,solve_costs,bench --bench solve_costs --no-run); \
 	for n in 1 2; do \
 	  echo "contact solve vs plain elastic solve, and what reuse saves, on $$n rank(s)"; \
 	  $(MPIRUN) -n $$n $$bin | tee bench-results/solve-costs-$$n.csv || exit 1; \
 	done
-	@bin=$$($(CARGO) bench --bench search --no-run 2>&1 | grep -o 'target/release/deps/search-[0-9a-f]*' | head -1); \
-	test -n "$$bin" || { echo "could not find the search benchmark"; exit 1; }; \
+	@set -e; bin=$(call cargo_exe,bench,search,bench --bench search --no-run); \
 	echo "contact search against slave points (serial)"; \
 	$$bin | tee bench-results/search.csv
 
@@ -102,7 +124,8 @@ friction-figures: ironing
 	$(MPIRUN) -n $(NP) target/release/contactlink run impact -q -o out/impact.h5
 	$(MPIRUN) -n $(NP) target/release/contactlink run impact -q -o out/impact-friction.h5 --set contact.friction=0.3
 
-lint:
+# Formatting and clippy with every warning an error (CI runs it before the tests).
+lint: deps
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --all-targets --release -- -D warnings
 

@@ -49,6 +49,10 @@ const CASES: &[Case] = &[
         "frictional_impact_conserves_momentum_and_dissipates",
         frictional_impact_conserves_momentum,
     ),
+    (
+        "agreement_carries_the_lowest_failing_rank_everywhere",
+        agreement_carries_the_lowest_failing_rank,
+    ),
 ];
 
 fn main() -> ExitCode {
@@ -555,4 +559,53 @@ fn frictional_impact_conserves_momentum(rt: &Runtime) -> Result<(), String> {
     ensure(contact_steps >= 3 && energy < 0.3125, || {
         format!("{contact_steps} contact steps, energy {energy}")
     })
+}
+
+/// `parallel::agree`: when the last rank and (on 3+ ranks) rank 1 fail,
+/// every rank returns the lowest failing rank's own message, category
+/// included; when none fails, every rank keeps its own value.
+fn agreement_carries_the_lowest_failing_rank(rt: &Runtime) -> Result<(), String> {
+    use contactlink::parallel;
+    let world = rt.world();
+    let (rank, size) = (rt.rank(), rt.size());
+    let fails = size > 1 && (rank == size - 1 || rank == 1);
+    let lowest = (size > 1).then_some(1.min(size - 1));
+    ensure(parallel::lowest_rank(&world, fails) == lowest, || {
+        format!(
+            "lowest failing rank {:?}, expected {lowest:?}",
+            parallel::lowest_rank(&world, fails)
+        )
+    })?;
+    let local = fails.then(|| (7 + rank as i32, format!("failure of rank {rank}")));
+    let agreed = parallel::agree_failure(&world, local);
+    let expected = lowest.map(|r| parallel::RankFailure {
+        rank: r,
+        code: 7 + r as i32,
+        message: format!("failure of rank {r}"),
+    });
+    ensure(agreed == expected, || {
+        format!("agreed {agreed:?}, expected {expected:?}")
+    })?;
+    let mine: contactlink::Result<usize> = if fails {
+        Err(contactlink::Error::Fault("a test"))
+    } else {
+        Ok(rank)
+    };
+    match (parallel::agree(&world, mine), lowest) {
+        (Ok(v), None) => ensure(v == rank, || format!("value {v} on rank {rank}")),
+        (Err(e), Some(r)) => {
+            let text = e.to_string();
+            ensure(
+                text == format!("rank {r}: injected fault at a test (CONTACTLINK_FAULT)"),
+                || text.clone(),
+            )
+        }
+        (other, _) => Err(format!("agree gave {other:?} on {size} ranks")),
+    }?;
+    ensure(
+        parallel::all_ranks(&world, true) && !parallel::any_rank(&world, false),
+        || "all_ranks/any_rank".into(),
+    )?;
+    let [total] = parallel::sum_usize(&world, [rank + 1]);
+    ensure(total == size * (size + 1) / 2, || format!("sum {total}"))
 }

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   petsc-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
   libclang-dev clang pkg-config hdf5-tools libopenblas0-serial
-  python3-matplotlib fonts-dejavu-core
+  python3-matplotlib python3-h5py fonts-dejavu-core
 )
 missing=()
 for p in "${packages[@]}"; do

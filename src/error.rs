@@ -39,6 +39,16 @@ pub enum Error {
     Restart(String),
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// A failure one rank had, agreed by all ranks: every rank returns this,
+    /// with the lowest failing rank's message.
+    #[error("rank {rank}: {message}")]
+    OnRank { rank: usize, message: String },
+    /// NaN or infinite values where a finite result was expected.
+    #[error("non-finite values in the {0}")]
+    NonFinite(String),
+    /// A fault injected by `CONTACTLINK_FAULT` (tests only).
+    #[error("injected fault at {0} (CONTACTLINK_FAULT)")]
+    Fault(&'static str),
     /// A broken internal invariant (a bug, not bad input).
     #[error("internal error: {0}")]
     Internal(String),

@@ -10,6 +10,7 @@
 //!      ──► output (parallel HDF5 + XDMF)
 //! ```
 //!
+//! `parallel` is where rank-local outcomes become one decision of all ranks.
 //! `pipeline` strings these together for one run; `petsc` and `runtime` are
 //! the only places that touch C libraries directly.
 pub mod amplitude;
@@ -21,6 +22,7 @@ pub mod error;
 pub mod fem;
 pub mod mesh;
 pub mod output;
+pub mod parallel;
 pub mod partition;
 pub mod petsc;
 pub mod pipeline;

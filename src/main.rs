@@ -197,6 +197,9 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     };
     let rank = rt.rank();
     let result = pipeline::run_scene(&rt, scene, &cli.run);
+    // One error line under MPI: failures are agreed (every failing rank
+    // holds the same text), so the lowest rank that has it prints it.
+    let printer = contactlink::parallel::lowest_rank(&rt.world(), result.is_err());
     let code = match result {
         Ok(summary) => {
             // The summary prints unless -q (scripts parse its `done:` and
@@ -252,7 +255,9 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("contactlink (rank {rank}): {e}");
+            if printer == Some(rank) {
+                eprintln!("contactlink: {e}");
+            }
             ExitCode::FAILURE
         }
     };

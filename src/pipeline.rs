@@ -89,6 +89,7 @@ fn build_model(
 
 /// Runs a scene on all ranks of the runtime.
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
+    crate::parallel::fault::arm(rt.rank())?;
     let src = SceneSource::resolve(name_or_path)?;
     let (model, scene_out, mut inputs) = build_model(&src, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
@@ -138,7 +139,12 @@ fn read_restart(
             from.display()
         )));
     }
-    crate::restart::read(from, model)
+    // Every rank reads the file on its own: one rank's failure (a read
+    // error, a file system hiccup) is every rank's, named by that rank.
+    let world = mpi::topology::SimpleCommunicator::world();
+    let read = crate::parallel::fault::check(crate::parallel::fault::FaultPhase::RestartRead)
+        .and_then(|()| crate::restart::read(from, model));
+    crate::parallel::agree(&world, read)
 }
 
 /// Runs an already built model, writing `output` when given.
@@ -238,7 +244,7 @@ impl HistoryCsv {
         } else {
             None
         };
-        let out = crate::solve::collective(&rt.world(), out.transpose().map_err(Into::into))?;
+        let out = crate::parallel::agree(&rt.world(), out.transpose().map_err(Into::into))?;
         Ok(HistoryCsv {
             out,
             path: path.to_path_buf(),
@@ -546,6 +552,9 @@ impl Hdf5Sink {
                 },
             )?;
         }
+        if let Some(m) = &v.mortar {
+            self.write_mortar_nodes(step, name, m)?;
+        }
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
         self.file
             .write_step_small(step, &format!("contact/{name}/force"), &force)?;
@@ -555,6 +564,42 @@ impl Hdf5Sink {
             &format!("contact/{name}/penalty"),
             &[fields.pair.penalty],
         )?;
+        Ok(())
+    }
+}
+
+impl Hdf5Sink {
+    /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
+    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`.
+    fn write_mortar_nodes(
+        &mut self,
+        step: usize,
+        name: &str,
+        m: &crate::contact::mortar::pair::NodeFields,
+    ) -> Result<()> {
+        let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
+        for (label, cols, values) in [
+            ("node_lambda", 1, &m.lambda),
+            ("node_weighted_gap", 1, &m.weighted_gap),
+            ("node_traction", 3, &traction),
+        ] {
+            let order = if cols == 3 {
+                &mut self.natural
+            } else {
+                &mut self.natural_scalar
+            };
+            let (start, data) = order.block_of_owned(values)?;
+            self.file.write_step_block(
+                step,
+                &format!("contact/{name}/{label}"),
+                BlockRows {
+                    global_rows: self.nodes,
+                    start,
+                    cols,
+                    data: &data,
+                },
+            )?;
+        }
         Ok(())
     }
 }
@@ -746,21 +791,14 @@ fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
 /// when rank 0 cannot create the result file (or its directory). Only rank 0
 /// tries, as only one process should create directories and probe files.
 fn check_output_writable(rt: &Runtime, path: &Path) -> Result<()> {
-    use mpi::traits::Root;
-    let mut message = match rt.rank() {
-        0 => probe_writable(path).err().unwrap_or_default().into_bytes(),
-        _ => Vec::new(),
+    let mine = match rt.rank() {
+        0 => probe_writable(path).err().unwrap_or_default(),
+        _ => String::new(),
     };
-    let world = rt.world();
-    let root = world.process_at_rank(0);
-    let mut len = message.len() as u64;
-    root.broadcast_into(&mut len);
-    message.resize(len as usize, 0);
-    root.broadcast_into(&mut message[..]);
+    let message = crate::parallel::broadcast_text(&rt.world(), 0, &mine);
     if message.is_empty() {
         return Ok(());
     }
-    let message = String::from_utf8_lossy(&message).into_owned();
     Err(std::io::Error::other(message).into())
 }
 

@@ -338,6 +338,8 @@ pub struct ContactSection {
     pub search_distance: Option<f64>,
     /// "gauss" (default) or "nodal": where the slave links sit.
     pub quadrature: Option<String>,
+    /// "links" (default) or "mortar".
+    pub formulation: Option<String>,
     /// Coulomb friction coefficient μ (absent or 0: frictionless).
     pub friction: Option<f64>,
     /// Tangential penalty εT (default: the normal penalty).
@@ -1188,7 +1190,7 @@ fn amplitude(
     }
 }
 
-/// Gauss points on quadrilateral slave facets (the seed's choice); on
+/// Gauss points on quadrilateral slave facets (docs/formulation.md §2.4); on
 /// triangles, the slave nodes. Three Gauss points per triangle put about six
 /// constraints on every slave node of a tet mesh, more than linear tets can
 /// meet: the Uzawa loop then stalls just above its tolerance (sphere-block:
@@ -1259,6 +1261,8 @@ fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSp
     }
     spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))
         .map_err(|m| Bad::at(&key("motion_amplitude"), m))?;
+    spec.formulation =
+        formulation(mesh, c, &spec, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
     spec.quadrature = match c.quadrature.as_deref() {
         None => default_quadrature(mesh),
         Some("gauss") => SlaveQuadrature::Gauss,
@@ -1339,6 +1343,49 @@ fn rigid_point(r: &RigidSurface) -> [f64; 3] {
         RigidSurface::Plane { point, .. } | RigidSurface::Cylinder { point, .. } => point,
         RigidSurface::Sphere { centre, .. } => centre,
     }
+}
+
+/// The pair's `formulation`, checked against what the mortar formulation
+/// supports (a master facet set of quad4 or tri3 facets, no friction yet).
+fn formulation(
+    mesh: &Mesh,
+    c: &ContactSection,
+    spec: &PairSpec,
+    at: &str,
+) -> std::result::Result<crate::contact::Formulation, String> {
+    use crate::contact::Formulation;
+    let f = match c.formulation.as_deref() {
+        None | Some("links") => return Ok(Formulation::Links),
+        Some("mortar") => Formulation::Mortar,
+        Some(other) => {
+            return Err(format!(
+                "{at}: formulation '{other}' is not \"links\" or \"mortar\""
+            ))
+        }
+    };
+    let facet = mesh.cell_type.facet_type();
+    if !f.supports(facet) {
+        return Err(format!(
+            "{at}: formulation \"mortar\" does not support {} facets",
+            facet.name()
+        ));
+    }
+    if spec.master.is_rigid() {
+        return Err(format!(
+            "{at}: formulation \"mortar\" needs a master facet set, not a rigid surface"
+        ));
+    }
+    if c.friction.is_some_and(|mu| mu > 0.0) {
+        return Err(format!(
+            "{at}: formulation \"mortar\" is frictionless for now; remove friction or use \"links\""
+        ));
+    }
+    if c.quadrature.is_some() {
+        return Err(format!(
+            "{at}: quadrature places the links' points; formulation \"mortar\" integrates the overlaps itself"
+        ));
+    }
+    Ok(f)
 }
 
 /// Self-contact (slave and master on one body) is not supported: the search

@@ -1,4 +1,4 @@
-//! Closed-form answers (DESIGN.md §7) and the post-processing that compares a
+//! Closed-form answers (docs/formulation.md §12) and the post-processing that compares a
 //! run against them: Hertz line and point contact.
 use std::f64::consts::PI;
 

@@ -1,4 +1,4 @@
-//! Contact verification against closed forms (DESIGN.md §7) and the parallel
+//! Contact verification against closed forms (docs/formulation.md §12) and the parallel
 //! consistency of contact runs. Each test runs the binary (under mpirun where
 //! it says so) and reads the HDF5 file it wrote.
 mod common;

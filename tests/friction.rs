@@ -1,4 +1,4 @@
-//! Coulomb friction and implicit dynamics end to end (DESIGN.md §4, §7):
+//! Coulomb friction and implicit dynamics end to end (docs/formulation.md §5, §8, §12):
 //! block-slide (stick below μN, exactly μN while sliding), ironing (μ in
 //! steady sliding), impact (momentum through contact, energy never created),
 //! and the frictional scenes on 1 and 2 ranks.

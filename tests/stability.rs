@@ -1,4 +1,4 @@
-//! Numerical stability when pushed (issue 5): the contact patch test under
+//! Numerical stability when pushed: the contact patch test under
 //! penalties from 1e-3 to 1e6 times the default, an initial penetration of
 //! half an element, slave points exactly on master nodes, edges and corners,
 //! and nearly incompressible bodies. Each converges to the same answer

@@ -1,6 +1,6 @@
 //! ContactLink3D kernel: one slave quadrature point against one master
 //! (deformable facet or rigid analytic surface), frictionless normal part of
-//! the augmented-Lagrangian formulation of DESIGN.md §3.
+//! the augmented-Lagrangian formulation of docs/formulation.md §3–§4.
 //!
 //! Conventions.
 //! - DOFs: slave facet nodes first, then master facet nodes (none for rigid
@@ -23,7 +23,7 @@
 //!   derivative of ξ̄. Gap, normal and forces are then evaluated in duals, so
 //!   the change of ξ̄ and ν (curvature terms) is included.
 //!
-//! Coulomb friction (DESIGN.md §4), when the input carries a [`Friction`]:
+//! Coulomb friction (docs/formulation.md §5), when the input carries a [`Friction`]:
 //! - slip increment ΔgT in the master's convected frame: `(ξ̄ − ξ̄ₙ)^α τ_α`
 //!   on a facet, the tangential move of the contact point on a rigid master,
 //!   or `Δt · vT` (relative tangential velocity) in dynamics;
@@ -1776,7 +1776,7 @@ mod tests {
 
     #[test]
     fn damping_matrix_is_the_velocity_derivative() {
-        // k(dv/dx = c) − k(dv/dx = 0) = c ∂r/∂v: the seed's damping matrix
+        // k(dv/dx = c) − k(dv/dx = 0) = c ∂r/∂v: the friction damping matrix (docs/formulation.md §8)
         // enters through the integrator's coefficient and nothing else.
         const HV: f64 = 1e-6;
         for (name, case) in friction_cases() {

@@ -3,10 +3,11 @@
 //! residual and tangent, and the Uzawa update of their multipliers.
 use super::dual::{dot, norm, sub};
 use super::link::{self, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
+use super::mortar::pair::MortarPair;
 use super::multipliers::{
     updated_multiplier, FrictionRecord, Multipliers, PointFriction, PointState,
 };
-use super::pair::{MasterSpec, PairSpec, RigidSurface};
+use super::pair::{Formulation, MasterSpec, PairSpec, RigidSurface};
 use super::search::{self, SearchIndex};
 use super::surfaces::{MasterSurface, SlaveSurface};
 use crate::dofs::{DofMap, DIM};
@@ -69,6 +70,26 @@ pub struct PointValues {
     pub records: Vec<FrictionRecord>,
     /// Owned slave nodes: reference position and nodal contact pressure.
     pub nodes: Vec<([f64; 3], f64)>,
+    /// Mortar pairs: the nodal fields, per owned mesh node.
+    pub mortar: Option<crate::contact::mortar::pair::NodeFields>,
+}
+
+impl PointValues {
+    fn empty() -> Self {
+        PointValues {
+            points: Vec::new(),
+            pressure: Vec::new(),
+            gap: Vec::new(),
+            lambda: Vec::new(),
+            weight: Vec::new(),
+            traction: Vec::new(),
+            slip: Vec::new(),
+            state: Vec::new(),
+            records: Vec::new(),
+            nodes: Vec::new(),
+            mortar: None,
+        }
+    }
 }
 
 /// One pair's state as a result file stores it, whole-pair arrays in output
@@ -135,6 +156,8 @@ pub struct SlipRateMap {
 pub struct PairSnapshot {
     lambda: Vec<f64>,
     friction: Option<Vec<PointFriction>>,
+    /// The nodal multipliers of a mortar pair.
+    mortar: Option<Vec<f64>>,
 }
 
 /// Scratch space for one link's input (no allocation per link).
@@ -164,6 +187,10 @@ pub struct ContactPair {
     friction: Option<PairFriction>,
     /// Set by the solver in dynamics (slip from velocities); None: quasi-static.
     pub rate: Option<SlipRateMap>,
+    /// `formulation = "mortar"`: the pair's constraint is the mortar one and
+    /// the links above stay empty (the slave surface still gives the output
+    /// its points).
+    pub mortar: Option<MortarPair>,
 }
 
 const MAX_LINK_NODES: usize = 8;
@@ -214,6 +241,26 @@ impl ContactPair {
         let search_distance = spec
             .search_distance
             .unwrap_or_else(|| default_search_distance(mesh, &master, slave.h));
+        let mortar = match (&spec.formulation, &spec.master) {
+            (Formulation::Links, _) => None,
+            (Formulation::Mortar, MasterSpec::Surface { set }) => Some(MortarPair::new(
+                mesh,
+                dofs,
+                spec,
+                set,
+                |h| spec.penalty.unwrap_or(10.0 * softest_youngs / h),
+                // Candidates are fixed for a step and every one widens the
+                // Jacobian pattern: one element size of margin, not the
+                // links' search distance.
+                search_distance.min(slave.h),
+            )?),
+            (Formulation::Mortar, MasterSpec::Rigid(_)) => {
+                return Err(Error::scene(
+                    "contact",
+                    format!("pair '{}': mortar needs a master facet set", spec.name),
+                ))
+            }
+        };
         let friction = friction_spec.map(|f| PairFriction {
             mu: f.mu,
             penalty: match f.penalty {
@@ -234,6 +281,7 @@ impl ContactPair {
             positions: Vec::new(),
             friction,
             rate: None,
+            mortar,
         })
     }
 
@@ -246,6 +294,9 @@ impl ContactPair {
     /// facets around it) for every slave point. Returns true when the coupling
     /// pattern differs from the previous step's.
     pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
+        if let Some(m) = &mut self.mortar {
+            return m.search(u_local);
+        }
         let nq = self.slave.num_qps();
         let points: Vec<[f64; 3]> = (0..nq)
             .map(|q| self.slave.qp_position(q, u_local))
@@ -331,6 +382,9 @@ impl ContactPair {
     /// Records every entry the links of this step may couple: each slave
     /// facet with itself and with every master node in its links' patches.
     pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut PatternBuilder) -> Result<()> {
+        if let Some(m) = &self.mortar {
+            return m.add_pattern(dofs, pattern);
+        }
         let mut by_facet: std::collections::BTreeMap<usize, Vec<u32>> =
             std::collections::BTreeMap::new();
         for l in &self.links {
@@ -612,6 +666,10 @@ impl ContactPair {
         factor: f64,
         r_local: &mut [f64],
     ) -> Result<()> {
+        if let Some(m) = &self.mortar {
+            m.add_residual(u_local, r_local);
+            return Ok(());
+        }
         self.for_each_link(
             u_local,
             factor,
@@ -636,6 +694,9 @@ impl ContactPair {
         factor: f64,
         k: &mut dyn BlockSink,
     ) -> Result<()> {
+        if let Some(m) = &self.mortar {
+            return m.add_tangent(dofs, u_local, k);
+        }
         self.for_each_link(
             u_local,
             factor,
@@ -652,6 +713,9 @@ impl ContactPair {
     /// every slave point of this rank (points without a link get λ = 0),
     /// then the halo exchange.
     pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
+        if let Some(m) = &mut self.mortar {
+            return Ok(m.uzawa_update(u_local));
+        }
         let before = self.multipliers.nodal_forces()?;
         let before_t = self.multipliers.nodal_tangential_forces()?;
         let states = self.evaluate_links(u_local, factor);
@@ -748,6 +812,12 @@ impl ContactPair {
     /// result file, given as whole-pair arrays in output row order (set
     /// facet × quadrature point), then commits them as the step end did.
     pub fn restart_from(&mut self, rows: &RestartRows) -> Result<()> {
+        if self.mortar.is_some() {
+            return Err(Error::Restart(format!(
+                "contact pair '{}': restarting a mortar pair is not supported",
+                self.spec.name
+            )));
+        }
         let nqp = self.slave.nqp;
         let row_of = |i: usize| self.slave.facets[i / nqp].set_index * nqp + i % nqp;
         let n = self.slave.num_qps();
@@ -777,7 +847,11 @@ impl ContactPair {
             // Raised during the first run: continue with the same penalty.
             self.raise_penalty(p / self.penalty);
         }
-        self.restore(PairSnapshot { lambda, friction })?;
+        self.restore(PairSnapshot {
+            lambda,
+            friction,
+            mortar: None,
+        })?;
         self.commit()
     }
 
@@ -798,10 +872,14 @@ impl ContactPair {
                 .tangential
                 .as_ref()
                 .map(|t| t.points.clone()),
+            mortar: self.mortar.as_ref().map(MortarPair::snapshot),
         }
     }
 
     pub fn restore(&mut self, snap: PairSnapshot) -> Result<()> {
+        if let (Some(m), Some(lambda)) = (&mut self.mortar, snap.mortar) {
+            m.restore(lambda);
+        }
         self.multipliers.lambda = snap.lambda;
         if let (Some(t), Some(points)) = (&mut self.multipliers.tangential, snap.friction) {
             t.points = points;
@@ -832,6 +910,9 @@ impl ContactPair {
     pub fn raise_penalty(&mut self, factor: f64) {
         self.penalty *= factor;
         self.facet_penalty.iter_mut().for_each(|p| *p *= factor);
+        if let Some(m) = &mut self.mortar {
+            m.raise_penalty(factor);
+        }
         let follows = self
             .spec
             .active_friction()
@@ -843,6 +924,9 @@ impl ContactPair {
 
     /// This rank's points in contact (λN > 0) and, of those, sliding.
     pub fn multiplier_states(&self) -> (usize, usize) {
+        if let Some(m) = &self.mortar {
+            return (m.active_nodes(), 0);
+        }
         let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();
         let sliding = self.multipliers.tangential.as_ref().map_or(0, |t| {
             t.points
@@ -856,6 +940,13 @@ impl ContactPair {
     /// Whether the pair computes friction.
     pub fn has_friction(&self) -> bool {
         self.friction.is_some()
+    }
+
+    /// Whether the pair's tangent is symmetric: frictionless links (the
+    /// Hessian of a potential). The mortar residual is not a gradient (the
+    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric.
+    pub fn tangent_is_symmetric(&self) -> bool {
+        !self.has_friction() && self.mortar.is_none()
     }
 
     fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
@@ -872,6 +963,9 @@ impl ContactPair {
     /// describe the pressure over the undeformed surface: the surfaces also
     /// slide inward under load (about 1 % of the Hertz width here).
     pub fn node_values(&self) -> Result<Vec<([f64; 3], f64)>> {
+        if let Some(m) = &self.mortar {
+            return Ok(m.node_values());
+        }
         let pressures = self.multipliers.nodal_pressures()?;
         Ok(self
             .multipliers
@@ -890,6 +984,9 @@ impl ContactPair {
         u_local: &[f64],
         factor: f64,
     ) -> Result<(PointValues, PairForce)> {
+        if self.mortar.is_some() {
+            return Ok(self.mortar_point_values(u_local));
+        }
         let nq = self.slave.num_qps();
         let states = self.evaluate_links(u_local, factor);
         let mut values = PointValues {
@@ -905,6 +1002,7 @@ impl ContactPair {
             state: Vec::new(),
             records: Vec::new(),
             nodes: self.node_values()?,
+            mortar: None,
         };
         if let Some(t) = &self.multipliers.tangential {
             values.traction = t.points.iter().map(|p| p.traction).collect();
@@ -936,6 +1034,53 @@ impl ContactPair {
             }
         }
         Ok((values, force))
+    }
+
+    /// Mortar pair: the slave points carry λ interpolated from the nodes
+    /// with the standard shape functions (Σ N_a λ_a, the smooth nodal
+    /// traction; the mortar field Σ Φ_a λ_a itself oscillates inside a facet).
+    fn mortar_point_values(&self, u_local: &[f64]) -> (PointValues, PairForce) {
+        let Some(m) = &self.mortar else {
+            return (PointValues::empty(), PairForce::default());
+        };
+        let lambda = m.lambda_by_local_node();
+        let nq = self.slave.num_qps();
+        let mut pressure = vec![0.0; nq];
+        for (q, p) in pressure.iter_mut().enumerate() {
+            let facet = &self.slave.facets[q / self.slave.nqp];
+            let s = crate::fem::shape::facet_shape(self.slave.facet_type, self.slave.qp_zeta[q]);
+            *p = facet
+                .nodes
+                .iter()
+                .zip(s.n)
+                .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
+                .sum();
+        }
+        let (fields, force) = m.output(u_local);
+        let values = PointValues {
+            points: (0..nq)
+                .map(|q| self.slave.qp_position(q, u_local))
+                .collect(),
+            lambda: pressure.clone(),
+            pressure,
+            gap: vec![0.0; nq],
+            weight: self.slave.qp_weight.clone(),
+            nodes: m.node_values(),
+            mortar: Some(fields),
+            ..PointValues::empty()
+        };
+        (values, force)
+    }
+
+    /// Adds this pair's nodal contact pressure (owned nodes) into the field.
+    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) -> Result<()> {
+        match &self.mortar {
+            Some(m) => {
+                m.add_nodal_pressure(numerator, denominator);
+                Ok(())
+            }
+            None => self.multipliers.add_nodal_pressure(numerator, denominator),
+        }
     }
 }
 

@@ -1,4 +1,4 @@
-//! Contact: the ContactLink3D condition (DESIGN.md §2–§3).
+//! Contact: the ContactLink3D condition (docs/formulation.md §2–§5, §9).
 //!
 //! - `pair`: what a scene says about a pair;
 //! - `surfaces`: the slave and master sides as one rank sees them;
@@ -9,12 +9,15 @@
 //!   map), residual and consistent tangent;
 //! - `multipliers`: λN and the friction state (λT, slip origin, stick/slip)
 //!   at the slave points, the Uzawa update rule, halo exchange;
-//! - `links`: a pair at run time (search per step, assembly, Uzawa update).
+//! - `links`: a pair at run time (search per step, assembly, Uzawa update);
+//! - `mortar`: the mortar formulation (nodal dual multipliers, segment-based
+//!   integration of the slave–master overlap).
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
 pub mod dual;
 pub mod link;
 pub mod links;
+pub mod mortar;
 pub mod multipliers;
 pub mod pair;
 pub mod projection;
@@ -22,4 +25,4 @@ pub mod search;
 pub mod surfaces;
 
 pub use links::{ContactPair, UzawaStats};
-pub use pair::{FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
+pub use pair::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

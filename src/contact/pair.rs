@@ -154,7 +154,7 @@ impl MasterSpec {
 /// Where a slave facet's contact links sit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SlaveQuadrature {
-    /// At the facet's Gauss points (2×2 / 3-point), as the seed does. There are
+    /// At the facet's Gauss points (2×2 / 3-point; docs/formulation.md §2.4). There are
     /// more points than slave nodes, so where the Uzawa loop enforces the
     /// constraint exactly the multipliers are not unique; the loop therefore
     /// judges convergence by the nodal contact forces, which are.
@@ -183,6 +183,30 @@ impl SlaveQuadrature {
     }
 }
 
+/// How a pair discretises the contact constraint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Formulation {
+    /// One link (and one multiplier) per slave quadrature point.
+    #[default]
+    Links,
+    /// Multipliers at the slave nodes with dual shape functions, integrated
+    /// over the slave–master overlaps (segment-based mortar).
+    Mortar,
+}
+
+impl Formulation {
+    /// Whether the formulation handles slave and master facets of this type.
+    pub fn supports(self, facet: crate::fem::FacetType) -> bool {
+        match self {
+            Formulation::Links => true,
+            Formulation::Mortar => matches!(
+                facet,
+                crate::fem::FacetType::Quad4 | crate::fem::FacetType::Tri3
+            ),
+        }
+    }
+}
+
 /// Coulomb friction of a pair.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrictionSpec {
@@ -199,6 +223,7 @@ pub struct PairSpec {
     /// Facet set of the slave surface (its quadrature points carry the links).
     pub slave: String,
     pub master: MasterSpec,
+    pub formulation: Formulation,
     pub quadrature: SlaveQuadrature,
     /// Translation of a rigid master at full amplitude ...
     pub motion: [f64; 3],
@@ -231,6 +256,7 @@ impl PairSpec {
             name: name.to_owned(),
             slave: slave.to_owned(),
             master,
+            formulation: Formulation::default(),
             quadrature: SlaveQuadrature::default(),
             motion: [0.0; 3],
             motion_amplitude: crate::amplitude::Amplitude::ramp(),

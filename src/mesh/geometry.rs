@@ -2,6 +2,8 @@
 //! facet normals and areas, bounding boxes.
 
 use super::{CellType, FacetRef, Mesh, MeshError};
+// The reference hex's corners are its nodes (VTK order): ξ_i = ±1.
+use crate::fem::shape::HEX8_REF_NODES;
 
 pub(crate) type Vec3 = [f64; 3];
 
@@ -116,22 +118,10 @@ pub(crate) fn tet_scaled_jacobian(p: &[Vec3; 4]) -> f64 {
     }
 }
 
-/// Signs (ξ_i, η_i, ζ_i) of the VTK hex nodes in the reference cube.
-const HEX_NODE_SIGNS: [Vec3; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
-
 /// Jacobian determinant of the trilinear hex map at reference point `xi`.
 fn hex_jacobian_at(p: &[Vec3; 8], xi: Vec3) -> f64 {
     let mut columns = [[0.0; 3]; 3];
-    for (x, s) in p.iter().zip(HEX_NODE_SIGNS) {
+    for (x, s) in p.iter().zip(HEX8_REF_NODES) {
         let f = [1.0 + s[0] * xi[0], 1.0 + s[1] * xi[1], 1.0 + s[2] * xi[2]];
         let dn = [
             s[0] * f[1] * f[2] / 8.0,
@@ -149,7 +139,7 @@ fn hex_jacobian_at(p: &[Vec3; 8], xi: Vec3) -> f64 {
 /// in each reference coordinate, so 2×2×2 Gauss quadrature is exact.
 pub(crate) fn hex_volume(p: &[Vec3; 8]) -> f64 {
     let g = 1.0 / 3.0_f64.sqrt();
-    HEX_NODE_SIGNS
+    HEX8_REF_NODES
         .iter()
         .map(|s| hex_jacobian_at(p, scale(*s, g)))
         .sum()

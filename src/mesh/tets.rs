@@ -16,21 +16,16 @@
 //! classic 5-tet split (4 corners + 1 central tet).
 
 use super::{CellType, FacetRef, Mesh, MeshError};
+use crate::fem::shape::HEX8_REF_NODES;
 
 /// A rotation of the reference hex as `old = map[new]`.
 type HexRotation = [usize; 8];
 
-/// Reference coordinates of the VTK hex nodes, as integer signs.
-const HEX_CORNERS: [[i8; 3]; 8] = [
-    [-1, -1, -1],
-    [1, -1, -1],
-    [1, 1, -1],
-    [-1, 1, -1],
-    [-1, -1, 1],
-    [1, -1, 1],
-    [1, 1, 1],
-    [-1, 1, 1],
-];
+/// Reference coordinates of hex node `a` (VTK order), as integer signs so
+/// that rotated corners compare exactly.
+fn hex_corner(a: usize) -> [i8; 3] {
+    HEX8_REF_NODES[a].map(|c| if c < 0.0 { -1 } else { 1 })
+}
 
 const AXIS_PERMUTATIONS: [[usize; 3]; 6] = [
     [0, 1, 2],
@@ -55,9 +50,9 @@ fn hex_rotations() -> Vec<HexRotation> {
                 continue;
             }
             let map = std::array::from_fn(|new| {
-                let c = HEX_CORNERS[new];
+                let c = hex_corner(new);
                 let rotated: [i8; 3] = std::array::from_fn(|k| s[k] * c[axes[k]]);
-                HEX_CORNERS.iter().position(|&x| x == rotated).unwrap_or(0)
+                (0..8).position(|a| hex_corner(a) == rotated).unwrap_or(0)
             });
             rotations.push(map);
         }

@@ -28,7 +28,6 @@ use std::str::FromStr;
 use hdf5::dataset::FillTime;
 use hdf5::types::VarLenUnicode;
 use hdf5::{File, Group, H5Type, Location};
-use mpi::collective::SystemOperation;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{AsRaw, Communicator, CommunicatorCollectives};
 use ndarray::{ArrayView1, ArrayView2};
@@ -78,22 +77,36 @@ impl Coll<'_> {
         self.comm.rank() == 0
     }
 
-    /// Collective: every rank learns whether all ranks succeeded. A rank that
-    /// failed returns its own error; the others return `PeerFailed` naming the
-    /// first failing rank. Without this, a rank that failed alone would return
-    /// while the others wait forever in the next collective HDF5 call.
+    /// Collective: every rank learns whether all ranks succeeded. If one
+    /// failed, every rank returns `PeerFailed` with the lowest failing rank's
+    /// message (agreed in [`crate::parallel`]). Without this, a rank that
+    /// failed alone would return while the others wait forever in the next
+    /// collective HDF5 call.
     fn agree<T>(&self, object: &str, local: Result<T, OutputError>) -> Result<T, OutputError> {
-        let flag: i32 = i32::from(local.is_ok());
-        let mut all = vec![0_i32; self.size()];
-        self.comm.all_gather_into(&flag, &mut all[..]);
-        let local = local?;
-        match all.iter().position(|&f| f == 0) {
-            None => Ok(local),
-            Some(rank) => Err(OutputError::PeerFailed {
-                path: self.path.to_path_buf(),
-                object: object.to_string(),
-                rank: i32::try_from(rank).unwrap_or(i32::MAX),
-            }),
+        if self.size() == 1 {
+            return local;
+        }
+        let (value, failure) = match local {
+            Ok(v) => (Some(v), None),
+            Err(e) => (None, Some((0, e.to_string()))),
+        };
+        match (crate::parallel::agree_failure(self.comm, failure), value) {
+            (None, Some(v)) => Ok(v),
+            (Some(f), _) => Err(self.peer_failed(object, f.rank, f.message)),
+            (None, None) => Err(OutputError::invalid(
+                self.path,
+                object,
+                "agreement lost a value",
+            )),
+        }
+    }
+
+    fn peer_failed(&self, object: &str, rank: usize, message: String) -> OutputError {
+        OutputError::PeerFailed {
+            path: self.path.to_path_buf(),
+            object: object.to_string(),
+            rank: i32::try_from(rank).unwrap_or(i32::MAX),
+            message,
         }
     }
 
@@ -191,14 +204,15 @@ impl Coll<'_> {
         local: Result<usize, OutputError>,
         table: &[u64],
     ) -> Result<usize, OutputError> {
-        let local = local?;
         match table.chunks_exact(5).position(|e| e.get(4) != Some(&1)) {
-            None => Ok(local),
-            Some(rank) => Err(OutputError::PeerFailed {
-                path: self.path.to_path_buf(),
-                object: object.to_string(),
-                rank: i32::try_from(rank).unwrap_or(i32::MAX),
-            }),
+            None => local,
+            Some(_) if self.size() == 1 => local,
+            Some(rank) => {
+                // Every rank saw the same table: all take this branch.
+                let mine = local.err().map(|e| e.to_string()).unwrap_or_default();
+                let message = crate::parallel::broadcast_text(self.comm, rank, &mine);
+                Err(self.peer_failed(object, rank, message))
+            }
         }
     }
 
@@ -760,7 +774,15 @@ impl ResultFile {
         let gpath = format!("/steps/{group}");
         let c = self.coll();
         let p = c.path;
-        c.agree(&gpath, self.check_step(&gpath, info, nodal, cell))?;
+        let checked = self.check_step(&gpath, info, nodal, cell).and_then(|()| {
+            use crate::parallel::fault::{self, FaultPhase};
+            if fault::fires(FaultPhase::OutputWrite) {
+                let why = crate::Error::Fault(FaultPhase::OutputWrite.name()).to_string();
+                return Err(OutputError::invalid(p, &gpath, why));
+            }
+            Ok(())
+        });
+        c.agree(&gpath, checked)?;
         c.same_everywhere(&gpath, step_fingerprint(info, nodal, cell))?;
 
         // Check every field's block layout before anything is created, so a
@@ -779,9 +801,7 @@ impl ResultFile {
 
         // The slowest rank's time is the step's time; every rank must write
         // the same attribute value, so reduce first.
-        let mut wall = 0.0_f64;
-        self.comm
-            .all_reduce_into(&info.wall_seconds, &mut wall, SystemOperation::max());
+        let [wall] = crate::parallel::max(&self.comm, [info.wall_seconds]);
 
         let gsteps = self
             .file

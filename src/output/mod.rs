@@ -190,12 +190,14 @@ pub enum OutputError {
         reason: String,
     },
 
-    /// Another rank failed; its own error (on that rank) says why.
-    #[error("rank {rank} failed on '{object}' in {} (see that rank's error)", .path.display())]
+    /// A rank failed on a collective operation: every rank returns this,
+    /// with the lowest failing rank's own message.
+    #[error("rank {rank}: {message}")]
     PeerFailed {
         path: PathBuf,
         object: String,
         rank: i32,
+        message: String,
     },
 
     #[error("cannot write XDMF sidecar {}: {source}", .path.display())]

@@ -302,7 +302,8 @@ mod tests {
             text.contains("Name=\"stress&lt;&amp;&gt;\" AttributeType=\"Tensor6\" Center=\"Cell\"")
         );
         assert!(text.contains("Precision=\"4\" Dimensions=\"2\">out.h5:/mesh/partition<"));
-        assert!(!text.contains("/work") && !text.contains("stress<"));
+        // Data references are relative to the sidecar: none starts with `/`.
+        assert!(!text.contains(">/") && !text.contains("stress<"));
     }
 
     #[test]

@@ -147,6 +147,45 @@ impl Matrix {
         set_values(self.raw, rows, cols, values, sys::InsertMode_ADD_VALUES)
     }
 
+    /// The first row this rank owns that holds a NaN or infinite value
+    /// (local, no communication; the matrix must be assembled). Used to say
+    /// which rank made a linear solve fail.
+    pub fn first_nonfinite_owned_row(&self) -> Result<Option<PetscInt>> {
+        let (mut lo, mut hi) = (0, 0);
+        // SAFETY: valid assembled mat; MatGetRow's pointers are read only
+        // between it and the paired MatRestoreRow.
+        unsafe {
+            petsc_call!(MatGetOwnershipRange(self.raw, &mut lo, &mut hi))?;
+            for row in lo..hi {
+                let mut n: PetscInt = 0;
+                let mut vals: *const f64 = std::ptr::null();
+                petsc_call!(MatGetRow(
+                    self.raw,
+                    row,
+                    &mut n,
+                    std::ptr::null_mut(),
+                    &mut vals
+                ))?;
+                let bad = !vals.is_null()
+                    && n > 0
+                    && std::slice::from_raw_parts(vals, n as usize)
+                        .iter()
+                        .any(|v| !v.is_finite());
+                petsc_call!(MatRestoreRow(
+                    self.raw,
+                    row,
+                    &mut n,
+                    std::ptr::null_mut(),
+                    &mut vals
+                ))?;
+                if bad {
+                    return Ok(Some(row));
+                }
+            }
+        }
+        Ok(None)
+    }
+
     pub fn assemble(&mut self) -> Result<()> {
         final_assembly(self.raw)
     }

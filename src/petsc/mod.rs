@@ -4,6 +4,7 @@
 pub mod log;
 pub mod matrix;
 pub mod options;
+pub mod reason;
 pub mod scatter;
 pub mod snes;
 pub mod sys;
@@ -11,6 +12,7 @@ pub mod vector;
 
 pub use log::LogStage;
 pub use matrix::{BlockSink, Matrix, PatternBuilder};
+pub use reason::{KspReason, SnesReason};
 pub use scatter::Scatter;
 pub use snes::{NonlinearProblem, Snes, SnesOutcome};
 pub use vector::{GhostedVector, Vector};

@@ -1,5 +1,6 @@
 //! Newton's method through PETSc SNES, with residual and Jacobian computed by
 //! Rust code behind the [`NonlinearProblem`] trait.
+use super::reason::{KspReason, SnesReason};
 use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -9,12 +10,18 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 pub enum CallbackError {
     /// The state is outside the problem's domain (e.g. an inverted element): SNES
     /// treats the step as failed and the caller can cut the load step back.
+    /// Must be returned on every rank alike (the problem agrees it first).
     Domain(String),
-    /// Anything else: the solve stops and the error is reported.
+    /// Anything else: the solve stops and the error is reported; also on
+    /// every rank alike.
     Fatal(String),
 }
 
 /// The residual R(x) and its Jacobian, evaluated by the application.
+///
+/// Both are collective: an implementation finishes its collective work
+/// (ghost updates, assembly) even when its local part failed, and returns
+/// the same outcome on every rank.
 pub trait NonlinearProblem {
     fn residual(&mut self, x: &Vector, r: &mut Vector) -> std::result::Result<(), CallbackError>;
     fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError>;
@@ -23,16 +30,19 @@ pub trait NonlinearProblem {
 /// The result of one SNES solve.
 #[derive(Debug, Clone)]
 pub struct SnesOutcome {
+    /// SNES converged and no callback reported a domain error.
     pub converged: bool,
-    /// PETSc's SNESConvergedReason (positive: converged, negative: diverged).
-    pub reason: i32,
-    pub reason_text: String,
+    pub reason: SnesReason,
     pub iterations: usize,
     pub linear_iterations: usize,
+    /// The last linear solve: why it stopped and after how many iterations.
+    pub ksp_reason: KspReason,
+    pub ksp_iterations: usize,
     pub residual_norm: f64,
     /// Residual norm after each Newton iteration (index 0: initial).
     pub history: Vec<f64>,
-    /// Set when a callback hit a domain error (inverted element, ...).
+    /// Set when a callback hit a domain error (inverted element, ...); the
+    /// callbacks agree it over all ranks, so it is the same everywhere.
     pub domain_error: Option<String>,
 }
 
@@ -40,6 +50,8 @@ struct Context<'a> {
     problem: &'a mut dyn NonlinearProblem,
     fatal: Option<String>,
     domain: Option<String>,
+    /// The Jacobian callback ended the solve with a domain error.
+    jacobian_stopped: bool,
 }
 
 pub struct Snes {
@@ -53,7 +65,8 @@ impl Snes {
         let mut raw: sys::SNES = std::ptr::null_mut();
         // SAFETY: PETSc is initialised; out-pointer valid.
         unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
-        Ok(Snes { raw })
+        let snes = Snes { raw };
+        Ok(snes)
     }
 
     pub fn set_tolerances(&mut self, atol: f64, rtol: f64, stol: f64, max_it: usize) -> Result<()> {
@@ -84,6 +97,21 @@ impl Snes {
         }
     }
 
+    /// Drops the preconditioner's factors, symbolic ones included: after a
+    /// failed factorisation (MUMPS keeps a failed analysis and skips every
+    /// later numeric factorisation of the same pattern) the next solve
+    /// starts afresh. Collective.
+    pub fn reset_preconditioner(&mut self) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut pc: sys::PC = std::ptr::null_mut();
+        // SAFETY: valid snes; the KSP and PC handles are borrowed from it.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetPC(ksp, &mut pc))?;
+            petsc_call!(PCReset(pc))
+        }
+    }
+
     /// Applies the options database (after the program's defaults are set).
     pub fn set_from_options(&mut self) -> Result<()> {
         // SAFETY: valid snes.
@@ -108,6 +136,7 @@ impl Snes {
             problem,
             fatal: None,
             domain: None,
+            jacobian_stopped: false,
         };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
         const HIST: usize = 200;
@@ -115,8 +144,9 @@ impl Snes {
         let mut hist_its = [0 as sys::PetscInt; HIST];
         // SAFETY: the context lives on this stack frame and SNES calls back into it
         // only during SNESSolve below; callbacks are reset to this context before
-        // every solve. The history arrays outlive the solve and are detached after.
-        let outcome = unsafe {
+        // every solve. The history arrays outlive the solve and are detached
+        // after it, whatever the solve returned.
+        let solved = unsafe {
             petsc_call!(SNESSetFunction(
                 self.raw,
                 r.raw(),
@@ -137,30 +167,19 @@ impl Snes {
                 HIST as sys::PetscInt,
                 sys::PetscBool_PETSC_TRUE
             ))?;
-            let solved = petsc_call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()));
-            let mut reason: sys::SNESConvergedReason = 0;
-            let mut its: sys::PetscInt = 0;
-            let mut lits: sys::PetscInt = 0;
-            let mut norm = 0.0;
-            let mut nhist: sys::PetscInt = 0;
-            let mut hptr: *mut f64 = std::ptr::null_mut();
-            let mut iptr: *mut sys::PetscInt = std::ptr::null_mut();
-            sys::SNESGetConvergedReason(self.raw, &mut reason);
-            sys::SNESGetIterationNumber(self.raw, &mut its);
-            sys::SNESGetLinearSolveIterations(self.raw, &mut lits);
-            sys::SNESGetFunctionNorm(self.raw, &mut norm);
-            sys::SNESGetConvergenceHistory(self.raw, &mut hptr, &mut iptr, &mut nhist);
-            let history = hist[..(nhist.max(0) as usize).min(HIST)].to_vec();
-            sys::SNESSetConvergenceHistory(
+            petsc_call!(SNESSolve(self.raw, std::ptr::null_mut(), x.raw()))
+        };
+        let read = self.read_outcome(&hist);
+        // SAFETY: valid snes; detaching the stack arrays before they go away.
+        let detached = unsafe {
+            petsc_call!(SNESSetConvergenceHistory(
                 self.raw,
                 std::ptr::null_mut(),
                 std::ptr::null_mut(),
                 0,
-                sys::PetscBool_PETSC_TRUE,
-            );
-            (solved, reason, its, lits, norm, history)
+                sys::PetscBool_PETSC_TRUE
+            ))
         };
-        let (solved, reason, its, lits, norm, history) = outcome;
         if let Some(msg) = ctx.fatal.take() {
             return Err(PetscError {
                 call: "SNESSolve callback",
@@ -168,16 +187,54 @@ impl Snes {
                 message: msg,
             });
         }
-        solved?;
+        detached?;
+        let mut outcome = read?;
+        if ctx.jacobian_stopped {
+            outcome.reason = SnesReason::JacobianDomain;
+        } else {
+            solved?;
+        }
+        outcome.domain_error = ctx.domain.take();
+        outcome.converged = outcome.reason.converged() && outcome.domain_error.is_none();
+        Ok(outcome)
+    }
+
+    /// Reason, counts and history after a solve (every call checked).
+    fn read_outcome(&self, hist: &[f64]) -> Result<SnesOutcome> {
+        let mut reason: sys::SNESConvergedReason = 0;
+        let mut its: sys::PetscInt = 0;
+        let mut lits: sys::PetscInt = 0;
+        let mut norm = 0.0;
+        let mut nhist: sys::PetscInt = 0;
+        let mut hptr: *mut f64 = std::ptr::null_mut();
+        let mut iptr: *mut sys::PetscInt = std::ptr::null_mut();
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut ksp_reason: sys::KSPConvergedReason = 0;
+        let mut ksp_its: sys::PetscInt = 0;
+        // SAFETY: valid snes; out-pointers valid for the calls.
+        unsafe {
+            petsc_call!(SNESGetConvergedReason(self.raw, &mut reason))?;
+            petsc_call!(SNESGetIterationNumber(self.raw, &mut its))?;
+            petsc_call!(SNESGetLinearSolveIterations(self.raw, &mut lits))?;
+            petsc_call!(SNESGetFunctionNorm(self.raw, &mut norm))?;
+            petsc_call!(SNESGetConvergenceHistory(
+                self.raw, &mut hptr, &mut iptr, &mut nhist
+            ))?;
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetConvergedReason(ksp, &mut ksp_reason))?;
+            petsc_call!(KSPGetIterationNumber(ksp, &mut ksp_its))?;
+        }
+        let reason = SnesReason::from_raw(reason);
         Ok(SnesOutcome {
-            converged: reason > 0,
+            converged: reason.converged(),
             reason,
-            reason_text: reason_text(reason),
-            iterations: its as usize,
-            linear_iterations: lits as usize,
+            iterations: its.max(0) as usize,
+            linear_iterations: lits.max(0) as usize,
+            ksp_reason: KspReason::from_raw(ksp_reason),
+            ksp_iterations: ksp_its.max(0) as usize,
             residual_norm: norm,
-            history,
-            domain_error: ctx.domain.take(),
+            history: hist[..(nhist.max(0) as usize).min(hist.len())].to_vec(),
+            domain_error: None,
         })
     }
 }
@@ -191,33 +248,17 @@ impl Drop for Snes {
     }
 }
 
-fn reason_text(reason: i32) -> String {
-    // PETSc's own name table (SNESConvergedReasons) is a macro-indexed array
-    // bindgen cannot see, so the documented meanings are spelled out here.
-    match reason {
-        2 => "converged: |F| < atol",
-        3 => "converged: |F| < rtol |F0|",
-        4 => "converged: |dx| < stol |x|",
-        5 => "converged: iteration limit (ksponly)",
-        -1 => "diverged: function count",
-        -2 => "diverged: linear solve failed",
-        -3 => "diverged: NaN or Inf in the residual",
-        -4 => "diverged: |F| exceeded divergence tolerance",
-        -5 => "diverged: maximum iterations reached",
-        -6 => "diverged: line search failed",
-        -7 => "diverged: inner solve failed",
-        -8 => "diverged: local minimum",
-        -10 => "diverged: domain error (inverted element?)",
-        -11 => "diverged: Jacobian domain error",
-        -12 => "diverged: trust region delta",
-        _ => "unknown",
-    }
-    .to_owned()
+/// Which callback is running: a domain error is flagged on its own kind.
+#[derive(Clone, Copy)]
+enum Kind {
+    Residual,
+    Jacobian,
 }
 
 fn run_callback(
     ctx: *mut c_void,
     snes: sys::SNES,
+    kind: Kind,
     f: impl FnOnce(&mut dyn NonlinearProblem) -> std::result::Result<(), CallbackError>,
 ) -> sys::PetscErrorCode {
     // SAFETY: ctx is the `Context` set in `solve`, alive for the whole SNESSolve.
@@ -226,12 +267,29 @@ fn run_callback(
     match result {
         Ok(Ok(())) => 0,
         Ok(Err(CallbackError::Domain(msg))) => {
+            // The problem agreed the failure over all ranks before returning
+            // it, so every rank flags the same domain error here.
             ctx.domain = Some(msg);
-            // SAFETY: valid snes handed to the callback by PETSc.
-            unsafe {
-                sys::SNESSetFunctionDomainError(snes);
+            match kind {
+                Kind::Residual => {
+                    // SAFETY: valid snes handed to the callback by PETSc.
+                    match unsafe { petsc_call!(SNESSetFunctionDomainError(snes)) } {
+                        Ok(()) => 0,
+                        Err(e) => {
+                            ctx.fatal = Some(e.to_string());
+                            sys::PETSC_ERR_USER
+                        }
+                    }
+                }
+                // PETSc 3.18 keeps a Jacobian domain flag set into the next
+                // solve (and checks it only on request), so the Jacobian
+                // stops the solve with an error code instead, on every
+                // rank alike; `solve` reads it back as this domain error.
+                Kind::Jacobian => {
+                    ctx.jacobian_stopped = true;
+                    sys::PETSC_ERR_NOT_CONVERGED
+                }
             }
-            0
         }
         Ok(Err(CallbackError::Fatal(msg))) => {
             ctx.fatal = Some(msg);
@@ -252,7 +310,7 @@ unsafe extern "C" fn residual_trampoline(
 ) -> sys::PetscErrorCode {
     // SAFETY: PETSc passes valid vectors owned by the SNES for the call's duration.
     let (xv, mut rv) = unsafe { (Vector::borrowed(x), Vector::borrowed(r)) };
-    run_callback(ctx, snes, |p| p.residual(&xv, &mut rv))
+    run_callback(ctx, snes, Kind::Residual, |p| p.residual(&xv, &mut rv))
 }
 
 unsafe extern "C" fn jacobian_trampoline(
@@ -265,5 +323,5 @@ unsafe extern "C" fn jacobian_trampoline(
     // SAFETY: PETSc passes valid objects for the call's duration; A and P are the
     // same matrix (set in `solve`).
     let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(a)) };
-    run_callback(ctx, snes, |p| p.jacobian(&xv, &mut am))
+    run_callback(ctx, snes, Kind::Jacobian, |p| p.jacobian(&xv, &mut am))
 }

@@ -5,8 +5,8 @@
 //!
 //! Friction in dynamics measures slip from the relative velocity, which the
 //! integrator makes affine in `u` (`v = γ/(βΔt) u + …`): the links get that
-//! map ([`SlipRateMap`]) and their tangent then carries the seed's damping
-//! contribution `γ/(βΔt) ∂f/∂v`.
+//! map ([`SlipRateMap`]) and their tangent then carries the friction damping
+//! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
 use super::newmark::{Coefficients, Newmark};
 use crate::assembly::BulkAssembler;
 use crate::contact::links::SlipRateMap;
@@ -14,7 +14,6 @@ use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
-use mpi::collective::SystemOperation;
 use mpi::traits::*;
 
 /// What a scene says about dynamics.
@@ -208,8 +207,7 @@ impl TimeStepper {
             p[3] = strain_local;
             p
         })?;
-        let mut total = [0.0; 4];
-        world.all_reduce_into(&local[..], &mut total[..], SystemOperation::sum());
+        let total = crate::parallel::sum(world, local);
         Ok(DynamicsReport {
             time,
             kinetic,

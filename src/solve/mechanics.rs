@@ -8,8 +8,11 @@ use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
+use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, PatternBuilder, Vector};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::Communicator;
 
 /// Everything the residual and Jacobian need, plus the work vectors that hold
 /// the ghosted state between callbacks.
@@ -30,6 +33,8 @@ pub struct Mechanics<'a> {
     /// Time spent per phase in these callbacks (this rank).
     pub times: PhaseTimes,
     stages: Stages,
+    /// The callbacks agree their outcome over these ranks (PETSc's world).
+    world: SimpleCommunicator,
     u: GhostedVector,
     r: GhostedVector,
     /// Bulk stiffness when every body is linear: assembled once, reused.
@@ -67,6 +72,7 @@ impl<'a> Mechanics<'a> {
             inertia: None,
             times: PhaseTimes::default(),
             stages: Stages::register()?,
+            world: SimpleCommunicator::world(),
             u,
             r,
             linear_k: None,
@@ -111,6 +117,11 @@ impl<'a> Mechanics<'a> {
 
     /// f_int − f_ext + r_contact at `x`, without the Dirichlet replacement
     /// (its constrained entries are the reactions).
+    ///
+    /// Collective, and never left early past a collective call: when this
+    /// rank's assembly fails (an inverted cell, non-finite values) it still
+    /// takes part in the ghost accumulation and the products after it, and
+    /// returns its local failure at the end (not agreed: callers agree it).
     pub fn raw_residual(&mut self, x: &Vector, out: &mut Vector) -> Result<()> {
         self.load_state(x)?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
@@ -120,10 +131,11 @@ impl<'a> Mechanics<'a> {
         let contact = &mut *self.contact;
         let u = &self.u;
         let (stages, times) = (self.stages, &mut self.times);
-        self.r.with_local_mut(|r_local| -> Result<()> {
+        let local = self.r.with_local_mut(|r_local| -> Result<()> {
             r_local.fill(0.0);
             u.with_local(|u_local| -> Result<()> {
                 stages.time(Phase::BulkAssembly, times, || -> Result<()> {
+                    fault::check(FaultPhase::BulkResidual)?;
                     if !linear {
                         bulk.add_internal_force(u_local, r_local)?;
                     }
@@ -137,13 +149,20 @@ impl<'a> Mechanics<'a> {
                     Ok(())
                 })?;
                 stages.time(Phase::ContactAssembly, times, || -> Result<()> {
+                    fault::check(FaultPhase::ContactAssembly)?;
                     for pair in contact.iter_mut() {
                         pair.add_residual(dofs, u_local, factor, r_local)?;
                     }
                     Ok(())
                 })
             })?
-        })??;
+        })?;
+        // Non-finite local values (a NaN load, an overflowing material law)
+        // are this rank's failure too, found before they spread to others.
+        let local = local.and_then(|()| {
+            self.r
+                .with_local(|r_local| first_nonfinite(r_local, "residual"))?
+        });
         let r = &mut self.r;
         stages.time(Phase::HaloExchange, times, || r.accumulate_ghosts())?;
         out.copy_from(self.r.global())?;
@@ -157,86 +176,161 @@ impl<'a> Mechanics<'a> {
                 inertia.add_force(x, out)?;
             }
             Ok(())
-        })
+        })?;
+        local
     }
 
-    /// ‖R(x)‖ with the Dirichlet rows replaced, as SNES sees it.
-    pub fn residual_norm(&mut self, x: &Vector, work: &mut Vector) -> Result<f64> {
-        self.residual_impl(x, work)?;
-        Ok(work.norm2()?)
+    /// ‖R(x)‖ with the Dirichlet rows replaced, as SNES sees it: the first
+    /// residual of a load step. The outcome is agreed over all ranks; a
+    /// domain error (an inverted cell on any rank) sends the step to the
+    /// cutback path like a failed Newton solve.
+    pub fn residual_norm(
+        &mut self,
+        x: &Vector,
+        work: &mut Vector,
+    ) -> std::result::Result<f64, CallbackError> {
+        let local = self.residual_impl(x, work);
+        let norm = work
+            .norm2()
+            .map_err(|e| CallbackError::Fatal(e.to_string()));
+        self.agree(local)?;
+        norm
     }
 
     fn residual_impl(&mut self, x: &Vector, r: &mut Vector) -> Result<()> {
         self.residual_evaluations += 1;
-        self.raw_residual(x, r)?;
+        let local = self.raw_residual(x, r);
         let factor = self.factor;
         let dirichlet = self.dirichlet;
         x.with_array(|xa| r.with_array_mut(|ra| dirichlet.constrain_residual(xa, ra, factor)))??;
-        Ok(())
+        local
     }
 
+    /// The Jacobian at `x`. Collective, and like [`Self::raw_residual`] never
+    /// left early past a collective call (the whole-matrix additions and the
+    /// final assembly run on every rank whatever this rank's part did).
     fn jacobian_impl(&mut self, x: &Vector, j: &mut Matrix) -> Result<()> {
         self.jacobian_evaluations += 1;
         self.load_state(x)?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         let (stages, times) = (self.stages, &mut self.times);
         let (u, inertia, linear_k) = (&self.u, &self.inertia, &self.linear_k);
-        let assembled_bulk = stages.time(Phase::BulkAssembly, times, || -> Result<bool> {
+        let bulk_part = stages.time(Phase::BulkAssembly, times, || -> Result<Result<bool>> {
             j.zero_entries()?;
-            // Whole-matrix additions (MatAXPY) need the assembled (zeroed)
-            // matrix, so they come before any element values are set.
+            // Whole-matrix additions (MatAXPY, collective) need the assembled
+            // (zeroed) matrix, so they come before any element values are set.
             if let Some(inertia) = inertia {
                 j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
             }
-            let assembled = match linear_k {
-                Some(k) => {
-                    j.add_scaled_subset(1.0, k)?;
-                    false
-                }
-                None => {
-                    u.with_local(|u_local| bulk.add_tangent(u_local, j))??;
-                    true
-                }
-            };
-            if loads.has_follower() {
-                u.with_local(|u_local| loads.add_tangent(u_local, factor, j))??;
+            if let Some(k) = linear_k {
+                j.add_scaled_subset(1.0, k)?;
             }
-            Ok(assembled)
-        })?;
-        if assembled_bulk {
-            self.bulk_tangent_assemblies += 1;
-        }
-        let contact = &mut *self.contact;
-        stages.time(Phase::ContactAssembly, times, || {
-            u.with_local(|u_local| -> Result<()> {
-                for pair in contact.iter_mut() {
-                    pair.add_tangent(dofs, u_local, factor, j)?;
+            // From here on only this rank's values: a failure is kept for the end.
+            let mut local = || -> Result<bool> {
+                fault::check(FaultPhase::Jacobian)?;
+                let assembled = linear_k.is_none();
+                if assembled {
+                    u.with_local(|u_local| bulk.add_tangent(u_local, j))??;
                 }
-                Ok(())
-            })?
+                if loads.has_follower() {
+                    u.with_local(|u_local| loads.add_tangent(u_local, factor, j))??;
+                }
+                Ok(assembled)
+            };
+            Ok(local())
         })?;
+        let contact = &mut *self.contact;
+        let local = match bulk_part {
+            Ok(assembled) => {
+                if assembled {
+                    self.bulk_tangent_assemblies += 1;
+                }
+                stages.time(Phase::ContactAssembly, times, || {
+                    u.with_local(|u_local| -> Result<()> {
+                        fault::check(FaultPhase::ContactAssembly)?;
+                        for pair in contact.iter_mut() {
+                            pair.add_tangent(dofs, u_local, factor, j)?;
+                        }
+                        Ok(())
+                    })?
+                })
+            }
+            Err(e) => Err(e),
+        };
+        if fault::fires(FaultPhase::LinearSolve) {
+            // A NaN on one of this rank's diagonal entries: the linear solve
+            // itself fails, on every rank, as with a broken material tangent.
+            poison_diagonal(dofs, self.dirichlet, j)?;
+        }
         let rows = self.dirichlet.global_rows();
         stages.time(Phase::BulkAssembly, times, || -> Result<()> {
             j.assemble()?;
             j.zero_rows_columns_identity(&rows)?;
             Ok(())
+        })?;
+        local
+    }
+
+    /// Collective: this rank's callback outcome made every rank's. Local
+    /// assembly failures (inverted cells, non-finite values, injected
+    /// faults) are domain errors, which cut the step back; anything else
+    /// stops the run. The message names the lowest failing rank.
+    fn agree(&self, local: Result<()>) -> std::result::Result<(), CallbackError> {
+        const DOMAIN: i32 = 1;
+        const FATAL: i32 = 2;
+        let failure = local.err().map(|e| {
+            let code = match e {
+                Error::Element { .. } | Error::NonFinite(_) | Error::Fault(_) => DOMAIN,
+                _ => FATAL,
+            };
+            (code, e.to_string())
+        });
+        let Some(f) = parallel::agree_failure(&self.world, failure) else {
+            return Ok(());
+        };
+        let message = if self.world.size() > 1 {
+            format!("rank {}: {}", f.rank, f.message)
+        } else {
+            f.message
+        };
+        Err(match f.code {
+            DOMAIN => CallbackError::Domain(message),
+            _ => CallbackError::Fatal(message),
         })
     }
 }
 
-fn classify(e: Error) -> CallbackError {
-    match e {
-        Error::Element { .. } => CallbackError::Domain(e.to_string()),
-        other => CallbackError::Fatal(other.to_string()),
+/// Adds NaN to the diagonal of this rank's first unconstrained row.
+fn poison_diagonal(dofs: &DofMap, dirichlet: &Dirichlet, j: &mut Matrix) -> Result<()> {
+    let constrained: std::collections::HashSet<usize> =
+        dirichlet.dofs.iter().map(|d| d.owned_index).collect();
+    let free = (0..dofs.num_owned_dofs()).find(|i| !constrained.contains(i));
+    if let Some(i) = free {
+        let row = crate::petsc::to_petsc_int(dofs.owned_dof_start() + i)?;
+        j.add_block(&[row], &[row], &[f64::NAN])?;
+    }
+    Ok(())
+}
+
+/// `Err` naming the first non-finite entry of this rank's local `values`.
+fn first_nonfinite(values: &[f64], what: &str) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NonFinite(format!(
+            "{what} (local DOF {i}: {})",
+            values[i]
+        ))),
     }
 }
 
 impl NonlinearProblem for Mechanics<'_> {
     fn residual(&mut self, x: &Vector, r: &mut Vector) -> std::result::Result<(), CallbackError> {
-        self.residual_impl(x, r).map_err(classify)
+        let local = self.residual_impl(x, r);
+        self.agree(local)
     }
 
     fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError> {
-        self.jacobian_impl(x, j).map_err(classify)
+        let local = self.jacobian_impl(x, j);
+        self.agree(local)
     }
 }

@@ -7,6 +7,7 @@
 //! SNES, and only this module calls the solver.
 pub mod boundary;
 pub mod dynamics;
+mod failure;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
@@ -24,10 +25,12 @@ use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
+use crate::parallel::{self, fault, fault::FaultPhase};
+use crate::petsc::snes::CallbackError;
 use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, Vector};
 use crate::restart::RestartState;
 use crate::runtime::Runtime;
-use mpi::collective::SystemOperation;
+use failure::{failure_text, newton_failure, StepFailure};
 use mpi::traits::*;
 use phases::{Phase, PhaseTimes};
 use std::time::Instant;
@@ -285,17 +288,6 @@ pub struct Simulation<'m> {
     jac: Matrix,
 }
 
-/// Why a load increment failed.
-enum StepFailure {
-    /// Newton failed; with the link states of the last Uzawa update before
-    /// it (empty when it failed in the step's first solve).
-    Newton(SnesOutcome, Vec<(String, UzawaStats)>),
-    Uzawa {
-        iterations: usize,
-        stats: UzawaStats,
-    },
-}
-
 impl<'m> Simulation<'m> {
     /// Partitions (METIS on rank 0, broadcast), numbers the DOFs, precomputes
     /// element data, resolves contact pairs and allocates the Jacobian.
@@ -339,12 +331,14 @@ impl<'m> Simulation<'m> {
         let stages = phases::Stages::register()?;
         // Phases booked here; the callbacks book theirs in `mech.times`.
         let mut times = PhaseTimes::default();
-        // Frictionless contact keeps the tangent symmetric (it is the Hessian
-        // of a potential); friction and follower loads do not.
-        let friction = self.contact.iter().any(ContactPair::has_friction);
-        let symmetric = !self.loads.has_follower()
-            && !friction
-            && model.materials.iter().all(Material::tangent_is_symmetric);
+        // Frictionless links keep the tangent symmetric (it is the Hessian
+        // of a potential); friction, mortar pairs and follower loads do not.
+        // A follower load's facets may sit on some ranks only: the choice is
+        // agreed, or the ranks would factor one matrix as LU and LDLᵀ at once.
+        let unsymmetric = self.contact.iter().any(|p| !p.tangent_is_symmetric());
+        let follower = parallel::any_rank(&world, self.loads.has_follower());
+        let symmetric =
+            !follower && !unsymmetric && model.materials.iter().all(Material::tangent_is_symmetric);
         let tangent = TangentKind {
             symmetric,
             linear_bulk: model.materials.iter().all(Material::is_linear),
@@ -394,7 +388,7 @@ impl<'m> Simulation<'m> {
         x.set_all(0.0)?;
         let (first_step, mut done) = match restart {
             Some(state) => {
-                take_over(state, dofs, &mut x, mech.contact)?;
+                parallel::agree(&world, take_over(state, dofs, &mut x, mech.contact))?;
                 (state.step, state.load_factor)
             }
             None => (0, 0.0),
@@ -434,14 +428,17 @@ impl<'m> Simulation<'m> {
             let step_start_times = add_times(&times, &mech.times);
             if !mech.contact.is_empty() {
                 let mark = PhaseMark::new(&mech);
-                let changed = stages.scope(Phase::ContactSearch, || {
+                let searched = stages.scope(Phase::ContactSearch, || {
                     mech.with_state(&x, |u, pairs| {
-                        Ok(pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c))
+                        let changed = pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c);
+                        fault::check(FaultPhase::Search)?;
+                        Ok(changed)
                     })
-                })?;
+                });
+                let changed = parallel::agree(&world, searched)?;
                 mark.book(Phase::ContactSearch, &mut times, &mech);
                 let rebuild = !model.solver.reuse.pattern || pattern_builds == 0;
-                if any_rank(&world, changed) || rebuild {
+                if parallel::any_rank(&world, changed) || rebuild {
                     // A new coupling pattern is contact assembly's cost.
                     *jac = stages.time(Phase::ContactAssembly, &mut times, || {
                         build_jacobian(dofs, bulk, loads, mech.contact, &model.mesh)
@@ -449,39 +446,74 @@ impl<'m> Simulation<'m> {
                     pattern_builds += 1;
                 }
             }
+            // The step's first residual (the step's own force scale when no
+            // atol is given) fails like any other: into the cutback path.
+            let mut first = Ok(());
             if model.solver.atol.is_none() && !user_atol {
                 // The step's own force scale: the residual once the new loads
                 // and prescribed displacements are in place.
-                let r0 = mech.residual_norm(&x, &mut r)?;
-                snes.set_tolerances(
-                    (model.solver.rtol * r0).max(atol_floor),
-                    model.solver.rtol,
-                    0.0,
-                    model.solver.max_newton,
-                )?;
+                match mech.residual_norm(&x, &mut r) {
+                    Ok(r0) => snes.set_tolerances(
+                        (model.solver.rtol * r0).max(atol_floor),
+                        model.solver.rtol,
+                        0.0,
+                        model.solver.max_newton,
+                    )?,
+                    Err(CallbackError::Domain(why)) => first = Err(StepFailure::Residual(why)),
+                    Err(CallbackError::Fatal(why)) => {
+                        return Err(Error::Petsc(petsc::PetscError {
+                            call: "first residual of a step",
+                            code: -1,
+                            message: why,
+                        }))
+                    }
+                }
             }
-            let attempt = stage_solve.scope(|| {
-                let mut ctx = StepContext {
-                    snes: &mut snes,
-                    x: &mut x,
-                    r: &mut r,
-                    jac,
-                    stages: &stages,
-                    times: &mut times,
-                    reuse_preconditioner: model.solver.reuse.preconditioner,
-                };
-                uzawa_loop(&world, &mut ctx, &mut mech, target)
-            });
+            let attempt = first.map_or_else(
+                |f| Ok(Err(f)),
+                |()| {
+                    stage_solve.scope(|| {
+                        let mut ctx = StepContext {
+                            snes: &mut snes,
+                            x: &mut x,
+                            r: &mut r,
+                            jac,
+                            stages: &stages,
+                            times: &mut times,
+                            reuse_preconditioner: model.solver.reuse.preconditioner,
+                        };
+                        uzawa_loop(&world, &mut ctx, &mut mech, target)
+                    })
+                },
+            );
             let (outcome, uzawa_iterations, stats) = match attempt? {
                 Ok(done_step) => done_step,
                 Err(failure) => {
-                    x.copy_from(&x_prev)?;
-                    for (p, snap) in mech.contact.iter_mut().zip(contact_prev) {
-                        p.restore(snap)?;
+                    if failure.linear_solve_failed() {
+                        snes.reset_preconditioner()?;
                     }
+                    x.copy_from(&x_prev)?;
+                    let restored = mech
+                        .contact
+                        .iter_mut()
+                        .zip(contact_prev)
+                        .try_for_each(|(p, snap)| p.restore(snap));
+                    parallel::agree(&world, restored)?;
                     cutbacks_here += 1;
-                    let why = failure_text(&failure);
-                    if cutbacks_here > model.solver.max_cutbacks {
+                    let mut why = failure_text(&failure);
+                    // The count restarts after every converged step, so a
+                    // load path stuck at a limit point would creep on with
+                    // ever smaller increments: they never go below the
+                    // scene's increment halved max_cutbacks times.
+                    let smallest = base * 0.5f64.powi(model.solver.max_cutbacks as i32);
+                    let too_small = increment * 0.5 < smallest * (1.0 - 1e-9);
+                    if too_small && cutbacks_here <= model.solver.max_cutbacks {
+                        why += &format!(
+                            "; the next increment would be below the smallest allowed ({smallest:.3e}: the scene's increment halved max_cutbacks = {} times)",
+                            model.solver.max_cutbacks
+                        );
+                    }
+                    if cutbacks_here > model.solver.max_cutbacks || too_small {
                         return Err(Error::NoConvergence {
                             step: first_step + steps.len() + 1,
                             load_factor: target,
@@ -501,7 +533,8 @@ impl<'m> Simulation<'m> {
             let dynamics_report = match (&mut stepper, &coefficients) {
                 (Some(s), Some(c)) => {
                     s.advance(&x, c)?;
-                    let strain = mech.with_state(&x, |u, _| bulk.strain_energy(u))?;
+                    let strain =
+                        parallel::agree(&world, mech.with_state(&x, |u, _| bulk.strain_energy(u)))?;
                     let time = done * s.t_end;
                     let inertia = mech
                         .inertia
@@ -513,18 +546,19 @@ impl<'m> Simulation<'m> {
             };
             let output_mark = PhaseMark::new(&mech);
             // In dynamics the support also carries the inertia of its rows.
-            mech.raw_residual(&x, &mut reaction)?;
+            parallel::agree(&world, mech.raw_residual(&x, &mut reaction))?;
             let reactions = reaction_totals(&world, dirichlet, &reaction, dofs.owned_dof_start())?;
             zero_unconstrained(&mut reaction, dirichlet)?;
-            let (fields, forces) = mech.with_state(&x, |u, pairs| {
+            let values = mech.with_state(&x, |u, pairs| {
                 let values = pairs
                     .iter_mut()
                     .map(|p| p.point_values(u, target))
                     .collect::<Result<Vec<_>>>()?;
                 Ok(values.into_iter().unzip::<_, PairForce, Vec<_>, Vec<_>>())
-            })?;
+            });
+            let (fields, forces) = parallel::agree(&world, values)?;
             let contact_reports = contact_reports(&world, mech.contact, &forces, &stats);
-            let nodal_pressure = nodal_pressure(dofs, mech.contact)?;
+            let nodal_pressure = parallel::agree(&world, nodal_pressure(dofs, mech.contact))?;
             let report = StepReport {
                 index: first_step + steps.len() + 1,
                 load_factor: done,
@@ -564,9 +598,8 @@ impl<'m> Simulation<'m> {
             })?;
             drop(pair_fields);
             output_mark.book(Phase::Output, &mut times, &mech);
-            for pair in mech.contact.iter_mut() {
-                pair.commit()?;
-            }
+            let committed = mech.contact.iter_mut().try_for_each(|p| p.commit());
+            parallel::agree(&world, committed)?;
             steps.push(report);
             cutbacks_here = 0;
             // Grow back towards the scene's increment after a successful cut step.
@@ -582,14 +615,15 @@ impl<'m> Simulation<'m> {
             bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
             pattern_builds,
             phases: max_over_ranks(&world, add_times(&times, &mech.times)),
-            halo_displacements: sum_over_ranks(&world, dofs.ghost_dofs().len()),
-            halo_multipliers: sum_over_ranks(
+            halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
+            halo_multipliers: parallel::sum_usize(
                 &world,
-                mech.contact
+                [mech
+                    .contact
                     .iter()
                     .map(|p| p.multipliers.ghost_values())
-                    .sum(),
-            ),
+                    .sum()],
+            )[0],
         })
     }
 }
@@ -629,16 +663,8 @@ fn add_times(a: &PhaseTimes, b: &PhaseTimes) -> PhaseTimes {
     t
 }
 
-fn sum_over_ranks(world: &impl Communicator, n: usize) -> usize {
-    let mut total = 0u64;
-    world.all_reduce_into(&(n as u64), &mut total, SystemOperation::sum());
-    total as usize
-}
-
 fn max_over_ranks(world: &impl Communicator, t: PhaseTimes) -> PhaseTimes {
-    let mut out = PhaseTimes::default();
-    world.all_reduce_into(&t.0[..], &mut out.0[..], SystemOperation::max());
-    out
+    PhaseTimes(parallel::max(world, t.0))
 }
 
 /// The solver state one Uzawa loop works on.
@@ -753,7 +779,7 @@ fn prepare_time_step(
 
 type StepResult = std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), StepFailure>;
 
-/// The seed's Uzawa loop for one load step: Newton with λ fixed, then
+/// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
 /// λ ← ⟨λ − εN gN⟩ at every link, until the penetration and the multiplier
 /// change meet the tolerances on every rank (or there is no contact).
 /// Newton iterations are summed over the Uzawa iterations.
@@ -787,10 +813,6 @@ fn uzawa_loop(
     let mut raises = 0;
     // Uzawa iterations over every round (k counts within one).
     let mut total = 0;
-    // What the links carried into this step (the last converged step's
-    // multipliers), replaced after every Uzawa update: reported if Newton
-    // fails for good.
-    let mut last_links = link_summaries(world, mech.contact);
     loop {
         k += 1;
         total += 1;
@@ -810,28 +832,25 @@ fn uzawa_loop(
         linear += outcome.linear_iterations;
         history.extend_from_slice(&outcome.history);
         if !outcome.converged {
-            return Ok(Err(StepFailure::Newton(outcome, last_links)));
+            return Ok(Err(newton_failure(world, mech, x, jac, factor, outcome)?));
         }
         if mech.contact.is_empty() {
             return Ok(Ok((outcome, 0, Vec::new())));
         }
         let mark = PhaseMark::new(mech);
-        let local: Vec<UzawaStats> = stages.scope(Phase::UzawaUpdate, || {
+        let updated = stages.scope(Phase::UzawaUpdate, || {
             mech.with_state(x, |u, pairs| {
-                pairs
+                let stats = pairs
                     .iter_mut()
                     .map(|p| p.uzawa_update(u, factor))
-                    .collect()
+                    .collect::<Result<Vec<UzawaStats>>>()?;
+                fault::check(FaultPhase::UzawaUpdate)?;
+                Ok(stats)
             })
-        })?;
+        });
+        let local = parallel::agree(world, updated)?;
         mark.book(Phase::UzawaUpdate, times, mech);
         let stats = reduce_stats(world, &local);
-        last_links = mech
-            .contact
-            .iter()
-            .map(|p| p.spec.name.clone())
-            .zip(stats.iter().copied())
-            .collect();
         let converged = mech
             .contact
             .iter()
@@ -889,84 +908,28 @@ fn pair_converged(p: &ContactPair, s: &UzawaStats) -> bool {
         && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
 }
 
-/// Per pair: points in contact and sliding under the current multipliers
-/// (totals over ranks).
-fn link_summaries(world: &impl Communicator, pairs: &[ContactPair]) -> Vec<(String, UzawaStats)> {
-    pairs
-        .iter()
-        .map(|p| {
-            let (active, sliding) = p.multiplier_states();
-            let mine = [active as u64, sliding as u64];
-            let mut total = [0u64; 2];
-            world.all_reduce_into(&mine[..], &mut total[..], SystemOperation::sum());
-            let stats = UzawaStats {
-                active: total[0] as usize,
-                sliding: total[1] as usize,
-                // Not measured until the step's first Uzawa update.
-                max_penetration: f64::NAN,
-                ..UzawaStats::default()
-            };
-            (p.spec.name.clone(), stats)
-        })
-        .collect()
-}
-
-fn failure_text(f: &StepFailure) -> String {
-    match f {
-        StepFailure::Newton(o, links) => {
-            let mut text = match &o.domain_error {
-                Some(d) => format!("{} ({d})", o.reason_text),
-                None => format!("{} after {} iterations, |R| = {:.3e}", o.reason_text, o.iterations, o.residual_norm),
-            };
-            for (name, s) in links {
-                text += &format!(
-                    "; links of pair '{name}' at the last multiplier update: {} in contact, {} sliding, {} sticking",
-                    s.active, s.sliding, s.active - s.sliding.min(s.active)
-                );
-                if s.max_penetration.is_finite() {
-                    text += &format!(", max penetration {:.3e} h", s.max_penetration);
-                }
-            }
-            text
-        }
-        StepFailure::Uzawa { iterations, stats } => format!(
-            "Uzawa loop did not converge in {iterations} iterations, the last ones with the penalty raised {}× (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
-            PENALTY_RAISE.powi(PENALTY_RAISES as i32),
-            stats.max_penetration, stats.max_change, stats.max_force
-        ),
-    }
-}
-
-/// True on every rank if `flag` is true on any.
-fn any_rank(world: &impl Communicator, flag: bool) -> bool {
-    let mine = i32::from(flag);
-    let mut any = 0;
-    world.all_reduce_into(&mine, &mut any, SystemOperation::max());
-    any == 1
-}
-
+/// Collective: each pair's Uzawa figures over all ranks.
 fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaStats> {
     local
         .iter()
         .map(|s| {
-            let maxes = [
-                s.max_penetration,
-                s.max_change,
-                s.max_force,
-                s.max_multiplier,
-            ];
-            let mut g = [0.0; 4];
-            world.all_reduce_into(&maxes[..], &mut g[..], SystemOperation::max());
-            let counts = [s.active as u64, s.sliding as u64];
-            let mut total = [0u64; 2];
-            world.all_reduce_into(&counts[..], &mut total[..], SystemOperation::sum());
+            let [max_penetration, max_change, max_force, max_multiplier] = parallel::max(
+                world,
+                [
+                    s.max_penetration,
+                    s.max_change,
+                    s.max_force,
+                    s.max_multiplier,
+                ],
+            );
+            let [active, sliding] = parallel::sum_usize(world, [s.active, s.sliding]);
             UzawaStats {
-                max_penetration: g[0],
-                max_change: g[1],
-                max_force: g[2],
-                max_multiplier: g[3],
-                active: total[0] as usize,
-                sliding: total[1] as usize,
+                max_penetration,
+                max_change,
+                max_force,
+                max_multiplier,
+                active,
+                sliding,
             }
         })
         .collect()
@@ -983,9 +946,7 @@ fn contact_reports(
         .zip(forces)
         .enumerate()
         .map(|(i, (p, f))| {
-            let mut total = [0.0; 5];
-            world.all_reduce_into(&f.to_array()[..], &mut total[..], SystemOperation::sum());
-            let total = PairForce::from_array(total);
+            let total = PairForce::from_array(parallel::sum(world, f.to_array()));
             let s = stats.get(i).copied().unwrap_or_default();
             ContactReport {
                 name: p.spec.name.clone(),
@@ -1006,7 +967,7 @@ fn nodal_pressure(dofs: &DofMap, pairs: &[ContactPair]) -> Result<Vec<f64>> {
     let n = dofs.num_owned_nodes();
     let (mut num, mut den) = (vec![0.0; n], vec![0.0; n]);
     for p in pairs {
-        p.multipliers.add_nodal_pressure(&mut num, &mut den)?;
+        p.add_nodal_pressure(&mut num, &mut den)?;
     }
     Ok(num
         .iter()
@@ -1049,9 +1010,15 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
                 mesh, set,
             )?);
         }
+        if pair.formulation == crate::contact::Formulation::Mortar {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh,
+                &pair.slave,
+            )?);
+        }
     }
     let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
-    let bulk = collective(
+    let bulk = parallel::agree(
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
     )?;
@@ -1065,14 +1032,14 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         })?;
         facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
     }
-    let loads = SurfaceLoads::new(mesh, &dofs, &facet_loads)?;
-    let dirichlet = collective(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
+    let loads = parallel::agree(&world, SurfaceLoads::new(mesh, &dofs, &facet_loads))?;
+    let dirichlet = parallel::agree(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
     let softest = model
         .materials
         .iter()
         .map(Material::youngs)
         .fold(f64::INFINITY, f64::min);
-    let contact = collective(
+    let contact = parallel::agree(
         &world,
         model
             .contact
@@ -1106,32 +1073,10 @@ fn broadcast_partition(
     } else {
         Ok(Vec::new())
     };
-    let mut ok = i32::from(mine.is_ok());
-    world.process_at_rank(0).broadcast_into(&mut ok);
-    if ok == 0 {
-        return Err(mine
-            .err()
-            .unwrap_or_else(|| Error::Partition("rank 0 could not partition the mesh".into())));
-    }
-    let mut part = mine.unwrap_or_else(|_| Vec::new());
+    let mut part = parallel::agree(world, mine)?;
     part.resize(mesh.num_cells(), 0);
     world.process_at_rank(0).broadcast_into(&mut part[..]);
     Ok(part)
-}
-
-/// Makes a per-rank result collective: if any rank failed, every rank returns
-/// an error (the failing rank its own), so no rank waits in a later collective.
-pub fn collective<T>(world: &impl Communicator, r: Result<T>) -> Result<T> {
-    let mine = r.is_ok() as i32;
-    let mut all = 0i32;
-    world.all_reduce_into(&mine, &mut all, SystemOperation::min());
-    match r {
-        Ok(v) if all == 1 => Ok(v),
-        Ok(_) => Err(Error::Mpi(
-            "another rank failed during set-up (its message is printed by that rank)".into(),
-        )),
-        Err(e) => Err(e),
-    }
 }
 
 fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
@@ -1168,9 +1113,10 @@ fn reaction_totals(
     start: usize,
 ) -> Result<Vec<(String, [f64; 3])>> {
     let local = raw.with_array(|a| dirichlet.reaction_sums(a, start))?;
-    let flat: Vec<f64> = local.iter().flat_map(|s| s.iter().copied()).collect();
-    let mut total = vec![0.0; flat.len()];
-    world.all_reduce_into(&flat[..], &mut total[..], SystemOperation::sum());
+    let total: Vec<f64> = local
+        .iter()
+        .flat_map(|s| parallel::sum(world, *s))
+        .collect();
     Ok(dirichlet
         .set_names
         .iter()

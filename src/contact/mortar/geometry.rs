@@ -1,0 +1,496 @@
+//! Segment geometry of the mortar formulation: the slave facet's auxiliary
+//! plane, both facets projected onto it, the clipped overlap polygon, its
+//! triangulation and the quadrature points mapped back to both facets'
+//! parametric coordinates.
+//!
+//! Everything is written in the scalar type `T` (f64 or a dual number), so
+//! the derivative of the clipped geometry (moving vertices, moving plane)
+//! comes out of the same code. Combinatorial decisions (which vertex is
+//! inside, which edges cross) are made on the f64 values: the derivative is
+//! then that of the current clipping pattern, which is the derivative almost
+//! everywhere.
+use crate::contact::dual::{self, Scalar, Vec3};
+use crate::fem::{FacetType, MAX_FACET_NODES};
+
+/// A 2-vector in the auxiliary plane.
+pub type Vec2<T> = [T; 2];
+
+/// Most vertices a clipped polygon can have: a convex n-gon clipped by a
+/// convex m-gon keeps at most n + m.
+pub const MAX_POLYGON: usize = 2 * MAX_FACET_NODES;
+
+/// Relative size (to the slave facet's size) under which two vertices are the
+/// same and a point counts as lying on a clipping edge.
+pub const GEOMETRY_TOL: f64 = 1e-9;
+
+/// The auxiliary plane of a slave facet: through the facet centre, normal to
+/// the facet there (outward of the slave body, towards the master), with an
+/// orthonormal in-plane basis.
+#[derive(Debug, Clone, Copy)]
+pub struct Plane<T> {
+    pub origin: Vec3<T>,
+    pub normal: Vec3<T>,
+    pub e1: Vec3<T>,
+    pub e2: Vec3<T>,
+}
+
+impl<T: Scalar> Plane<T> {
+    /// The plane of a slave facet (current positions `x`); `None` for a
+    /// degenerate facet (no normal at its centre).
+    pub fn of_facet(facet: FacetType, x: &[Vec3<T>]) -> Option<Self> {
+        let centre = crate::contact::projection::reference_centre(facet);
+        let s = crate::fem::shape::facet_shape(facet, centre);
+        let zero = dual::constant3::<T>([0.0; 3]);
+        let (mut origin, mut t1, mut t2) = (zero, zero, zero);
+        for (a, xa) in x.iter().enumerate().take(facet.nodes()) {
+            origin = dual::axpy(&origin, s.n[a], xa);
+            t1 = dual::axpy(&t1, s.dn[a][0], xa);
+            t2 = dual::axpy(&t2, s.dn[a][1], xa);
+        }
+        let (l1, l2) = (dual::norm(&t1), dual::norm(&t2));
+        let n = dual::cross(&t1, &t2);
+        let ln = dual::norm(&n);
+        if !(l1.re() > 0.0 && l2.re() > 0.0 && ln.re() > 1e-12 * l1.re() * l2.re()) {
+            return None;
+        }
+        let normal = dual::scale(&n, ln.recip());
+        let e1 = dual::scale(&t1, l1.recip());
+        let e2 = dual::cross(&normal, &e1);
+        Some(Plane {
+            origin,
+            normal,
+            e1,
+            e2,
+        })
+    }
+
+    /// In-plane coordinates of the projection of `x` along the normal.
+    pub fn coordinates(&self, x: &Vec3<T>) -> Vec2<T> {
+        let d = dual::sub(x, &self.origin);
+        [dual::dot(&d, &self.e1), dual::dot(&d, &self.e2)]
+    }
+}
+
+/// A polygon of at most [`MAX_POLYGON`] vertices (no allocation).
+#[derive(Debug, Clone, Copy)]
+pub struct Polygon<T> {
+    pub vertices: [Vec2<T>; MAX_POLYGON],
+    pub len: usize,
+}
+
+impl<T: Scalar> Polygon<T> {
+    pub fn new() -> Self {
+        Polygon {
+            vertices: [[T::from_f64(0.0); 2]; MAX_POLYGON],
+            len: 0,
+        }
+    }
+
+    pub fn from_points(points: &[Vec2<T>]) -> Self {
+        let mut p = Self::new();
+        for v in points.iter().take(MAX_POLYGON) {
+            p.push(*v);
+        }
+        p
+    }
+
+    fn push(&mut self, v: Vec2<T>) {
+        if let Some(slot) = self.vertices.get_mut(self.len) {
+            *slot = v;
+            self.len += 1;
+        }
+    }
+
+    pub fn points(&self) -> &[Vec2<T>] {
+        &self.vertices[..self.len]
+    }
+
+    /// Signed area (> 0 counter-clockwise), shoelace formula.
+    pub fn signed_area(&self) -> T {
+        let mut twice = T::from_f64(0.0);
+        let p = self.points();
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            twice = twice + (a[0] * b[1] - a[1] * b[0]);
+        }
+        twice * 0.5
+    }
+
+    /// The same polygon counter-clockwise.
+    pub fn counter_clockwise(mut self) -> Self {
+        if self.signed_area().re() < 0.0 {
+            self.vertices[..self.len].reverse();
+        }
+        self
+    }
+
+    /// Whether every turn is to the left (allowing straight angles to `tol`).
+    pub fn is_convex_ccw(&self, tol: f64) -> bool {
+        let p = self.points();
+        let n = p.len();
+        n >= 3
+            && (0..n).all(|i| {
+                let (a, b, c) = (p[i], p[(i + 1) % n], p[(i + 2) % n]);
+                cross2(&sub2(&b, &a), &sub2(&c, &b)).re() >= -tol
+            })
+    }
+
+    /// Arithmetic mean of the vertices (inside a convex polygon).
+    pub fn centroid(&self) -> Vec2<T> {
+        let mut c = [T::from_f64(0.0); 2];
+        for v in self.points() {
+            c = [c[0] + v[0], c[1] + v[1]];
+        }
+        let inv = 1.0 / self.len.max(1) as f64;
+        [c[0] * inv, c[1] * inv]
+    }
+}
+
+impl<T: Scalar> Default for Polygon<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+pub fn sub2<T: Scalar>(a: &Vec2<T>, b: &Vec2<T>) -> Vec2<T> {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+pub fn cross2<T: Scalar>(a: &Vec2<T>, b: &Vec2<T>) -> T {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// Where a point lies relative to a clipping edge.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Side {
+    In,
+    On,
+    Out,
+}
+
+/// Sutherland–Hodgman: the part of `subject` inside the convex,
+/// counter-clockwise `clip`. `tol` is a length: points within it of a clip
+/// edge's line count as on it. Intersections are computed only between a
+/// point strictly inside and one strictly outside, so the division is by at
+/// least `2 tol` and the derivative stays bounded when edges coincide.
+pub fn clip<T: Scalar>(subject: &Polygon<T>, clip: &Polygon<T>, tol: f64) -> Polygon<T> {
+    let mut out = *subject;
+    let c = clip.points();
+    for i in 0..c.len() {
+        if out.len == 0 {
+            break;
+        }
+        let (a, b) = (c[i], c[(i + 1) % c.len()]);
+        out = clip_by_edge(&out, &a, &b, tol);
+    }
+    remove_duplicates(out, tol)
+}
+
+fn clip_by_edge<T: Scalar>(poly: &Polygon<T>, a: &Vec2<T>, b: &Vec2<T>, tol: f64) -> Polygon<T> {
+    let edge = sub2(b, a);
+    let length = edge[0].re().hypot(edge[1].re());
+    let mut out = Polygon::new();
+    if length <= 0.0 {
+        return *poly;
+    }
+    // Signed distance from the edge's line, > 0 on the inner (left) side.
+    let distance = |p: &Vec2<T>| cross2(&edge, &sub2(p, a)) * (1.0 / length);
+    let side = |d: f64| {
+        if d > tol {
+            Side::In
+        } else if d < -tol {
+            Side::Out
+        } else {
+            Side::On
+        }
+    };
+    let p = poly.points();
+    for j in 0..p.len() {
+        let (p0, p1) = (p[(j + p.len() - 1) % p.len()], p[j]);
+        let (d0, d1) = (distance(&p0), distance(&p1));
+        let (s0, s1) = (side(d0.re()), side(d1.re()));
+        let crossing = (s0 == Side::In && s1 == Side::Out) || (s0 == Side::Out && s1 == Side::In);
+        if crossing {
+            let t = d0 / (d0 - d1);
+            out.push([p0[0] + (p1[0] - p0[0]) * t, p0[1] + (p1[1] - p0[1]) * t]);
+        }
+        if s1 != Side::Out {
+            out.push(p1);
+        }
+    }
+    out
+}
+
+/// Drops vertices that coincide (within `tol`) with their predecessor.
+fn remove_duplicates<T: Scalar>(poly: Polygon<T>, tol: f64) -> Polygon<T> {
+    let mut out = Polygon::new();
+    for v in poly.points() {
+        let same = |w: &Vec2<T>| (v[0].re() - w[0].re()).hypot(v[1].re() - w[1].re()) <= tol;
+        if out.len > 0 && same(&out.vertices[out.len - 1]) {
+            continue;
+        }
+        out.push(*v);
+    }
+    while out.len > 1 {
+        let (first, last) = (out.vertices[0], out.vertices[out.len - 1]);
+        if (first[0].re() - last[0].re()).hypot(first[1].re() - last[1].re()) <= tol {
+            out.len -= 1;
+        } else {
+            break;
+        }
+    }
+    out
+}
+
+/// A triangle of the overlap's triangulation.
+#[derive(Debug, Clone, Copy)]
+pub struct Triangle<T> {
+    pub corners: [Vec2<T>; 3],
+}
+
+impl<T: Scalar> Triangle<T> {
+    pub fn area(&self) -> T {
+        let [a, b, c] = self.corners;
+        cross2(&sub2(&b, &a), &sub2(&c, &a)) * 0.5
+    }
+
+    /// `a + ξ (b − a) + η (c − a)`.
+    pub fn point(&self, xi: [f64; 2]) -> Vec2<T> {
+        let [a, b, c] = self.corners;
+        [
+            a[0] + (b[0] - a[0]) * xi[0] + (c[0] - a[0]) * xi[1],
+            a[1] + (b[1] - a[1]) * xi[0] + (c[1] - a[1]) * xi[1],
+        ]
+    }
+}
+
+/// Fan triangulation of a convex polygon about its vertex centroid: one
+/// triangle per edge, so every vertex enters smoothly (no vertex is special).
+pub fn triangulate<T: Scalar>(poly: &Polygon<T>) -> impl Iterator<Item = Triangle<T>> + '_ {
+    let c = poly.centroid();
+    let p = poly.points();
+    let n = if p.len() >= 3 { p.len() } else { 0 };
+    (0..n).map(move |i| Triangle {
+        corners: [c, p[i], p[(i + 1) % n]],
+    })
+}
+
+/// Facet shape functions at a parametric point in `T` (bilinear quad,
+/// linear triangle), so a dual-valued point carries its derivative.
+pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
+    let one = T::from_f64(1.0);
+    let zero = T::from_f64(0.0);
+    match facet {
+        FacetType::Quad4 => {
+            let mut n = [zero; MAX_FACET_NODES];
+            for (na, node) in n.iter_mut().zip(crate::fem::shape::QUAD4_REF_NODES) {
+                *na = (zeta[0] * node[0] + 1.0) * (zeta[1] * node[1] + 1.0) * 0.25;
+            }
+            n
+        }
+        FacetType::Tri3 => [one - zeta[0] - zeta[1], zeta[0], zeta[1], zero],
+    }
+}
+
+/// Parametric coordinates of the facet point whose projection is `p`, given
+/// the projected nodes `nodes`: Newton in f64 from the facet centre, then one
+/// more step in `T` from the converged point, whose derivative is the
+/// implicit-function derivative. `None` if Newton fails (folded projection).
+pub fn inverse_map<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
+    let nodes_f: [Vec2<f64>; MAX_FACET_NODES] = {
+        let mut out = [[0.0; 2]; MAX_FACET_NODES];
+        for (o, v) in out.iter_mut().zip(nodes) {
+            *o = [v[0].re(), v[1].re()];
+        }
+        out
+    };
+    let target = [p[0].re(), p[1].re()];
+    let mut zeta = crate::contact::projection::reference_centre(facet);
+    let scale = nodes_f[..facet.nodes()]
+        .iter()
+        .map(|v| v[0].abs().max(v[1].abs()))
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let mut converged = false;
+    for _ in 0..30 {
+        let step = newton_step(facet, &nodes_f, &target, [zeta[0], zeta[1]])?;
+        zeta = [zeta[0] + step[0], zeta[1] + step[1]];
+        if step[0].abs().max(step[1].abs()) < 1e-14 {
+            converged = true;
+            break;
+        }
+        if !(zeta[0].abs() < 10.0 && zeta[1].abs() < 10.0) {
+            return None;
+        }
+    }
+    if !converged {
+        // Accept a residual at rounding level (bilinear Newton stalls there).
+        let x = interpolate(facet, &nodes_f, &[zeta[0], zeta[1]]);
+        if (x[0] - target[0]).hypot(x[1] - target[1]) > 1e-12 * scale {
+            return None;
+        }
+    }
+    let zeta_t = [T::from_f64(zeta[0]), T::from_f64(zeta[1])];
+    let step = newton_step(facet, nodes, p, zeta_t)?;
+    Some([zeta_t[0] + step[0], zeta_t[1] + step[1]])
+}
+
+fn interpolate<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], zeta: &Vec2<T>) -> Vec2<T> {
+    let n = shape_values(facet, zeta);
+    let mut x = [T::from_f64(0.0); 2];
+    for (na, v) in n.iter().zip(nodes).take(facet.nodes()) {
+        x = [x[0] + *na * v[0], x[1] + *na * v[1]];
+    }
+    x
+}
+
+/// One Newton step `J⁻¹ (p − x(ζ))` of the planar map; `None` if singular.
+fn newton_step<T: Scalar>(
+    facet: FacetType,
+    nodes: &[Vec2<T>],
+    p: &Vec2<T>,
+    zeta: Vec2<T>,
+) -> Option<Vec2<T>> {
+    let x = interpolate(facet, nodes, &zeta);
+    let r = sub2(p, &x);
+    // Jacobian ∂x/∂ζ in T: the shape gradients are affine in ζ.
+    let dn = shape_gradients(facet, &zeta);
+    let mut j = [[T::from_f64(0.0); 2]; 2];
+    for (d, v) in dn.iter().zip(nodes).take(facet.nodes()) {
+        for row in 0..2 {
+            j[row][0] = j[row][0] + v[row] * d[0];
+            j[row][1] = j[row][1] + v[row] * d[1];
+        }
+    }
+    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    let size =
+        (j[0][0].re().abs() + j[1][1].re().abs() + j[0][1].re().abs() + j[1][0].re().abs()).powi(2);
+    if !(det.re().abs() > 1e-14 * size && size > 0.0) {
+        return None;
+    }
+    let inv = det.recip();
+    Some([
+        (j[1][1] * r[0] - j[0][1] * r[1]) * inv,
+        (j[0][0] * r[1] - j[1][0] * r[0]) * inv,
+    ])
+}
+
+/// `∂N_a/∂ζ` at a point in `T`.
+pub fn shape_gradients<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [[T; 2]; MAX_FACET_NODES] {
+    let zero = T::from_f64(0.0);
+    let mut dn = [[zero; 2]; MAX_FACET_NODES];
+    match facet {
+        FacetType::Quad4 => {
+            for (d, node) in dn.iter_mut().zip(crate::fem::shape::QUAD4_REF_NODES) {
+                *d = [
+                    (zeta[1] * node[1] + 1.0) * (0.25 * node[0]),
+                    (zeta[0] * node[0] + 1.0) * (0.25 * node[1]),
+                ];
+            }
+        }
+        FacetType::Tri3 => {
+            let (one, m) = (T::from_f64(1.0), T::from_f64(-1.0));
+            dn[0] = [m, m];
+            dn[1] = [one, zero];
+            dn[2] = [zero, one];
+        }
+    }
+    dn
+}
+
+/// The overlap of a slave and a master facet in the slave's auxiliary plane.
+#[derive(Debug, Clone, Copy)]
+pub struct Overlap<T> {
+    pub plane: Plane<T>,
+    /// Projected slave and master nodes (in-plane coordinates).
+    pub slave_nodes: [Vec2<T>; MAX_FACET_NODES],
+    pub master_nodes: [Vec2<T>; MAX_FACET_NODES],
+    /// The clipped polygon, counter-clockwise about the plane normal.
+    pub polygon: Polygon<T>,
+}
+
+/// A quadrature point of an overlap: its weight (area in the plane) and its
+/// parametric coordinates on both facets.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentPoint<T> {
+    pub weight: T,
+    pub zeta: Vec2<T>,
+    pub xi: Vec2<T>,
+}
+
+/// The size of a facet (largest node distance from its first node), what
+/// the geometric tolerance is scaled with.
+pub fn facet_size<T: Scalar>(x: &[Vec3<T>]) -> f64 {
+    x.iter()
+        .map(|p| dual::norm(&dual::sub(&dual::re3(p), &dual::re3(&x[0]))))
+        .fold(0.0, f64::max)
+}
+
+/// Projects and clips a slave and a master facet (current positions). `None`
+/// when they do not overlap (or the geometry is degenerate: a slave facet
+/// without normal, a master projected edge-on or folded).
+pub fn overlap<T: Scalar>(
+    slave_type: FacetType,
+    xs: &[Vec3<T>],
+    master_type: FacetType,
+    xm: &[Vec3<T>],
+) -> Option<Overlap<T>> {
+    let plane = Plane::of_facet(slave_type, xs)?;
+    let tol = GEOMETRY_TOL * facet_size(xs);
+    let mut slave_nodes = [[T::from_f64(0.0); 2]; MAX_FACET_NODES];
+    let mut master_nodes = slave_nodes;
+    for (o, x) in slave_nodes.iter_mut().zip(xs).take(slave_type.nodes()) {
+        *o = plane.coordinates(x);
+    }
+    for (o, x) in master_nodes.iter_mut().zip(xm).take(master_type.nodes()) {
+        *o = plane.coordinates(x);
+    }
+    let subject = Polygon::from_points(&slave_nodes[..slave_type.nodes()]).counter_clockwise();
+    let clipper = Polygon::from_points(&master_nodes[..master_type.nodes()]).counter_clockwise();
+    let area_tol = tol * facet_size(xs);
+    if !clipper.is_convex_ccw(area_tol) || clipper.signed_area().re() <= area_tol {
+        return None;
+    }
+    let polygon = clip(&subject, &clipper, tol);
+    if polygon.len < 3 || polygon.signed_area().re() <= area_tol {
+        return None;
+    }
+    Some(Overlap {
+        plane,
+        slave_nodes,
+        master_nodes,
+        polygon,
+    })
+}
+
+impl<T: Scalar> Overlap<T> {
+    /// Quadrature points on the overlap's triangles with the triangle rule
+    /// `rule` (reference triangle, weights summing to ½), mapped back to both
+    /// facets; `f` is called once per point. Returns false if a point could
+    /// not be mapped back (then the overlap should be dropped).
+    pub fn for_each_point(
+        &self,
+        slave_type: FacetType,
+        master_type: FacetType,
+        rule: &[([f64; 2], f64)],
+        mut f: impl FnMut(&SegmentPoint<T>),
+    ) -> bool {
+        for tri in triangulate(&self.polygon) {
+            let area = tri.area();
+            for (xi_ref, w) in rule {
+                let p = tri.point(*xi_ref);
+                let zeta = inverse_map(slave_type, &self.slave_nodes, &p);
+                let xi = inverse_map(master_type, &self.master_nodes, &p);
+                let (Some(zeta), Some(xi)) = (zeta, xi) else {
+                    return false;
+                };
+                f(&SegmentPoint {
+                    weight: area * (2.0 * w),
+                    zeta,
+                    xi,
+                });
+            }
+        }
+        true
+    }
+}

@@ -1,0 +1,18 @@
+//! Mortar contact: multipliers at the slave nodes with dual (biorthogonal)
+//! shape functions, integrated segment by segment over the slave–master
+//! overlaps.
+//!
+//! - `geometry`: auxiliary plane, projection, polygon clipping,
+//!   triangulation, quadrature points mapped back to both facets;
+//! - `segment`: dual basis of a slave facet and the integrals of one segment
+//!   (weighted gap, mortar matrices `D` and `M`);
+//! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//! - `system`: nodal weighted gaps and pressures, residual and consistent
+//!   tangent of a set of segments.
+pub mod geometry;
+pub mod pair;
+pub mod segment;
+pub mod system;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,506 @@
+//! A mortar contact pair at run time: candidate segments per load step,
+//! residual and tangent contributions, the nodal Uzawa update.
+//!
+//! Parallel layout. Both sides' nodes are ghosted on every rank (the slave
+//! set joins the master halo). A rank assembles the segments of the slave
+//! facets whose cell it owns, and evaluates in addition every slave facet
+//! that shares a node with one of those, so the weighted gap `g̃_j` of each
+//! node of its own facets is complete. Segments are integrated in a fixed
+//! order (slave facet, then master facet, by set index) from the same ghosted
+//! positions, so every rank that sees node `j` computes the same `g̃_j` and
+//! the same update of `λ_j` bit for bit; the owner of the node is the one
+//! that counts it in the Uzawa statistics and writes it out.
+use super::segment::MortarRules;
+use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use crate::contact::dual::Dual;
+use crate::contact::links::{PairForce, UzawaStats};
+use crate::contact::pair::PairSpec;
+use crate::contact::surfaces::MasterSurface;
+use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::error::{Error, Result};
+use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
+use crate::mesh::Mesh;
+use crate::petsc::{BlockSink, PatternBuilder, PetscInt};
+
+/// The nodal fields the output writes, one entry per owned mesh node of
+/// this rank (zero at nodes off the slave surface).
+#[derive(Debug, Clone, Default)]
+pub struct NodeFields {
+    /// The multipliers λ_j (contact pressure).
+    pub lambda: Vec<f64>,
+    /// Weighted gaps g̃_j = ∫ Φ_j g dA.
+    pub weighted_gap: Vec<f64>,
+    /// Contact traction on the slave at the node: −λ_j ν_j, ν_j the
+    /// D-weighted mean of its segments' normals.
+    pub traction: Vec<[f64; 3]>,
+}
+
+pub struct MortarPair {
+    facet_type: FacetType,
+    /// Slave nodes are ids `0..n`, master nodes follow (n = slave nodes).
+    node_local: Vec<u32>,
+    x_ref: Vec<[f64; 3]>,
+    slave_facets: Vec<[u32; MAX_FACET_NODES]>,
+    master_facets: Vec<[u32; MAX_FACET_NODES]>,
+    assembled: Vec<bool>,
+    /// Slave facets this rank evaluates (ascending).
+    evaluated: Vec<u32>,
+    pub nodal: NodalData,
+    /// Per slot: all of the node's facets are evaluated here ...
+    complete: Vec<bool>,
+    /// ... and this rank owns the node.
+    owned: Vec<bool>,
+    /// Per slot: the node's element size (mean shortest edge of its facets).
+    h: Vec<f64>,
+    candidates: Vec<(u32, u32)>,
+    search_distance: f64,
+    rules: MortarRules,
+    /// Owned mesh nodes of this rank (the length of the output fields).
+    owned_mesh_nodes: usize,
+}
+
+fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
+    let mut row = [0; MAX_FACET_NODES];
+    row[..nodes.len()].copy_from_slice(nodes);
+    row
+}
+
+/// Shortest edge of a facet.
+fn shortest_edge(x: &[[f64; 3]]) -> f64 {
+    (0..x.len())
+        .map(|i| {
+            crate::contact::dual::norm(&crate::contact::dual::sub(&x[i], &x[(i + 1) % x.len()]))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+impl MortarPair {
+    /// `penalty(h)`: the pair's εN for a node of element size `h`.
+    pub fn new(
+        mesh: &Mesh,
+        dofs: &DofMap,
+        spec: &PairSpec,
+        master_set: &str,
+        penalty: impl Fn(f64) -> f64,
+        search_distance: f64,
+    ) -> Result<Self> {
+        let facet_type = mesh.cell_type.facet_type();
+        let slave = MasterSurface::new(mesh, dofs, &spec.slave)?;
+        let master = MasterSurface::new(mesh, dofs, master_set)?;
+        let n_slave = slave.x_ref.len();
+        let offset = n_slave as u32;
+        let nf = facet_type.nodes();
+        let slave_facets: Vec<_> = slave.facets.iter().map(|f| facet_row(&f[..nf])).collect();
+        let master_facets: Vec<_> = master
+            .facets
+            .iter()
+            .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
+            .collect();
+        let mut local_cell = vec![false; mesh.num_cells()];
+        for &c in &dofs.local_cells {
+            local_cell[c] = true;
+        }
+        let refs = mesh
+            .facet_sets
+            .get(&spec.slave)
+            .map(Vec::as_slice)
+            .unwrap_or(&[]);
+        let assembled: Vec<bool> = refs.iter().map(|f| local_cell[f.cell]).collect();
+        let mut mine = vec![false; n_slave];
+        for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
+            for &n in &f[..nf] {
+                mine[n as usize] = true;
+            }
+        }
+        let evaluated: Vec<u32> = (0..slave_facets.len() as u32)
+            .filter(|&f| {
+                slave_facets[f as usize][..nf]
+                    .iter()
+                    .any(|&n| mine[n as usize])
+            })
+            .collect();
+        // Nodal reference areas ∫ N_j dA₀ and element sizes.
+        let rule = QuadRule::default_for_facet(facet_type);
+        let (mut area, mut h_sum, mut h_count) = (
+            vec![0.0; n_slave],
+            vec![0.0; n_slave],
+            vec![0usize; n_slave],
+        );
+        let mut in_evaluated = vec![false; n_slave];
+        for &f in &evaluated {
+            let nodes = &slave_facets[f as usize][..nf];
+            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| slave.x_ref[n as usize]).collect();
+            let weights = crate::contact::link::reference_weights(facet_type, &x, &rule);
+            let h = shortest_edge(&x);
+            for (zeta, w) in weights {
+                let s = facet_shape(facet_type, zeta);
+                for (a, &n) in nodes.iter().enumerate() {
+                    area[n as usize] += s.n[a] * w;
+                }
+            }
+            for &n in nodes {
+                h_sum[n as usize] += h;
+                h_count[n as usize] += 1;
+                in_evaluated[n as usize] = true;
+            }
+        }
+        let slots: Vec<u32> = (0..n_slave as u32)
+            .filter(|&n| in_evaluated[n as usize])
+            .collect();
+        let h: Vec<f64> = slots
+            .iter()
+            .map(|&n| h_sum[n as usize] / h_count[n as usize] as f64)
+            .collect();
+        let complete = slots.iter().map(|&n| mine[n as usize]).collect();
+        let owned = slots
+            .iter()
+            .map(|&n| {
+                mine[n as usize] && dofs.is_owned(LocalNode(slave.node_local[n as usize] as usize))
+            })
+            .collect();
+        let nodal = NodalData::new(
+            slots.clone(),
+            vec![0.0; slots.len()],
+            h.iter().map(|&h| penalty(h)).collect(),
+            slots.iter().map(|&n| area[n as usize]).collect(),
+        );
+        if let Some(bad) = nodal.area.iter().position(|a| a.is_nan() || *a <= 0.0) {
+            return Err(Error::scene(
+                "contact",
+                format!(
+                    "pair '{}': slave node {} has no contact area",
+                    spec.name, slots[bad]
+                ),
+            ));
+        }
+        let mut node_local = slave.node_local;
+        node_local.extend(&master.node_local);
+        let mut x_ref = slave.x_ref;
+        x_ref.extend(&master.x_ref);
+        Ok(MortarPair {
+            facet_type,
+            node_local,
+            x_ref,
+            slave_facets,
+            master_facets,
+            assembled,
+            evaluated,
+            nodal,
+            complete,
+            owned,
+            h,
+            candidates: Vec::new(),
+            search_distance,
+            rules: MortarRules::default(),
+            owned_mesh_nodes: dofs.num_owned_nodes(),
+        })
+    }
+
+    fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
+        self.node_local
+            .iter()
+            .zip(&self.x_ref)
+            .map(|(&l, x)| {
+                let b = DIM * l as usize;
+                [
+                    x[0] + u_local[b],
+                    x[1] + u_local[b + 1],
+                    x[2] + u_local[b + 2],
+                ]
+            })
+            .collect()
+    }
+
+    fn interface<'a>(&'a self, positions: &'a [[f64; 3]]) -> Interface<'a> {
+        Interface {
+            slave_type: self.facet_type,
+            master_type: self.facet_type,
+            positions,
+            reference: &self.x_ref,
+            slave_facets: &self.slave_facets,
+            master_facets: &self.master_facets,
+            candidates: &self.candidates,
+            assembled: &self.assembled,
+        }
+    }
+
+    /// The search of a load step: every (evaluated slave, master) facet pair
+    /// whose bounding boxes, grown by the search distance, meet. Returns
+    /// whether the candidates changed.
+    pub fn search(&mut self, u_local: &[f64]) -> bool {
+        let x = self.positions(u_local);
+        let nf = self.facet_type.nodes();
+        let bbox = |f: &[u32; MAX_FACET_NODES]| {
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for &n in &f[..nf] {
+                for c in 0..3 {
+                    lo[c] = lo[c].min(x[n as usize][c]);
+                    hi[c] = hi[c].max(x[n as usize][c]);
+                }
+            }
+            (lo, hi)
+        };
+        let masters: Vec<_> = self.master_facets.iter().map(bbox).collect();
+        // Masters sorted by their lower x bound: a sweep finds each slave's.
+        let mut order: Vec<u32> = (0..masters.len() as u32).collect();
+        order.sort_by(|a, b| masters[*a as usize].0[0].total_cmp(&masters[*b as usize].0[0]));
+        let d = self.search_distance;
+        let mut candidates = Vec::new();
+        for &s in &self.evaluated {
+            let (lo, hi) = bbox(&self.slave_facets[s as usize]);
+            let end = order.partition_point(|&m| masters[m as usize].0[0] <= hi[0] + d);
+            let mut found: Vec<u32> = order[..end]
+                .iter()
+                .copied()
+                .filter(|&m| {
+                    let (mlo, mhi) = masters[m as usize];
+                    (0..3).all(|c| mlo[c] <= hi[c] + d && mhi[c] >= lo[c] - d)
+                })
+                .collect();
+            found.sort_unstable();
+            candidates.extend(found.into_iter().map(|m| (s, m)));
+        }
+        let changed = candidates != self.candidates;
+        self.candidates = candidates;
+        changed
+    }
+
+    fn local_dof(&self, id: u32, c: usize) -> usize {
+        DIM * self.node_local[id as usize] as usize + c
+    }
+
+    fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> PetscInt {
+        dofs.dof(LocalNode(self.node_local[id as usize] as usize), c)
+            .0
+    }
+
+    /// For each node of an assembled facet: the DOFs its tangent may couple
+    /// (all nodes of its candidate segments), squared into the pattern.
+    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut PatternBuilder) -> Result<()> {
+        let nf = self.facet_type.nodes();
+        let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
+        for &(s, m) in &self.candidates {
+            let ids = self.slave_facets[s as usize][..nf]
+                .iter()
+                .chain(&self.master_facets[m as usize][..nf]);
+            let ids: Vec<u32> = ids.copied().collect();
+            for &n in &self.slave_facets[s as usize][..nf] {
+                if let Some(j) = self.nodal.slot_of(n) {
+                    support[j].extend(&ids);
+                }
+            }
+        }
+        let mut d: Vec<PetscInt> = Vec::new();
+        for (j, mut nodes) in support.into_iter().enumerate() {
+            if !self.complete[j] || nodes.is_empty() {
+                continue;
+            }
+            nodes.sort_unstable();
+            nodes.dedup();
+            d.clear();
+            for n in nodes {
+                d.extend((0..DIM).map(|c| self.global_dof(dofs, n, c)));
+            }
+            pattern.add_square(&d)?;
+        }
+        Ok(())
+    }
+
+    fn evaluate<T: system::Seed>(&self, x: &[[f64; 3]]) -> (Vec<Segment<T>>, Vec<NodeState>) {
+        let interface = self.interface(x);
+        let segments = system::segments::<T>(&interface, &self.rules);
+        let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
+        let states = system::node_states(&self.nodal, &gap, &covered);
+        (segments, states)
+    }
+
+    pub fn add_residual(&self, u_local: &[f64], r_local: &mut [f64]) {
+        let x = self.positions(u_local);
+        let (segments, states) = self.evaluate::<f64>(&x);
+        system::residual(
+            &self.interface(&x),
+            &self.nodal,
+            &segments,
+            &states,
+            |n, c, v| {
+                r_local[self.local_dof(n, c)] += v;
+            },
+        );
+    }
+
+    pub fn add_tangent(&self, dofs: &DofMap, u_local: &[f64], k: &mut dyn BlockSink) -> Result<()> {
+        let x = self.positions(u_local);
+        let (segments, states) = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x);
+        let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
+        system::tangent(
+            &self.interface(&x),
+            &self.nodal,
+            &segments,
+            &states,
+            |r, c, v| {
+                entries.push((r, c, v));
+            },
+        );
+        entries.sort_by_key(|e| (e.0, e.1));
+        let (mut cols, mut vals): (Vec<PetscInt>, Vec<f64>) = (Vec::new(), Vec::new());
+        let mut i = 0;
+        while i < entries.len() {
+            let row = entries[i].0;
+            cols.clear();
+            vals.clear();
+            while i < entries.len() && entries[i].0 == row {
+                let (col, v) = (entries[i].1, entries[i].2);
+                let g = self.global_dof(dofs, col.0, col.1);
+                if cols.last() == Some(&g) {
+                    *vals.last_mut().unwrap_or(&mut 0.0) += v;
+                } else {
+                    cols.push(g);
+                    vals.push(v);
+                }
+                i += 1;
+            }
+            k.add_block(&[self.global_dof(dofs, row.0, row.1)], &cols, &vals)?;
+        }
+        Ok(())
+    }
+
+    /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ at every node whose weighted gap is complete on
+    /// this rank; statistics over the nodes this rank owns.
+    pub fn uzawa_update(&mut self, u_local: &[f64]) -> UzawaStats {
+        let x = self.positions(u_local);
+        let (_, states) = self.evaluate::<f64>(&x);
+        let mut stats = UzawaStats::default();
+        for (j, s) in states.iter().enumerate() {
+            if !self.complete[j] {
+                continue;
+            }
+            let old = self.nodal.lambda[j];
+            self.nodal.lambda[j] = s.pressure;
+            if !self.owned[j] {
+                continue;
+            }
+            let area = self.nodal.area[j];
+            if s.pressure > 0.0 || s.closed {
+                stats.max_penetration = stats
+                    .max_penetration
+                    .max(-s.weighted_gap / area / self.h[j]);
+            }
+            if s.pressure > 0.0 {
+                stats.active += 1;
+            }
+            stats.max_multiplier = stats.max_multiplier.max(s.pressure);
+            stats.max_change = stats.max_change.max((s.pressure - old).abs() * area);
+            stats.max_force = stats.max_force.max(s.pressure * area);
+        }
+        stats
+    }
+
+    pub fn snapshot(&self) -> Vec<f64> {
+        self.nodal.lambda.clone()
+    }
+
+    pub fn restore(&mut self, lambda: Vec<f64>) {
+        if lambda.len() == self.nodal.lambda.len() {
+            self.nodal.lambda = lambda;
+        }
+    }
+
+    pub fn raise_penalty(&mut self, factor: f64) {
+        self.nodal.penalty.iter_mut().for_each(|p| *p *= factor);
+    }
+
+    /// Owned nodes in contact.
+    pub fn active_nodes(&self) -> usize {
+        (0..self.owned.len())
+            .filter(|&j| self.owned[j] && self.nodal.lambda[j] > 0.0)
+            .count()
+    }
+
+    /// Owned slave nodes: reference position and λ_j.
+    pub fn node_values(&self) -> Vec<([f64; 3], f64)> {
+        (0..self.owned.len())
+            .filter(|&j| self.owned[j])
+            .map(|j| {
+                (
+                    self.x_ref[self.nodal.nodes[j] as usize],
+                    self.nodal.lambda[j],
+                )
+            })
+            .collect()
+    }
+
+    /// Nodal output of the owned nodes and this rank's part of the pair's
+    /// force on the slave, `Σ_j λ_j D_jk ν` summed over `k` (`D` of the
+    /// current segments, so the force is the one the residual applied).
+    pub fn output(&self, u_local: &[f64]) -> (NodeFields, PairForce) {
+        let x = self.positions(u_local);
+        let (segments, states) = self.evaluate::<f64>(&x);
+        let nf = self.facet_type.nodes();
+        let mut normal_sum = vec![[0.0; 3]; self.nodal.nodes.len()];
+        let mut force = PairForce::default();
+        for seg in segments.iter().filter(|s| self.assembled[s.slave as usize]) {
+            for (a, &n) in self.slave_facets[seg.slave as usize][..nf]
+                .iter()
+                .enumerate()
+            {
+                let Some(j) = self.nodal.slot_of(n) else {
+                    continue;
+                };
+                let d: f64 = seg.terms.d[a][..nf].iter().sum();
+                let lambda = self.nodal.lambda[j];
+                for ((sum, f), nc) in normal_sum[j]
+                    .iter_mut()
+                    .zip(force.force.iter_mut())
+                    .zip(seg.terms.normal)
+                {
+                    *sum += d * nc;
+                    *f -= lambda * d * nc;
+                }
+                force.normal += lambda * d;
+            }
+        }
+        let n = self.owned_mesh_nodes;
+        let mut out = NodeFields {
+            lambda: vec![0.0; n],
+            weighted_gap: vec![0.0; n],
+            traction: vec![[0.0; 3]; n],
+        };
+        for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
+            let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
+            if l >= n {
+                continue;
+            }
+            out.lambda[l] = self.nodal.lambda[j];
+            out.weighted_gap[l] = states[j].weighted_gap;
+            let len = crate::contact::dual::norm(&normal_sum[j]);
+            if len > 0.0 {
+                out.traction[l] = normal_sum[j].map(|c| -self.nodal.lambda[j] * c / len);
+            }
+        }
+        (out, force)
+    }
+
+    /// Adds λ_j of every owned node into the nodal contact-pressure field
+    /// (indexed by owned local node; the denominator counts the pairs).
+    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) {
+        for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
+            let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
+            if let (Some(n), Some(d)) = (numerator.get_mut(l), denominator.get_mut(l)) {
+                *n += self.nodal.lambda[j];
+                *d += 1.0;
+            }
+        }
+    }
+
+    /// λ_j by the slave node's local index, for the nodes this rank holds
+    /// (the point output interpolates them with the standard shape functions).
+    pub fn lambda_by_local_node(&self) -> std::collections::HashMap<u32, f64> {
+        self.nodal
+            .nodes
+            .iter()
+            .zip(&self.nodal.lambda)
+            .map(|(&id, &l)| (self.node_local[id as usize], l))
+            .collect()
+    }
+}

@@ -1,0 +1,296 @@
+//! Dual shape functions on a slave facet and the mortar integrals of one
+//! slave–master segment.
+//!
+//! Dual (biorthogonal) shape functions `Φ_j = Σ_k A_jk N_k` satisfy
+//! `∫ Φ_j N_k dA = δ_jk ∫ N_k dA` over the slave facet, which gives
+//! `A = D M⁻¹` with `D = diag(∫ N_j dA)` and `M_jk = ∫ N_j N_k dA`, computed
+//! per facet from its CURRENT geometry (so `A` depends on the slave nodes and
+//! its derivative enters the tangent). Since `M·1 = diag(D)`, `Σ_j Φ_j = 1`:
+//! a uniform multiplier field is represented exactly.
+//!
+//! On a segment (the overlap of the slave facet with one master facet in the
+//! slave's auxiliary plane) the kernel integrates
+//! - the weighted gap `g̃_j = ∫ Φ_j g dA` with `g = ν·(x² − x¹)`, `ν` the
+//!   auxiliary plane's normal (outward of the slave), `> 0` apart;
+//! - the mortar matrices `D_jk = ∫ Φ_j N¹_k dA` and `M_jl = ∫ Φ_j N²_l dA`,
+//!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
+//!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
+//!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
+use super::geometry::{overlap, shape_gradients, shape_values};
+use crate::contact::dual::{self, Scalar, Vec3};
+use crate::fem::shape::facet_shape;
+use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+
+/// A quadrature rule as (point, weight) pairs.
+pub type Rule = Vec<([f64; 2], f64)>;
+
+/// The rules the mortar kernels integrate with: on the whole slave facet (for
+/// `D` and `M` of the dual basis) and on the triangles of a segment.
+#[derive(Debug, Clone)]
+pub struct MortarRules {
+    pub quad_facet: Rule,
+    pub tri_facet: Rule,
+    pub triangle: Rule,
+}
+
+fn pairs(rule: &QuadRule) -> Rule {
+    rule.points
+        .iter()
+        .zip(&rule.weights)
+        .map(|(p, w)| ([p[0], p[1]], *w))
+        .collect()
+}
+
+/// Collapsed (Duffy) `n × n` Gauss rule on the reference triangle, exact to
+/// total degree `2n − 2` (the collapse adds a factor `1 − u`); weights sum
+/// to ½.
+fn collapsed_gauss(n: usize) -> Rule {
+    let line = QuadRule::quad_gauss(n).unwrap_or_else(|_| QuadRule::quad_4x4());
+    let m = (line.len() as f64).sqrt().round() as usize;
+    // The tensor rule's first m points run along ξ at the first η, with
+    // weights w_i w_0: they give the 1D rule.
+    let w0 = line.weights[0].sqrt();
+    let points: Vec<(f64, f64)> = (0..m)
+        .map(|i| (line.points[i][0], line.weights[i] / w0))
+        .collect();
+    let w1: f64 = points.iter().map(|p| p.1).sum();
+    let mut rule = Rule::new();
+    for &(a, wa) in &points {
+        for &(b, wb) in &points {
+            let u = 0.5 * (1.0 + a);
+            let v = 0.5 * (1.0 + b);
+            // (u, v) ∈ [0,1]² → (u, v (1 − u)), Jacobian (1 − u).
+            let w = (wa / w1) * (wb / w1) * (1.0 - u);
+            rule.push(([u, v * (1.0 - u)], w));
+        }
+    }
+    rule
+}
+
+impl Default for MortarRules {
+    /// 3×3 Gauss on quads (exact for `N_j N_k J`, biquadratic × bilinear),
+    /// the degree-4 six-point rule on tri facets. On segment triangles the
+    /// integrands `N(ζ(p))` are not polynomial where a quad facet is not a
+    /// parallelogram (the inverse bilinear map): a collapsed 4×4 Gauss rule
+    /// (degree 6) keeps their error below the patch test's 1e-6 on a
+    /// 30 %-distorted mesh, where the six-point rule left 7e-7.
+    fn default() -> Self {
+        MortarRules {
+            quad_facet: pairs(&QuadRule::quad_3x3()),
+            tri_facet: pairs(&QuadRule::tri_6()),
+            triangle: collapsed_gauss(4),
+        }
+    }
+}
+
+impl MortarRules {
+    pub fn facet(&self, facet: FacetType) -> &Rule {
+        match facet {
+            FacetType::Quad4 => &self.quad_facet,
+            FacetType::Tri3 => &self.tri_facet,
+        }
+    }
+}
+
+/// Dual-basis coefficients `A` (row `j` gives `Φ_j`) of a slave facet at its
+/// current positions `x`. `None` for a degenerate facet.
+pub fn dual_coefficients<T: Scalar>(
+    facet: FacetType,
+    x: &[Vec3<T>],
+    rules: &MortarRules,
+) -> Option<[[T; MAX_FACET_NODES]; MAX_FACET_NODES]> {
+    let n = facet.nodes();
+    let zero = T::from_f64(0.0);
+    let mut m = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    let mut d = [zero; MAX_FACET_NODES];
+    for (zeta, w) in rules.facet(facet) {
+        let s = facet_shape(facet, *zeta);
+        let (mut t1, mut t2) = (
+            dual::constant3::<T>([0.0; 3]),
+            dual::constant3::<T>([0.0; 3]),
+        );
+        for (a, xa) in x.iter().enumerate().take(n) {
+            t1 = dual::axpy(&t1, s.dn[a][0], xa);
+            t2 = dual::axpy(&t2, s.dn[a][1], xa);
+        }
+        let jw = dual::norm(&dual::cross(&t1, &t2)) * *w;
+        for ((dj, mj), nj) in d.iter_mut().zip(m.iter_mut()).zip(&s.n).take(n) {
+            *dj = *dj + jw * *nj;
+            for (mjk, nk) in mj.iter_mut().zip(&s.n).take(n) {
+                *mjk = *mjk + jw * (nj * nk);
+            }
+        }
+    }
+    let inv = invert(m, n)?;
+    let mut a = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    for j in 0..n {
+        for k in 0..n {
+            a[j][k] = d[j] * inv[j][k];
+        }
+    }
+    Some(a)
+}
+
+/// Gauss–Jordan inverse of the leading `n × n` block with partial pivoting
+/// (pivots chosen on the f64 values); `None` if singular.
+fn invert<T: Scalar>(
+    mut m: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    n: usize,
+) -> Option<[[T; MAX_FACET_NODES]; MAX_FACET_NODES]> {
+    let zero = T::from_f64(0.0);
+    let mut inv = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
+    for (i, row) in inv.iter_mut().enumerate().take(n) {
+        row[i] = T::from_f64(1.0);
+    }
+    let size = (0..n).map(|i| m[i][i].re().abs()).fold(0.0, f64::max);
+    for col in 0..n {
+        let pivot =
+            (col..n).max_by(|&a, &b| m[a][col].re().abs().total_cmp(&m[b][col].re().abs()))?;
+        let magnitude = m[pivot][col].re().abs();
+        if magnitude.is_nan() || magnitude <= 1e-13 * size {
+            return None;
+        }
+        m.swap(col, pivot);
+        inv.swap(col, pivot);
+        let p = m[col][col].recip();
+        for k in 0..n {
+            m[col][k] = m[col][k] * p;
+            inv[col][k] = inv[col][k] * p;
+        }
+        for row in 0..n {
+            if row == col {
+                continue;
+            }
+            let f = m[row][col];
+            for k in 0..n {
+                m[row][k] = m[row][k] - f * m[col][k];
+                inv[row][k] = inv[row][k] - f * inv[col][k];
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// `Φ_j(ζ)` from the coefficients and the standard shape values.
+pub fn dual_values<T: Scalar>(
+    a: &[[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    n: &[T; MAX_FACET_NODES],
+    nodes: usize,
+) -> [T; MAX_FACET_NODES] {
+    let mut phi = [T::from_f64(0.0); MAX_FACET_NODES];
+    for j in 0..nodes {
+        for k in 0..nodes {
+            phi[j] = phi[j] + a[j][k] * n[k];
+        }
+    }
+    phi
+}
+
+/// The mortar integrals of one segment (rows `j`: slave facet nodes).
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentTerms<T> {
+    /// `∫ Φ_j g dA`.
+    pub weighted_gap: [T; MAX_FACET_NODES],
+    /// `D_jk = ∫ Φ_j N¹_k dA`.
+    pub d: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    /// `M_jl = ∫ Φ_j N²_l dA`.
+    pub m: [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    /// The auxiliary plane's unit normal (outward of the slave).
+    pub normal: Vec3<T>,
+    /// The segment's reference area (on the slave).
+    pub area: T,
+}
+
+fn point_on<T: Scalar>(n: &[T; MAX_FACET_NODES], x: &[Vec3<T>], nodes: usize) -> Vec3<T> {
+    let mut p = dual::constant3::<T>([0.0; 3]);
+    for (na, xa) in n.iter().zip(x).take(nodes) {
+        p = dual::add(&p, &dual::scale(xa, *na));
+    }
+    p
+}
+
+/// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.
+fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T; 2]) -> T {
+    let dn = shape_gradients(facet, zeta);
+    let zero = dual::constant3::<T>([0.0; 3]);
+    let (mut t1, mut t2) = (zero, zero);
+    for (d, x) in dn.iter().zip(x_ref).take(facet.nodes()) {
+        let x = dual::constant3::<T>(*x);
+        t1 = dual::add(&t1, &dual::scale(&x, d[0]));
+        t2 = dual::add(&t2, &dual::scale(&x, d[1]));
+    }
+    dual::norm(&dual::cross(&t1, &t2))
+}
+
+/// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane.
+fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: &[T; 2]) -> T {
+    let dn = shape_gradients(facet, zeta);
+    let mut j = [[T::from_f64(0.0); 2]; 2];
+    for (d, p) in dn.iter().zip(nodes).take(facet.nodes()) {
+        for (row, pr) in j.iter_mut().zip(p) {
+            row[0] = row[0] + *pr * d[0];
+            row[1] = row[1] + *pr * d[1];
+        }
+    }
+    j[0][0] * j[1][1] - j[0][1] * j[1][0]
+}
+
+/// The integrals of the segment between slave facet `xs` (reference
+/// positions `x_ref`, dual coefficients `a`) and master facet `xm`; `None`
+/// when they do not overlap.
+///
+/// The integrals are over the REFERENCE slave surface: a point's area in the
+/// auxiliary plane is scaled by `J₀(ζ) / |det ∂P/∂ζ|`, the reference
+/// facet's area element over the projected one. The multipliers are then
+/// nominal pressures (force per reference area, as the links'), the
+/// traction a body load applies is matched node by node, and `A` is that of
+/// the reference facet.
+pub fn segment_terms<T: Scalar>(
+    slave_type: FacetType,
+    xs: &[Vec3<T>],
+    x_ref: &[[f64; 3]],
+    master_type: FacetType,
+    xm: &[Vec3<T>],
+    a: &[[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+    rules: &MortarRules,
+) -> Option<SegmentTerms<T>> {
+    let ov = overlap(slave_type, xs, master_type, xm)?;
+    let (ns, nm) = (slave_type.nodes(), master_type.nodes());
+    let zero = T::from_f64(0.0);
+    let mut terms = SegmentTerms {
+        weighted_gap: [zero; MAX_FACET_NODES],
+        d: [[zero; MAX_FACET_NODES]; MAX_FACET_NODES],
+        m: [[zero; MAX_FACET_NODES]; MAX_FACET_NODES],
+        normal: ov.plane.normal,
+        area: zero,
+    };
+    let normal = ov.plane.normal;
+    let slave_nodes = ov.slave_nodes;
+    let mapped = ov.for_each_point(slave_type, master_type, &rules.triangle, |q| {
+        let projected = plane_jacobian(slave_type, &slave_nodes, &q.zeta);
+        let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
+        // The projected facet is counter-clockwise or clockwise depending on
+        // its node order; the area element is the absolute value.
+        let scale = if projected.re() < 0.0 { -scale } else { scale };
+        let weight = q.weight * scale;
+        let n1 = shape_values(slave_type, &q.zeta);
+        let n2 = shape_values(master_type, &q.xi);
+        let phi = dual_values(a, &n1, ns);
+        let gap = dual::dot(
+            &normal,
+            &dual::sub(&point_on(&n2, xm, nm), &point_on(&n1, xs, ns)),
+        );
+        terms.area = terms.area + weight;
+        for (j, phi_j) in phi.iter().enumerate().take(ns) {
+            let pw = *phi_j * weight;
+            terms.weighted_gap[j] = terms.weighted_gap[j] + pw * gap;
+            for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
+                *djk = *djk + pw * *nk;
+            }
+            for (mjl, nl) in terms.m[j].iter_mut().zip(&n2).take(nm) {
+                *mjl = *mjl + pw * *nl;
+            }
+        }
+    });
+    mapped.then_some(terms)
+}

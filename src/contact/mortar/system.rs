@@ -1,0 +1,387 @@
+//! Nodal assembly of the mortar normal contact: weighted gaps, nodal
+//! pressures, residual and consistent tangent of a set of segments.
+//!
+//! Sign and scaling. Each slave node `j` carries a nominal pressure `λ_j`
+//! (force per reference area: the integrals are over the reference slave
+//! surface, see `segment_terms`). With `A_j = ∫ N_j dA₀` its reference nodal
+//! area, `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
+//! converged Newton solution is `p_j = ⟨λ_j − ε_j ḡ_j⟩` (the links' own rule,
+//! [`updated_multiplier`]). The residual, added to `R = f_int − f_ext`, is
+//! the mortar force `r = −Σ_j p_j c_j` with `c_j = ∂g̃_j/∂x` at fixed `D`,
+//! `M` and `ν`: `+p_j D_jk ν` on slave node `k`, `−p_j M_jl ν` on master node
+//! `l` (for a uniform `p` these are the exact consistent nodal forces on
+//! both sides, hence the patch test). Its tangent, exact for this residual,
+//! is `Σ_j p_j ∂c_j/∂x + c_j ⊗ ∂p_j/∂x` with `∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x`
+//! on a closed node, `∂g̃_j/∂x` including the move of the auxiliary plane, of
+//! the clipped polygon and of the dual basis. It couples every DOF of every
+//! segment of node `j` with every other: see [`node_supports`].
+use super::segment::{dual_coefficients, segment_terms, MortarRules, SegmentTerms};
+use crate::contact::dual::{Dual, Scalar, Vec3};
+use crate::contact::multipliers::updated_multiplier;
+use crate::fem::{FacetType, MAX_FACET_NODES};
+
+/// Variables of one segment: slave nodes at `3a + i`, master nodes at
+/// `12 + 3b + i` (fixed slots, whatever the facet types).
+pub const SEGMENT_DOFS: usize = 6 * MAX_FACET_NODES;
+const MASTER_OFFSET: usize = 3 * MAX_FACET_NODES;
+type D = Dual<SEGMENT_DOFS>;
+
+/// A node DOF: (node id, component).
+pub type NodeDof = (u32, usize);
+
+/// The geometry of a mortar interface as node ids into `positions`.
+#[derive(Debug, Clone, Copy)]
+pub struct Interface<'a> {
+    pub slave_type: FacetType,
+    pub master_type: FacetType,
+    /// Current position of every node id used below.
+    pub positions: &'a [[f64; 3]],
+    /// Reference position of every node id (slave nodes are used).
+    pub reference: &'a [[f64; 3]],
+    pub slave_facets: &'a [[u32; MAX_FACET_NODES]],
+    pub master_facets: &'a [[u32; MAX_FACET_NODES]],
+    /// Slave–master facet pairs that may overlap (from a search).
+    pub candidates: &'a [(u32, u32)],
+    /// Per slave facet: whether its forces are assembled here (a rank
+    /// evaluates a layer of other ranks' facets too, so that the weighted gap
+    /// of each node of its own facets is complete).
+    pub assembled: &'a [bool],
+}
+
+/// Per slave node: its multiplier, penalty and reference nodal area.
+#[derive(Debug, Clone, Default)]
+pub struct NodalData {
+    /// Slave node ids; `slot_of` maps a node id to its position here.
+    pub nodes: Vec<u32>,
+    pub lambda: Vec<f64>,
+    pub penalty: Vec<f64>,
+    pub area: Vec<f64>,
+    slot: std::collections::HashMap<u32, usize>,
+}
+
+impl NodalData {
+    pub fn new(nodes: Vec<u32>, lambda: Vec<f64>, penalty: Vec<f64>, area: Vec<f64>) -> Self {
+        let slot = nodes.iter().enumerate().map(|(i, &n)| (n, i)).collect();
+        NodalData {
+            nodes,
+            lambda,
+            penalty,
+            area,
+            slot,
+        }
+    }
+
+    pub fn slot_of(&self, node: u32) -> Option<usize> {
+        self.slot.get(&node).copied()
+    }
+}
+
+/// A scalar that can be seeded as the `i`-th segment variable (f64 ignores
+/// the index: residual only).
+pub trait Seed: Scalar {
+    fn seed(v: f64, i: usize) -> Self;
+}
+
+impl Seed for f64 {
+    fn seed(v: f64, _: usize) -> Self {
+        v
+    }
+}
+
+impl Seed for D {
+    fn seed(v: f64, i: usize) -> Self {
+        Dual::variable(v, i)
+    }
+}
+
+/// One segment's integrals, with the facets it came from.
+#[derive(Debug, Clone, Copy)]
+pub struct Segment<T> {
+    pub slave: u32,
+    pub master: u32,
+    pub terms: SegmentTerms<T>,
+}
+
+fn seeded<T: Seed>(
+    interface: &Interface,
+    nodes: &[u32],
+    offset: usize,
+) -> [Vec3<T>; MAX_FACET_NODES] {
+    let mut out = [[T::from_f64(0.0); 3]; MAX_FACET_NODES];
+    for (a, (o, &n)) in out.iter_mut().zip(nodes).enumerate() {
+        let p = interface.positions[n as usize];
+        *o = [0, 1, 2].map(|i| T::seed(p[i], offset + 3 * a + i));
+    }
+    out
+}
+
+/// Every overlapping candidate's integrals.
+pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
+    let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
+    let mut out = Vec::new();
+    let mut cached: Option<(u32, [[T; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
+    for &(s, m) in interface.candidates {
+        let snodes = &interface.slave_facets[s as usize][..ns];
+        let mnodes = &interface.master_facets[m as usize][..nm];
+        let xs = seeded::<T>(interface, snodes, 0);
+        let xm = seeded::<T>(interface, mnodes, MASTER_OFFSET);
+        let mut x_ref = [[0.0; 3]; MAX_FACET_NODES];
+        for (r, &n) in x_ref.iter_mut().zip(snodes) {
+            *r = interface.reference[n as usize];
+        }
+        // The dual basis is the reference facet's (constant): compute it once
+        // per slave facet, for its consecutive candidates.
+        let a = match cached {
+            Some((f, a)) if f == s => a,
+            _ => match dual_coefficients::<f64>(interface.slave_type, &x_ref[..ns], rules) {
+                Some(a) => {
+                    let a = a.map(|row| row.map(T::from_f64));
+                    cached = Some((s, a));
+                    a
+                }
+                None => continue,
+            },
+        };
+        let terms = segment_terms(
+            interface.slave_type,
+            &xs[..ns],
+            &x_ref[..ns],
+            interface.master_type,
+            &xm[..nm],
+            &a,
+            rules,
+        );
+        if let Some(terms) = terms {
+            out.push(Segment {
+                slave: s,
+                master: m,
+                terms,
+            });
+        }
+    }
+    out
+}
+
+/// Nodal weighted gaps `g̃_j` (by slot) and whether any segment covers the
+/// node.
+pub fn weighted_gaps<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<T>],
+) -> (Vec<f64>, Vec<bool>) {
+    let mut gap = vec![0.0; nodal.nodes.len()];
+    let mut covered = vec![false; nodal.nodes.len()];
+    let ns = interface.slave_type.nodes();
+    for seg in segments {
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            if let Some(j) = nodal.slot_of(node) {
+                gap[j] += seg.terms.weighted_gap[a].re();
+                covered[j] = true;
+            }
+        }
+    }
+    (gap, covered)
+}
+
+/// The state of one slave node after an evaluation.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NodeState {
+    /// `g̃_j` (length × area).
+    pub weighted_gap: f64,
+    /// `p_j = ⟨λ_j − ε_j g̃_j / A_j⟩`.
+    pub pressure: f64,
+    /// In contact (covered and `λ_j − ε_j ḡ_j ≥ 0`): contributes a tangent.
+    pub closed: bool,
+}
+
+pub fn node_states(nodal: &NodalData, gap: &[f64], covered: &[bool]) -> Vec<NodeState> {
+    (0..nodal.nodes.len())
+        .map(|j| {
+            let mean = gap[j] / nodal.area[j];
+            let trial = nodal.lambda[j] - nodal.penalty[j] * mean;
+            NodeState {
+                weighted_gap: gap[j],
+                pressure: if covered[j] {
+                    updated_multiplier(nodal.lambda[j], nodal.penalty[j], mean)
+                } else {
+                    0.0
+                },
+                closed: covered[j] && trial >= 0.0,
+            }
+        })
+        .collect()
+}
+
+/// Node ids of a segment's variables in slot order (`u32::MAX`: unused).
+fn segment_nodes(
+    interface: &Interface,
+    seg_slave: u32,
+    seg_master: u32,
+) -> [u32; 2 * MAX_FACET_NODES] {
+    let mut ids = [u32::MAX; 2 * MAX_FACET_NODES];
+    let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
+    ids[..ns].copy_from_slice(&interface.slave_facets[seg_slave as usize][..ns]);
+    ids[MAX_FACET_NODES..MAX_FACET_NODES + nm]
+        .copy_from_slice(&interface.master_facets[seg_master as usize][..nm]);
+    ids
+}
+
+/// The coefficient of node `a`'s pressure in the force on segment variable
+/// `v = 3 b + i` (`b < 4` slave node, else master node `b − 4`).
+fn force_coefficient<T: Scalar>(terms: &SegmentTerms<T>, a: usize, v: usize) -> T {
+    let (b, i) = (v / 3, v % 3);
+    if b < MAX_FACET_NODES {
+        terms.d[a][b] * terms.normal[i]
+    } else {
+        -(terms.m[a][b - MAX_FACET_NODES] * terms.normal[i])
+    }
+}
+
+/// Adds the residual of the assembled segments: `emit(node, component, value)`.
+pub fn residual<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<T>],
+    states: &[NodeState],
+    mut emit: impl FnMut(u32, usize, f64),
+) {
+    let ns = interface.slave_type.nodes();
+    for seg in segments
+        .iter()
+        .filter(|s| interface.assembled[s.slave as usize])
+    {
+        let ids = segment_nodes(interface, seg.slave, seg.master);
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            let Some(j) = nodal.slot_of(node) else {
+                continue;
+            };
+            let p = states[j].pressure;
+            if p == 0.0 {
+                continue;
+            }
+            for v in 0..SEGMENT_DOFS {
+                if ids[v / 3] != u32::MAX {
+                    emit(
+                        ids[v / 3],
+                        v % 3,
+                        p * force_coefficient(&seg.terms, a, v).re(),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A sparse vector over node DOFs, merged (sorted, duplicates summed).
+fn merged(mut v: Vec<(NodeDof, f64)>) -> Vec<(NodeDof, f64)> {
+    v.sort_by_key(|e| e.0);
+    let mut out: Vec<(NodeDof, f64)> = Vec::with_capacity(v.len());
+    for (k, x) in v {
+        match out.last_mut() {
+            Some(last) if last.0 == k => last.1 += x,
+            _ => out.push((k, x)),
+        }
+    }
+    out
+}
+
+/// Adds the tangent of the assembled segments: `emit(row, col, value)`.
+/// `segments` must hold every segment of every node of an assembled facet.
+pub fn tangent(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<D>],
+    states: &[NodeState],
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    let ns = interface.slave_type.nodes();
+    let nn = nodal.nodes.len();
+    // Per closed node: ∂g̃_j/∂x over all its segments, and the assembled
+    // force coefficients c_j (rows).
+    let mut grad: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    let mut rows: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    for seg in segments {
+        let ids = segment_nodes(interface, seg.slave, seg.master);
+        let assembled = interface.assembled[seg.slave as usize];
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            let Some(j) = nodal.slot_of(node) else {
+                continue;
+            };
+            if !states[j].closed {
+                continue;
+            }
+            let p = states[j].pressure;
+            for v in 0..SEGMENT_DOFS {
+                let id = ids[v / 3];
+                if id == u32::MAX {
+                    continue;
+                }
+                grad[j].push(((id, v % 3), seg.terms.weighted_gap[a].eps[v]));
+                if !assembled {
+                    continue;
+                }
+                let c = force_coefficient(&seg.terms, a, v);
+                rows[j].push(((id, v % 3), c.re));
+                // p_j ∂c_j/∂x: local to the segment.
+                if p != 0.0 {
+                    for (w, d) in c.eps.iter().enumerate() {
+                        let col = ids[w / 3];
+                        if col != u32::MAX && *d != 0.0 {
+                            emit((id, v % 3), (col, w % 3), p * d);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
+    for j in 0..nn {
+        if rows[j].is_empty() {
+            continue;
+        }
+        let scale = -nodal.penalty[j] / nodal.area[j];
+        let g = merged(std::mem::take(&mut grad[j]));
+        for (row, c) in merged(std::mem::take(&mut rows[j])) {
+            for (col, dg) in &g {
+                let v = c * dg * scale;
+                if v != 0.0 {
+                    emit(row, *col, v);
+                }
+            }
+        }
+    }
+}
+
+/// For every slave node: the node ids its tangent couples (all nodes of all
+/// its segments), sorted. The Jacobian pattern needs `S_j × S_j` for each
+/// `j` (the segments of an evaluation, f64 suffices).
+pub fn node_supports<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<T>],
+) -> Vec<Vec<u32>> {
+    let ns = interface.slave_type.nodes();
+    let mut support: Vec<Vec<u32>> = vec![Vec::new(); nodal.nodes.len()];
+    for seg in segments {
+        let ids = segment_nodes(interface, seg.slave, seg.master);
+        for &node in &interface.slave_facets[seg.slave as usize][..ns] {
+            if let Some(j) = nodal.slot_of(node) {
+                support[j].extend(ids.iter().filter(|&&n| n != u32::MAX));
+            }
+        }
+    }
+    for s in &mut support {
+        s.sort_unstable();
+        s.dedup();
+    }
+    support
+}

@@ -1,0 +1,134 @@
+//! The facets of a master surface as the search sees them: the usable
+//! ones, their nodes and neighbours, and distances to their boundary.
+
+use super::grid::Rows;
+use super::{distance, distance2, dot, is_finite3, sub, MasterSurface};
+
+/// A facet whose node ids are in range and whose coordinates are finite.
+pub(super) struct UsableFacet {
+    pub(super) id: u32,
+    pub(super) ids: [u32; 4],
+    pub(super) nodes: [[f64; 3]; 4],
+    pub(super) k: usize,
+}
+
+pub(super) fn facet_nodes(surface: &MasterSurface, f: u32) -> Option<UsableFacet> {
+    let k = surface.facet_type.nodes();
+    let ids = *surface.facets.get(f as usize)?;
+    let mut nodes = [[0.0; 3]; 4];
+    for (slot, &n) in nodes.iter_mut().zip(&ids[..k]) {
+        let p = *surface.positions.get(n as usize)?;
+        if !is_finite3(p) {
+            return None;
+        }
+        *slot = p;
+    }
+    Some(UsableFacet {
+        id: f,
+        ids,
+        nodes,
+        k,
+    })
+}
+
+/// The usable facets in id order (ids beyond `u32` cannot be named and are
+/// left out).
+pub(super) fn usable_facets(surface: &MasterSurface) -> Vec<UsableFacet> {
+    let n = surface.facets.len().min(u32::MAX as usize);
+    (0..n as u32)
+        .filter_map(|f| facet_nodes(surface, f))
+        .collect()
+}
+
+/// Nodes of usable facets, ascending. Only these are searched: a node on no
+/// facet has no facet to project onto.
+pub(super) fn used_nodes(surface: &MasterSurface, facets: &[UsableFacet]) -> Vec<u32> {
+    let mut used = vec![false; surface.positions.len()];
+    for f in facets {
+        for &n in &f.ids[..f.k] {
+            used[n as usize] = true;
+        }
+    }
+    (0..used.len() as u32)
+        .filter(|&n| used[n as usize])
+        .collect()
+}
+
+/// For every facet id, the facets sharing a node with it (itself
+/// included), merged from the node rows; empty for unusable facets.
+pub(super) fn facet_neighbours(surface: &MasterSurface, node_facets: &Rows) -> Rows {
+    let k = surface.facet_type.nodes();
+    let mut start = Vec::with_capacity(surface.facets.len() + 1);
+    let mut items = Vec::new();
+    start.push(0);
+    for (f, conn) in surface.facets.iter().enumerate() {
+        // Usable facets are exactly those listed at their nodes.
+        let usable = u32::try_from(f)
+            .is_ok_and(|id| node_facets.row(conn[0] as usize).binary_search(&id).is_ok());
+        if usable {
+            let mut rows: [&[u32]; 4] = [&[]; 4];
+            for (row, &n) in rows.iter_mut().zip(&conn[..k]) {
+                *row = node_facets.row(n as usize);
+            }
+            merge_sorted_unique(&mut rows[..k], &mut items);
+        }
+        start.push(items.len());
+    }
+    Rows { start, items }
+}
+
+/// Appends the union of the sorted, repeat-free `lists` to `out`, sorted and
+/// each id once: a merge that always takes the smallest head. The lists are
+/// short and few, so scanning the heads beats any heap.
+pub(super) fn merge_sorted_unique(lists: &mut [&[u32]], out: &mut Vec<u32>) {
+    loop {
+        let Some(min) = lists.iter().filter_map(|l| l.first()).min().copied() else {
+            return;
+        };
+        out.push(min);
+        for l in lists.iter_mut() {
+            if let Some((&head, rest)) = l.split_first() {
+                if head == min {
+                    *l = rest;
+                }
+            }
+        }
+    }
+}
+
+pub(super) fn mean_edge_length(facets: &[UsableFacet]) -> f64 {
+    let (sum, count) = facets.iter().fold((0.0, 0usize), |(s, c), f| {
+        let x = &f.nodes[..f.k];
+        let edges = (0..f.k).map(|i| distance(x[i], x[(i + 1) % f.k]));
+        (s + edges.sum::<f64>(), c + f.k)
+    });
+    sum / count.max(1) as f64
+}
+
+/// Longest edge: the length scale for the tie and pruning tolerances.
+pub(super) fn facet_size(x: &[[f64; 3]]) -> f64 {
+    (0..x.len())
+        .map(|i| distance2(x[i], x[(i + 1) % x.len()]))
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
+/// Distance from `x` to the facet's boundary edges (straight for both tri3
+/// and the bilinear quad4): where the clamped projection of a point lies
+/// that projects outside a flat facet.
+pub(super) fn boundary_distance(x: &[[f64; 3]], p: [f64; 3]) -> f64 {
+    (0..x.len())
+        .map(|i| segment_distance(x[i], x[(i + 1) % x.len()], p))
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn segment_distance(a: [f64; 3], b: [f64; 3], p: [f64; 3]) -> f64 {
+    let ab = sub(b, a);
+    let len2 = dot(ab, ab);
+    let t = if len2 > 0.0 {
+        (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    distance(p, [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]])
+}

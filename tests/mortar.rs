@@ -1,0 +1,401 @@
+//! Mortar contact end to end: the contact patch test on non-matching
+//! stacked blocks (either side as slave, stiffness ratio 1 and 100, a
+//! distorted mesh, hex and tet cells) under a fixed-direction traction,
+//! with the links measured on the same cases; 1, 2 and 3 ranks agree; bad
+//! `formulation` input is one scene error naming the line.
+mod common;
+use common::*;
+use contactlink::output::{list_steps, read_dataset, read_nodal};
+use std::path::Path;
+
+/// One patch-test case: the stacked blocks with `upper` over `lower`
+/// divisions in x and y, Young's moduli, cell type, distortion, and which
+/// side is the slave.
+struct Case {
+    name: &'static str,
+    upper: usize,
+    lower: usize,
+    youngs_upper: f64,
+    youngs_lower: f64,
+    tets: bool,
+    distort: Option<f64>,
+    upper_is_slave: bool,
+}
+
+const CASES: &[Case] = &[
+    Case {
+        name: "hex 4x4 over 5x5, coarse slave",
+        upper: 4,
+        lower: 5,
+        youngs_upper: 1000.0,
+        youngs_lower: 1000.0,
+        tets: false,
+        distort: None,
+        upper_is_slave: true,
+    },
+    Case {
+        name: "hex 4x4 over 5x5, fine slave",
+        upper: 4,
+        lower: 5,
+        youngs_upper: 1000.0,
+        youngs_lower: 1000.0,
+        tets: false,
+        distort: None,
+        upper_is_slave: false,
+    },
+    Case {
+        name: "hex 4x4 over 7x7, E 1000 on 10, coarse slave",
+        upper: 4,
+        lower: 7,
+        youngs_upper: 1000.0,
+        youngs_lower: 10.0,
+        tets: false,
+        distort: None,
+        upper_is_slave: true,
+    },
+    Case {
+        name: "hex 4x4 over 7x7, E 1000 on 10, fine slave",
+        upper: 4,
+        lower: 7,
+        youngs_upper: 1000.0,
+        youngs_lower: 10.0,
+        tets: false,
+        distort: None,
+        upper_is_slave: false,
+    },
+    Case {
+        name: "hex 4x4 over 5x5, 30 % distorted, coarse slave",
+        upper: 4,
+        lower: 5,
+        youngs_upper: 1000.0,
+        youngs_lower: 1000.0,
+        tets: false,
+        distort: Some(0.3),
+        upper_is_slave: true,
+    },
+    Case {
+        name: "tet 3x3 over 4x4, coarse slave",
+        upper: 3,
+        lower: 4,
+        youngs_upper: 1000.0,
+        youngs_lower: 1000.0,
+        tets: true,
+        distort: None,
+        upper_is_slave: true,
+    },
+    Case {
+        name: "tet 3x3 over 4x4, fine slave",
+        upper: 3,
+        lower: 4,
+        youngs_upper: 1000.0,
+        youngs_lower: 1000.0,
+        tets: true,
+        distort: None,
+        upper_is_slave: false,
+    },
+];
+
+impl Case {
+    /// Poisson's ratio of a block of modulus `e`: 0.3 for the stiffer one,
+    /// scaled with E for the softer, so both blocks expand sideways alike and
+    /// the uniform stress state is the exact solution (with equal ratios the
+    /// softer block overhangs the stiffer one and the pressure is not
+    /// uniform near the edges, whatever the discretisation).
+    fn poisson(&self, e: f64) -> f64 {
+        0.3 * e / self.youngs_upper.max(self.youngs_lower)
+    }
+
+    /// A 1 % strain of the softer block.
+    fn traction(&self) -> f64 {
+        0.01 * self.youngs_upper.min(self.youngs_lower)
+    }
+
+    fn slave(&self) -> (&'static str, &'static str) {
+        if self.upper_is_slave {
+            ("upper.bottom", "lower.top")
+        } else {
+            ("lower.top", "upper.bottom")
+        }
+    }
+
+    /// The scene; the top carries a downward traction of fixed direction,
+    /// symmetry planes hold both blocks, the lower one sits on z = −h.
+    fn scene(&self, formulation: &str) -> String {
+        let (slave, master) = self.slave();
+        let cell_type = if self.tets { "tet4" } else { "hex8" };
+        let distort = self.distort.map_or(String::new(), |f| {
+            format!("[distort]\nfraction = {f}\nseed = 3\n")
+        });
+        // A distorted mesh expands sideways unevenly at the blocks' edges, so
+        // their outer edges would part by rounding-size amounts and the
+        // overlap's boundary would jump from one Newton iterate to the next:
+        // confine the blocks laterally (uniaxial strain, still a uniform
+        // stress state) so the edges stay where they are.
+        let confined = if self.distort.is_some() {
+            ["lower.xmax", "upper.xmax", "lower.ymax", "upper.ymax"]
+                .iter()
+                .map(|set| {
+                    let c = if set.ends_with("xmax") { "x" } else { "y" };
+                    format!("[[dirichlet]]\nset = \"{set}\"\ncomponents = [\"{c}\"]\n\n")
+                })
+                .collect::<String>()
+        } else {
+            String::new()
+        };
+        format!(
+            r#"title = "mortar patch test"
+[mesh]
+generator = "stacked-blocks"
+length = 1.0
+height = 0.5
+gap = 0.0
+lower_divisions = [{l}, {l}, 2]
+upper_divisions = [{u}, {u}, 2]
+cell_type = "{cell_type}"
+{distort}
+[[body]]
+name = "lower"
+material = "linear-elastic"
+youngs = {el}
+poisson = {nl}
+
+[[body]]
+name = "upper"
+material = "linear-elastic"
+youngs = {eu}
+poisson = {nu}
+
+[[dirichlet]]
+set = "lower.bottom"
+components = ["z"]
+
+[[dirichlet]]
+set = "lower.xmin"
+components = ["x"]
+
+[[dirichlet]]
+set = "lower.ymin"
+components = ["y"]
+
+[[dirichlet]]
+set = "upper.xmin"
+components = ["x"]
+
+[[dirichlet]]
+set = "upper.ymin"
+components = ["y"]
+
+{confined}[[traction]]
+set = "upper.top"
+vector = [0.0, 0.0, -{t}]
+
+[[contact]]
+name = "interface"
+slave = "{slave}"
+master = "{master}"
+formulation = "{formulation}"
+penetration_tol = 1e-9
+multiplier_tol = 1e-9
+max_uzawa = 60
+"#,
+            l = self.lower,
+            u = self.upper,
+            el = self.youngs_lower,
+            eu = self.youngs_upper,
+            t = self.traction(),
+            nl = self.poisson(self.youngs_lower),
+            nu = self.poisson(self.youngs_upper),
+        )
+    }
+}
+
+fn last_step(path: &Path) -> usize {
+    *list_steps(path).expect("steps").last().expect("a step")
+}
+
+/// Nodal contact pressure at the slave surface's nodes.
+fn slave_pressures(path: &Path, node_set: &str) -> Vec<f64> {
+    let (nodes, _) =
+        read_dataset::<i64>(path, &format!("/mesh/node_sets/{node_set}")).expect("node set");
+    let (p, _, _) = read_nodal(path, last_step(path), "contact_pressure").expect("pressure");
+    nodes.iter().map(|&n| p[n as usize]).collect()
+}
+
+/// max |p_j − p̄| / p̄ over the slave nodes, p̄ their mean.
+fn deviation(p: &[f64]) -> (f64, f64) {
+    let mean = p.iter().sum::<f64>() / p.len() as f64;
+    let dev = p.iter().fold(0.0f64, |m, v| m.max((v - mean).abs())) / mean;
+    (mean, dev)
+}
+
+/// The slave's nodal pressures and the pair's force, or the error text.
+fn try_case(
+    dir: &Path,
+    case: &Case,
+    formulation: &str,
+    ranks: usize,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let tag = format!(
+        "{}-{formulation}-{ranks}",
+        case.name.replace([' ', ','], "_")
+    );
+    let scene = write(dir, &format!("{tag}.toml"), &case.scene(formulation));
+    let out = dir.join(format!("{tag}.h5"));
+    let o = mpirun(
+        ranks,
+        &[
+            "run",
+            scene.to_str().unwrap(),
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    if !o.status.success() {
+        return Err(text(&o));
+    }
+    let step = last_step(&out);
+    let force = read_dataset::<f64>(&out, &format!("/steps/{step:06}/contact/interface/force"))
+        .expect("force")
+        .0;
+    Ok((slave_pressures(&out, case.slave().0), force))
+}
+
+/// The mortar pair's nodal datasets at the slave nodes: λ, g̃ and the traction.
+fn mortar_fields(path: &Path, node_set: &str) -> Vec<(f64, f64, [f64; 3])> {
+    let step = last_step(path);
+    let (nodes, _) =
+        read_dataset::<i64>(path, &format!("/mesh/node_sets/{node_set}")).expect("node set");
+    let read = |name: &str| {
+        read_dataset::<f64>(path, &format!("/steps/{step:06}/contact/interface/{name}"))
+            .expect(name)
+            .0
+    };
+    let (lambda, gap, traction) = (
+        read("node_lambda"),
+        read("node_weighted_gap"),
+        read("node_traction"),
+    );
+    nodes
+        .iter()
+        .map(|&n| {
+            let n = n as usize;
+            let t = [traction[3 * n], traction[3 * n + 1], traction[3 * n + 2]];
+            (lambda[n], gap[n], t)
+        })
+        .collect()
+}
+
+fn run_case(dir: &Path, case: &Case, formulation: &str, ranks: usize) -> (Vec<f64>, Vec<f64>) {
+    try_case(dir, case, formulation, ranks).unwrap_or_else(|t| panic!("{}: {t}", case.name))
+}
+
+#[test]
+fn mortar_passes_the_patch_test_where_the_links_do_not() {
+    let dir = scratch("mortar-patch");
+    let mut worst = 0.0f64;
+    for case in CASES {
+        let (p, force) = run_case(&dir, case, "mortar", 1);
+        let (mean, dev) = deviation(&p);
+        // The links on the same case, for comparison (their Uzawa loop may
+        // not reach 1e-9 at all: then the figure is their failure).
+        let links = match try_case(&dir, case, "links", 1) {
+            Ok((pl, _)) => format!("{:.2e}", deviation(&pl).1),
+            Err(t) => format!("failed ({})", t.lines().last().unwrap_or("")),
+        };
+        println!(
+            "{:<48} mortar: mean {mean:.9}, max deviation {dev:.2e}; links: {links}",
+            case.name
+        );
+        // The traction balances the contact force (Newton tolerance).
+        assert!(
+            (force[2].abs() - case.traction()).abs() < 1e-6 * case.traction(),
+            "{}: contact force {force:?}",
+            case.name
+        );
+        assert!(p.iter().all(|&v| v > 0.0), "{}: open slave node", case.name);
+        worst = worst.max(dev);
+    }
+    assert!(worst < 1e-6, "mortar patch test deviates {worst:.2e}");
+}
+
+#[test]
+fn mortar_writes_nodal_multipliers_weighted_gaps_and_tractions() {
+    let dir = scratch("mortar-output");
+    let case = &CASES[0];
+    let (p, _) = run_case(&dir, case, "mortar", 2);
+    let tag = format!("{}-mortar-2", case.name.replace([' ', ','], "_"));
+    let fields = mortar_fields(&dir.join(format!("{tag}.h5")), case.slave().0);
+    assert_eq!(fields.len(), p.len());
+    for ((lambda, gap, t), p) in fields.iter().zip(&p) {
+        // λ is the nodal contact pressure; the upper block's bottom is
+        // pushed up (+z); the weighted gap is closed to the Uzawa tolerance
+        // (1e-9 h of a node's area, h = 0.25, area ≤ 1/16).
+        assert!((lambda - p).abs() <= 1e-12 * p, "{lambda} vs {p}");
+        assert!((t[2] - lambda).abs() <= 1e-9 * lambda && t[0].abs() + t[1].abs() < 1e-9);
+        assert!(
+            gap.abs() <= 1e-9 * 0.25 / 16.0 * 1.01,
+            "weighted gap {gap:e}"
+        );
+    }
+}
+
+#[test]
+fn mortar_answers_agree_on_one_two_and_three_ranks() {
+    let dir = scratch("mortar-ranks");
+    for case in [&CASES[0], &CASES[5]] {
+        let (p1, f1) = run_case(&dir, case, "mortar", 1);
+        for ranks in [2, 3] {
+            let (p, f) = run_case(&dir, case, "mortar", ranks);
+            let dp = relative_difference(&p1, &p);
+            let df = relative_difference(&f1, &f);
+            println!(
+                "{}: {ranks} ranks vs 1: pressure {dp:.2e}, force {df:.2e}",
+                case.name
+            );
+            assert!(
+                dp < 1e-10 && df < 1e-10,
+                "{}: {ranks} ranks differ",
+                case.name
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_formulation_is_a_scene_error_naming_the_line() {
+    let dir = scratch("mortar-bad");
+    let case = &CASES[0];
+    for (formulation, expect) in [
+        (
+            "penalty",
+            "formulation 'penalty' is not \"links\" or \"mortar\"",
+        ),
+        ("mortar\"\nfriction = 0.3\n#\"", "frictionless for now"),
+    ] {
+        let scene = write(dir.as_path(), "bad.toml", &case.scene(formulation));
+        let o = run(&["run", scene.to_str().unwrap(), "-q", "-o", "/dev/null"]);
+        let t = text(&o);
+        assert!(!o.status.success());
+        assert!(t.contains(expect), "{t}");
+        // One line naming the file and the line of the key.
+        let line = t
+            .lines()
+            .find(|l| l.contains(expect))
+            .expect("the error line");
+        assert!(line.contains("bad.toml:"), "{line}");
+    }
+    // Mortar needs a master facet set.
+    let rigid = case.scene("mortar").replace(
+        "master = \"lower.top\"",
+        "rigid = { kind = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }",
+    );
+    let scene = write(dir.as_path(), "rigid.toml", &rigid);
+    let o = run(&["run", scene.to_str().unwrap(), "-q", "-o", "/dev/null"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("needs a master facet set"),
+        "{}",
+        text(&o)
+    );
+}
