@@ -319,6 +319,14 @@ fn plot(file: &str, cli: &Cli) -> ExitCode {
         .output
         .clone()
         .unwrap_or_else(|| path.with_extension("png"));
+    let input = contactlink::output::paths::Input {
+        what: "result file",
+        path: path.to_path_buf(),
+    };
+    if let Err(e) = contactlink::output::paths::check_not_same(&output, &input) {
+        eprintln!("contactlink: {e}");
+        return ExitCode::FAILURE;
+    }
     match contactlink::results::plot::plot(path, &output, cli.step) {
         Ok(r) => {
             let errors = r.comparison.map_or(String::new(), |c| {

@@ -3,6 +3,7 @@
 use crate::dofs::even_block;
 use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::output::paths::{check_not_input, Input};
 use crate::output::{BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
@@ -62,26 +63,48 @@ pub struct RunSummary {
 /// Loads a scene by built-in name or path and builds its model.
 pub fn load_model(name_or_path: &str, overrides: &[String]) -> Result<(Model, Option<String>)> {
     let src = SceneSource::resolve(name_or_path)?;
-    build_model(&src, overrides)
+    let (model, output, _) = build_model(&src, overrides)?;
+    Ok((model, output))
 }
 
-/// Builds the model of a resolved scene (and returns its [output] path).
-fn build_model(src: &SceneSource, overrides: &[String]) -> Result<(Model, Option<String>)> {
+/// Builds the model of a resolved scene; returns its [output] path and the
+/// files it reads (scene, mesh), which no output may replace.
+fn build_model(
+    src: &SceneSource,
+    overrides: &[String],
+) -> Result<(Model, Option<String>, Vec<Input>)> {
     let parsed = scene::parse(src, overrides)?;
     let model = parsed.build(&src.origin)?;
-    Ok((model, parsed.output_path().map(str::to_owned)))
+    let scene_file = src.path.clone().map(|path| Input {
+        what: "scene file",
+        path,
+    });
+    let mesh_file = parsed.mesh_file(&src.origin).map(|path| Input {
+        what: "mesh file",
+        path,
+    });
+    let inputs = scene_file.into_iter().chain(mesh_file).collect();
+    Ok((model, parsed.output_path().map(str::to_owned), inputs))
 }
 
 /// Runs a scene on all ranks of the runtime.
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
     crate::parallel::fault::arm(rt.rank())?;
     let src = SceneSource::resolve(name_or_path)?;
-    let (model, scene_out) = build_model(&src, &opts.overrides)?;
+    let (model, scene_out, mut inputs) = build_model(&src, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
     let restart = match &opts.restart {
         Some(from) => Some(read_restart(from, output.as_deref(), &model)?),
         None => None,
     };
+    if let Some(out) = &output {
+        // Every rank sees the same paths and files: the same answer.
+        inputs.extend(opts.restart.clone().map(|path| Input {
+            what: "restart file",
+            path,
+        }));
+        check_not_input(out, &inputs).map_err(std::io::Error::other)?;
+    }
     let provenance = Provenance {
         scene: src.text,
         overrides: opts.overrides.clone(),

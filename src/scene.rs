@@ -18,6 +18,8 @@ use crate::verify::{HertzCheck, HertzKind};
 use serde::Deserialize;
 use std::path::Path;
 
+mod held;
+mod limits;
 mod lines;
 pub use lines::{KeyLines, Origin, Seg};
 
@@ -394,6 +396,8 @@ pub struct OutputSection {
 pub struct SceneSource {
     pub origin: String,
     pub text: String,
+    /// The scene file read (none for a built-in scene).
+    pub path: Option<std::path::PathBuf>,
 }
 
 impl SceneSource {
@@ -403,6 +407,7 @@ impl SceneSource {
             return Ok(SceneSource {
                 origin: format!("built-in scene '{name}'"),
                 text: (*text).to_owned(),
+                path: None,
             });
         }
         let path = Path::new(name_or_path);
@@ -419,6 +424,7 @@ impl SceneSource {
         Ok(SceneSource {
             origin: path.display().to_string(),
             text,
+            path: Some(path.to_path_buf()),
         })
     }
 }
@@ -593,6 +599,14 @@ impl Scene {
         }
     }
 
+    /// The mesh file the scene reads, if any (a Gmsh `[mesh] file`).
+    pub fn mesh_file(&self, origin: &str) -> Option<std::path::PathBuf> {
+        match &self.mesh {
+            MeshSection::Gmsh(g) => Some(gmsh_path(g, origin)),
+            _ => None,
+        }
+    }
+
     /// The output path the scene asks for, if any.
     pub fn output_path(&self) -> Option<&str> {
         self.output.path.as_deref()
@@ -717,6 +731,18 @@ impl Scene {
                         ),
                     )
                 })?;
+            // A NaN here would reach every residual of the body and fail
+            // the first solve far from its cause.
+            bf.vector
+                .iter()
+                .try_for_each(|&v| check_finite(v, "vector"))
+                .map_err(|m| {
+                    self.error_at(
+                        origin,
+                        &[Key("body_force"), Index(j), Key("vector")],
+                        format!("[[body_force]] body '{}': {m}", bf.body),
+                    )
+                })?;
             for (acc, v) in body_force[i].iter_mut().zip(bf.vector) {
                 *acc += v;
             }
@@ -758,9 +784,11 @@ impl Scene {
                 "[steps] count must be at least 1",
             ));
         }
+        limits::at_most("[steps] count", self.steps.count, limits::MAX_STEPS)
+            .map_err(|m| self.error_at(origin, &[Key("steps"), Key("count")], m))?;
         let solver = self
             .solver_settings()
-            .map_err(|m| self.error_at(origin, &[Key("solver")], m))?;
+            .map_err(self.located(origin, &[Key("solver")]))?;
         let dynamics = self
             .dynamics_spec(&mesh)
             .map_err(self.located(origin, &[Key("dynamics")]))?;
@@ -768,20 +796,8 @@ impl Scene {
         // solver would fail (or return garbage) in the first step. Contact
         // may hold a body, and a mass matrix makes any body's operator regular.
         if dynamics.is_none() {
-            if let Some(b) = unheld_body(&mesh, &dirichlet, &contact) {
-                let name = &mesh.bodies[b];
-                let i = self
-                    .bodies
-                    .iter()
-                    .position(|s| &s.name == name)
-                    .unwrap_or(0);
-                return Err(self.error_at(
-                    origin,
-                    &[Key("body"), Index(i), Key("name")],
-                    format!(
-                        "body '{name}' has no [[dirichlet]] condition and no contact pair: nothing holds it, so its stiffness is singular (fix some of its nodes, give it a contact partner, or add [dynamics])"
-                    ),
-                ));
+            if let Some(group) = held::unheld_group(&mesh, &dirichlet, &contact) {
+                return Err(self.unheld_error(origin, &mesh, &group));
             }
         }
         let model = Model {
@@ -799,6 +815,41 @@ impl Scene {
             dynamics,
         };
         Ok((model, report))
+    }
+
+    /// The error for a group of static bodies that nothing holds, at the
+    /// `[[body]]` line of its first body.
+    fn unheld_error(&self, origin: &str, mesh: &Mesh, group: &held::Unheld) -> Error {
+        let names: Vec<String> = group
+            .bodies
+            .iter()
+            .map(|&b| format!("'{}'", mesh.bodies[b]))
+            .collect();
+        let first = &mesh.bodies[group.bodies[0]];
+        let i = self
+            .bodies
+            .iter()
+            .position(|s| &s.name == first)
+            .unwrap_or(0);
+        let message = match (names.len(), group.in_contact) {
+            (1, false) => format!(
+                "body {} has no [[dirichlet]] condition and no contact pair: nothing holds it, so its stiffness is singular (fix some of its nodes, give it a contact partner, or add [dynamics])",
+                names[0]
+            ),
+            (1, true) => format!(
+                "body {} is held by nothing: it has no [[dirichlet]] condition and no contact with a held body or a rigid surface, so its stiffness is singular (fix some of its nodes, or add [dynamics])",
+                names[0]
+            ),
+            _ => format!(
+                "bodies {} are held only through contact with each other: none has a [[dirichlet]] condition or a rigid contact surface, so together they float and their stiffness is singular (fix some nodes of one of them, or add [dynamics])",
+                names.join(", ")
+            ),
+        };
+        self.error_at(
+            origin,
+            &[Seg::Key("body"), Seg::Index(i), Seg::Key("name")],
+            message,
+        )
     }
 
     /// The dynamics settings, checked: a time step, valid Newmark parameters
@@ -889,23 +940,46 @@ impl Scene {
         }))
     }
 
-    fn solver_settings(&self) -> std::result::Result<SolverSettings, String> {
+    fn solver_settings(&self) -> Checked<SolverSettings> {
+        use Seg::Key;
         let d = SolverSettings::default();
         let s = &self.solver;
-        let positive = |v: f64, key: &str| {
+        let key = |k| [Key("solver"), Key(k)];
+        let positive = |v: f64, k: &'static str| {
             if v > 0.0 && v.is_finite() {
                 Ok(v)
             } else {
-                Err(format!("[solver] {key} must be positive (got {v})"))
+                Err(Bad::at(
+                    &key(k),
+                    format!("[solver] {k} must be positive (got {v})"),
+                ))
             }
         };
+        let count = |v: Option<usize>, default: usize, k: &'static str, max: usize| {
+            let v = v.unwrap_or(default);
+            limits::at_most(&format!("[solver] {k}"), v, max)
+                .map(|()| v)
+                .map_err(|m| Bad::at(&key(k), m))
+        };
+        let petsc_options = s.petsc_options.clone().unwrap_or_default();
+        crate::petsc::options::parse_pairs(&petsc_options).map_err(|m| {
+            Bad::at(
+                &key("petsc_options"),
+                format!("[solver] petsc_options: {m}"),
+            )
+        })?;
         Ok(SolverSettings {
-            max_newton: s.max_newton.unwrap_or(d.max_newton).max(1),
+            max_newton: count(s.max_newton, d.max_newton, "max_newton", limits::MAX_NEWTON)?.max(1),
             rtol: positive(s.rtol.unwrap_or(d.rtol), "rtol")?,
             atol: s.atol.map(|a| positive(a, "atol")).transpose()?,
-            max_cutbacks: s.max_cutbacks.unwrap_or(d.max_cutbacks),
+            max_cutbacks: count(
+                s.max_cutbacks,
+                d.max_cutbacks,
+                "max_cutbacks",
+                limits::MAX_CUTBACKS,
+            )?,
             direct_max_dofs: s.direct_max_dofs.unwrap_or(d.direct_max_dofs),
-            petsc_options: s.petsc_options.clone().unwrap_or_default(),
+            petsc_options,
             reuse: crate::solve::Reuse {
                 linear_stiffness: s.reuse_linear_stiffness.unwrap_or(d.reuse.linear_stiffness),
                 pattern: s.reuse_pattern.unwrap_or(d.reuse.pattern),
@@ -925,6 +999,19 @@ impl Scene {
     }
 
     fn build_mesh(&self, origin: &str) -> Result<(Mesh, MeshReport)> {
+        self.generate_mesh(origin).map_err(|e| match e {
+            Error::Mesh(m) => {
+                let key = lines::mesh_key(&m);
+                let at: Vec<Seg> = std::iter::once(Seg::Key("mesh"))
+                    .chain(key.map(Seg::Key))
+                    .collect();
+                self.error_at(origin, &at, format!("[mesh] {m}"))
+            }
+            other => other,
+        })
+    }
+
+    fn generate_mesh(&self, origin: &str) -> Result<(Mesh, MeshReport)> {
         let mut report = MeshReport::default();
         let mesh = match &self.mesh {
             MeshSection::Box(b) => generate::graded_box(&BoxSpec {
@@ -977,17 +1064,7 @@ impl Scene {
                 })?
             }
             MeshSection::Gmsh(g) => {
-                // `origin` is the scene's path, or names a built-in scene,
-                // which is compiled in from the crate's scenes/ directory.
-                let builtin = BUILTIN
-                    .iter()
-                    .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
-                let base = match Path::new(origin).parent() {
-                    _ if builtin => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
-                    Some(dir) => dir.to_path_buf(),
-                    None => Default::default(),
-                };
-                let (mesh, gmsh) = crate::mesh::read_gmsh(&base.join(&g.file)).map_err(|e| {
+                let (mesh, gmsh) = crate::mesh::read_gmsh(&gmsh_path(g, origin)).map_err(|e| {
                     let at = [Seg::Key("mesh"), Seg::Key("file")];
                     self.error_at(origin, &at, format!("[mesh] gmsh: {e}"))
                 })?;
@@ -999,41 +1076,27 @@ impl Scene {
     }
 }
 
+/// A Gmsh `file` as a path: relative to the scene's directory. `origin`
+/// is the scene's path, or names a built-in scene, which is compiled in
+/// from the crate's scenes/ directory.
+fn gmsh_path(g: &GmshSection, origin: &str) -> std::path::PathBuf {
+    let builtin = BUILTIN
+        .iter()
+        .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
+    let base = match Path::new(origin).parent() {
+        _ if builtin => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+        Some(dir) => dir.to_path_buf(),
+        None => Default::default(),
+    };
+    base.join(&g.file)
+}
+
 /// What reading the mesh found besides the mesh (for `check` to print).
 #[derive(Debug, Clone, Default)]
 pub struct MeshReport {
     /// The Gmsh reader's report (reoriented cells, skipped sections), for a
     /// `generator = "gmsh"` mesh.
     pub gmsh: Option<crate::mesh::GmshReport>,
-}
-
-/// The first body (index) that no Dirichlet condition touches and no contact
-/// pair names as slave or master.
-fn unheld_body(mesh: &Mesh, dirichlet: &[DirichletSpec], contact: &[PairSpec]) -> Option<usize> {
-    let mut held = vec![false; mesh.bodies.len()];
-    let mut node_body = vec![usize::MAX; mesh.num_nodes()];
-    for c in 0..mesh.num_cells() {
-        for &n in mesh.cell(c) {
-            node_body[n] = mesh.cell_body[c] as usize;
-        }
-    }
-    for d in dirichlet.iter().filter(|d| !d.components.is_empty()) {
-        for &n in &d.nodes {
-            if let Some(h) = held.get_mut(node_body[n]) {
-                *h = true;
-            }
-        }
-    }
-    for p in contact {
-        let mut sets = vec![p.slave.as_str()];
-        if let MasterSpec::Surface { set } = &p.master {
-            sets.push(set);
-        }
-        for b in sets.into_iter().filter_map(|s| body_of_set(mesh, s)) {
-            held[b] = true;
-        }
-    }
-    held.iter().position(|h| !h)
 }
 
 fn check_finite(v: f64, what: &str) -> std::result::Result<(), String> {
@@ -1187,6 +1250,17 @@ fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSp
             return Err(format!("{at}: needs a master facet set or a rigid surface").into())
         }
     };
+    if let MasterSpec::Rigid(r) = &master {
+        rigid_point(r)
+            .iter()
+            .try_for_each(|&v| check_finite(v, &format!("{at}: rigid point (or centre)")))
+            .map_err(|m| Bad::at(&key("rigid"), m))?;
+    }
+    if let Some(m) = c.motion {
+        m.iter()
+            .try_for_each(|&v| check_finite(v, &format!("{at}: motion")))
+            .map_err(|e| Bad::at(&key("motion"), e))?;
+    }
     if c.motion.is_some() && !master.is_rigid() {
         return Err(Bad::at(&key("motion"), format!("{at}: motion applies to rigid masters only; move a deformable master with [[dirichlet]] values")));
     }
@@ -1244,6 +1318,12 @@ fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSp
             format!("{at}: max_uzawa must be at least 1"),
         ));
     }
+    limits::at_most(
+        &format!("{at} max_uzawa"),
+        spec.max_uzawa,
+        limits::MAX_UZAWA,
+    )
+    .map_err(|m| Bad::at(&key("max_uzawa"), m))?;
     if let Some(mu) = c.friction {
         if !(mu >= 0.0 && mu.is_finite()) {
             return Err(Bad::at(
@@ -1267,6 +1347,15 @@ fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSp
         penalty: tangential_penalty,
     });
     Ok(spec)
+}
+
+/// The point a rigid surface is placed by (its normal, axis and radius are
+/// checked by [`RigidSurface::validate`]).
+fn rigid_point(r: &RigidSurface) -> [f64; 3] {
+    match *r {
+        RigidSurface::Plane { point, .. } | RigidSurface::Cylinder { point, .. } => point,
+        RigidSurface::Sphere { centre, .. } => centre,
+    }
 }
 
 /// The pair's `formulation`, checked against what the mortar formulation
@@ -1356,14 +1445,14 @@ fn hertz_check(
         .iter()
         .find(|p| p.name == h.pair)
         .ok_or_else(|| format!("[hertz] pair '{}' is not a [[contact]] name", h.pair))?;
-    if h.radius.is_nan() || h.radius <= 0.0 {
+    if !(h.radius.is_finite() && h.radius > 0.0) {
         return Err(format!(
             "[hertz] radius must be positive (got {})",
             h.radius
         ));
     }
     let kind = match (h.kind.as_str(), h.thickness) {
-        ("line", Some(t)) if t > 0.0 => HertzKind::Line { thickness: t },
+        ("line", Some(t)) if t > 0.0 && t.is_finite() => HertzKind::Line { thickness: t },
         ("line", _) => return Err("[hertz] kind = \"line\" needs a positive thickness".into()),
         ("point", None) => HertzKind::Point,
         ("point", Some(_)) => {

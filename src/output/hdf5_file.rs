@@ -48,7 +48,10 @@ pub struct ResultFile {
     path: PathBuf,
     xdmf_path: PathBuf,
     mesh: MeshDesc,
-    steps: Vec<StepDesc>,
+    /// Group names of the steps written, to refuse a step twice.
+    written: std::collections::BTreeSet<String>,
+    /// The open sidecar, on rank 0 (set by [`ResultFile::create`]).
+    sidecar: Option<xdmf::Sidecar>,
 }
 
 /// A dataset under a step: `/steps/<group>/<dirs...>/<name>` = `object`.
@@ -655,11 +658,12 @@ impl ResultFile {
             comm,
             file,
             mesh: desc,
-            steps: Vec::new(),
+            written: Default::default(),
+            sidecar: None,
         };
         out.write_mesh(mesh)?;
         out.flush()?;
-        out.write_xdmf()?;
+        out.create_xdmf()?;
         Ok(out)
     }
 
@@ -844,12 +848,13 @@ impl ResultFile {
                 center: *center,
             })
             .collect();
-        self.steps.push(StepDesc {
-            group,
+        let step = StepDesc {
+            group: group.clone(),
             time: info.time,
             fields,
-        });
-        self.write_xdmf()
+        };
+        self.written.insert(group);
+        self.append_xdmf(&step)
     }
 
     /// Local checks of a `write_step` call (same verdict on every rank for
@@ -862,11 +867,7 @@ impl ResultFile {
         cell: &[(&str, BlockRows<f64>)],
     ) -> Result<(), OutputError> {
         let p = self.path.as_path();
-        if self
-            .steps
-            .iter()
-            .any(|s| s.group == step_group_name(info.index))
-        {
+        if self.written.contains(&step_group_name(info.index)) {
             return Err(OutputError::invalid(
                 p,
                 gpath,
@@ -1013,7 +1014,7 @@ impl ResultFile {
         let mut dirs: Vec<String> = rel_path.split('/').map(str::to_string).collect();
         let name = dirs.pop().unwrap_or_default();
         let local = (|| {
-            if !self.steps.iter().any(|s| s.group == group) {
+            if !self.written.contains(&group) {
                 return Err(OutputError::invalid(
                     p,
                     &object,
@@ -1084,20 +1085,34 @@ impl ResultFile {
         &self.xdmf_path
     }
 
-    /// Rank 0 rewrites the sidecar; all ranks learn whether it worked.
-    fn write_xdmf(&self) -> Result<(), OutputError> {
-        let c = self.coll();
-        let res = if c.is_root() {
-            let text = xdmf::render(&self.mesh, &self.steps);
-            xdmf::write_atomic(&self.xdmf_path, &text).map_err(|source| OutputError::Xdmf {
-                path: self.xdmf_path.clone(),
-                source,
-            })
+    /// Rank 0 writes the sidecar with no steps and keeps it open; all ranks
+    /// learn whether it worked.
+    fn create_xdmf(&mut self) -> Result<(), OutputError> {
+        let res = if self.coll().is_root() {
+            xdmf::Sidecar::create(&self.xdmf_path, &self.mesh).map(|s| self.sidecar = Some(s))
         } else {
             Ok(())
         };
+        self.agree_xdmf(res)
+    }
+
+    /// Rank 0 appends one step to the sidecar; all ranks learn whether it
+    /// worked.
+    fn append_xdmf(&mut self, step: &StepDesc) -> Result<(), OutputError> {
+        let res = match &mut self.sidecar {
+            Some(s) => s.append(&self.mesh, step).map(drop),
+            None => Ok(()),
+        };
+        self.agree_xdmf(res)
+    }
+
+    fn agree_xdmf(&self, res: std::io::Result<()>) -> Result<(), OutputError> {
+        let res = res.map_err(|source| OutputError::Xdmf {
+            path: self.xdmf_path.clone(),
+            source,
+        });
         let object = self.xdmf_path.display().to_string();
-        c.agree(&object, res)
+        self.coll().agree(&object, res)
     }
 }
 

@@ -45,9 +45,10 @@
 //!
 //! # XDMF sidecar
 //!
-//! `out.xmf` next to `out.h5` (same stem) is rewritten by rank 0 after the
-//! mesh and after every step, so it always lists exactly the steps in the
-//! file; see [`xdmf`] for its shape.
+//! `out.xmf` next to `out.h5` (same stem) is written by rank 0 after the
+//! mesh and extended after every step (the new grid written over the closing
+//! tags, which follow it again), so it is always a complete document listing
+//! exactly the steps in the file; see [`xdmf`] for its shape.
 //!
 //! # Collective calls
 //!
@@ -59,6 +60,7 @@
 //! instead of leaving the others blocked in the next collective call.
 
 mod hdf5_file;
+pub mod paths;
 pub mod xdmf;
 
 use std::path::{Path, PathBuf};

@@ -9,12 +9,20 @@
 //! every nodal and cell field of the step, then `partition` and `cell_body`
 //! (Scalar, Cell).
 //!
+//! The writer keeps the sidecar open and, per step, writes the new grid and
+//! the fixed closing tail over the old tail in one write ([`Sidecar`]), so
+//! the file is a complete document after every step and each step costs the
+//! same few kilobytes however many steps came before (rewriting the whole
+//! file made the output cost of a run grow with the square of its steps).
+//!
 //! HDF5 references use the bare file name (`out.h5:/mesh/nodes`), which
 //! XDMF readers resolve relative to the `.xmf` file, so the pair can be
 //! moved or copied together.
 
 use std::fmt::Write as _;
+use std::fs::File;
 use std::io;
+use std::os::unix::fs::FileExt as _;
 use std::path::{Path, PathBuf};
 
 use super::CellKind;
@@ -57,6 +65,9 @@ pub fn sidecar_path(h5_path: &Path) -> PathBuf {
     h5_path.with_extension("xmf")
 }
 
+/// What follows the last step grid: it closes the collection and the document.
+const TAIL: &str = "    </Grid>\n  </Domain>\n</Xdmf>\n";
+
 /// Renders the whole sidecar for `steps` (in the order given).
 pub(crate) fn render(mesh: &MeshDesc, steps: &[StepDesc]) -> String {
     let mut s = String::new();
@@ -68,8 +79,43 @@ pub(crate) fn render(mesh: &MeshDesc, steps: &[StepDesc]) -> String {
     for step in steps {
         render_step(&mut s, mesh, step);
     }
-    s.push_str("    </Grid>\n  </Domain>\n</Xdmf>\n");
+    s.push_str(TAIL);
     s
+}
+
+/// The sidecar as its writer keeps it: open, with the offset where the
+/// closing tail starts (where the next grid goes).
+pub(crate) struct Sidecar {
+    file: File,
+    tail_at: u64,
+}
+
+impl Sidecar {
+    /// Writes the document with no steps (through a rename, replacing any
+    /// stale sidecar whole) and keeps it open for [`Sidecar::append`].
+    pub(crate) fn create(path: &Path, mesh: &MeshDesc) -> io::Result<Sidecar> {
+        let text = render(mesh, &[]);
+        write_atomic(path, &text)?;
+        let file = std::fs::OpenOptions::new().write(true).open(path)?;
+        Ok(Sidecar {
+            file,
+            tail_at: (text.len() - TAIL.len()) as u64,
+        })
+    }
+
+    /// Adds one step's grid: the grid and the tail are written over the old
+    /// tail in a single positioned write (the file only grows, nothing after
+    /// the tail is left over). Returns the bytes written, which do not
+    /// depend on how many steps the file already lists.
+    pub(crate) fn append(&mut self, mesh: &MeshDesc, step: &StepDesc) -> io::Result<usize> {
+        let mut s = String::new();
+        render_step(&mut s, mesh, step);
+        let grid = s.len() as u64;
+        s.push_str(TAIL);
+        self.file.write_all_at(s.as_bytes(), self.tail_at)?;
+        self.tail_at += grid;
+        Ok(s.len())
+    }
 }
 
 fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
@@ -274,6 +320,87 @@ mod tests {
             let back: f64 = fmt_f64(v).parse().unwrap_or(f64::NAN);
             assert_eq!(back, v);
         }
+    }
+
+    /// Whether `text` is one well-formed element tree (tags balanced and
+    /// properly nested, nothing but whitespace after the root).
+    fn well_formed(text: &str) -> bool {
+        let body = match text.strip_prefix("<?xml") {
+            Some(rest) => match rest.find("?>") {
+                Some(i) => &rest[i + 2..],
+                None => return false,
+            },
+            None => text,
+        };
+        let mut open: Vec<&str> = Vec::new();
+        let mut rest = body;
+        let mut roots = 0;
+        while let Some(start) = rest.find('<') {
+            let Some(len) = rest[start..].find('>') else {
+                return false;
+            };
+            let tag = &rest[start + 1..start + len];
+            rest = &rest[start + len + 1..];
+            if let Some(name) = tag.strip_prefix('/') {
+                if open.pop() != Some(name.trim()) {
+                    return false;
+                }
+            } else {
+                if open.is_empty() {
+                    roots += 1;
+                }
+                if !tag.ends_with('/') {
+                    open.push(tag.split_whitespace().next().unwrap_or(""));
+                }
+            }
+        }
+        open.is_empty() && roots == 1 && rest.trim().is_empty()
+    }
+
+    #[test]
+    fn appended_sidecar_is_the_full_document_after_every_step() {
+        let dir = std::env::temp_dir().join(format!("xdmf_append_{}", std::process::id()));
+        let _ = std::fs::create_dir_all(&dir);
+        let p = dir.join("out.xmf");
+        // A stale, longer sidecar is replaced, not partly overwritten.
+        let stale = render(&mesh(), &(1..=20).map(|i| step(i, 0.1)).collect::<Vec<_>>());
+        std::fs::write(&p, stale).unwrap();
+        let mut sidecar = Sidecar::create(&p, &mesh()).unwrap();
+        let read = || std::fs::read_to_string(&p).unwrap();
+        assert_eq!(read(), render(&mesh(), &[]));
+        assert!(well_formed(&read()));
+        let mut steps = Vec::new();
+        for i in 1..=12 {
+            steps.push(step(i, 0.25 * i as f64));
+            sidecar.append(&mesh(), &steps[i - 1]).unwrap();
+            let text = read();
+            assert_eq!(text, render(&mesh(), &steps), "after step {i}");
+            assert!(well_formed(&text), "after step {i}");
+            assert_eq!(text.matches("GridType=\"Uniform\"").count(), i);
+        }
+        assert!(!well_formed("<a><b></a></b>") && !well_formed("<a></a><a/>"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn bytes_written_per_step_do_not_grow_with_the_step_index() {
+        let dir = std::env::temp_dir().join(format!("xdmf_cost_{}", std::process::id()));
+        let _ = std::fs::create_dir_all(&dir);
+        let p = dir.join("out.xmf");
+        let mut sidecar = Sidecar::create(&p, &mesh()).unwrap();
+        // Same time text for every step, so only the index could matter.
+        let written: Vec<usize> = (1..=3000)
+            .map(|i| sidecar.append(&mesh(), &step(i, 1.0)).unwrap())
+            .collect();
+        assert!(
+            written.iter().all(|&n| n == written[0]),
+            "{:?}",
+            &written[..3]
+        );
+        let total = std::fs::metadata(&p).unwrap().len() as usize;
+        let grid = written[0] - TAIL.len();
+        assert_eq!(total, render(&mesh(), &[]).len() + 3000 * grid);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -44,13 +44,21 @@ pub(crate) fn check(call: &'static str, code: sys::PetscErrorCode) -> Result<()>
     unsafe {
         sys::PetscErrorMessage(code, &mut text, std::ptr::null_mut());
     }
-    let message = if text.is_null() {
+    let class = if text.is_null() {
         "unknown error".to_owned()
     } else {
         // SAFETY: non-null pointers from PetscErrorMessage are NUL-terminated statics.
         unsafe { CStr::from_ptr(text) }
             .to_string_lossy()
             .into_owned()
+    };
+    // PETSc's own text says which value it refused; with it, the option.
+    let message = match options::take_error_text(code) {
+        Some(detail) => match options::option_named_by(&detail) {
+            Some((key, value)) => format!("option {key} {value}: {detail} ({class})"),
+            None => format!("{class}: {detail}"),
+        },
+        None => class,
     };
     Err(PetscError {
         call,
@@ -118,9 +126,10 @@ impl PetscGuard {
                 std::ptr::null()
             ))?;
             // Errors come back as codes to Rust instead of PETSc printing a
-            // traceback: the Rust side reports them with context.
+            // traceback: the Rust side reports them with context, and with
+            // the message PETSc gave (kept by the handler).
             petsc_call!(PetscPushErrorHandler(
-                Some(sys::PetscReturnErrorHandler),
+                Some(options::keep_error_text),
                 std::ptr::null_mut()
             ))?;
         }

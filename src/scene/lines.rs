@@ -80,6 +80,39 @@ impl KeyLines {
     }
 }
 
+/// The `[mesh]` keys a generator's spec fields are read from (the same
+/// names, without an index such as `divisions[2]`).
+const MESH_KEYS: &[&str] = &[
+    "body",
+    "origin",
+    "size",
+    "divisions",
+    "grading",
+    "cell_type",
+    "radius",
+    "block_width",
+    "block_height",
+    "thickness",
+    "gap",
+    "fine_size",
+    "fine_half_width",
+    "growth",
+    "level",
+    "length",
+    "height",
+    "lower_divisions",
+    "upper_divisions",
+];
+
+/// The `[mesh]` key a generator error is about, if it names one.
+pub fn mesh_key(e: &crate::mesh::MeshError) -> Option<&'static str> {
+    let crate::mesh::MeshError::InvalidSpec { field, .. } = e else {
+        return None;
+    };
+    let name = field.split('[').next().unwrap_or(field);
+    MESH_KEYS.iter().copied().find(|k| *k == name)
+}
+
 /// Line number (from 1) of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
     text.as_bytes()[..offset.min(text.len())]

@@ -2,7 +2,7 @@
 
 use super::blocks::{alias_set, Block, BodyBuilder, Side};
 use super::spacing::{graded_coordinates, Grading};
-use super::{check_at_least, finalize, spec_error};
+use super::{check_at_least, check_size, finalize, spec_error};
 use crate::mesh::{CellType, Mesh, MeshError};
 
 const GENERATOR: &str = "graded_box";
@@ -59,6 +59,8 @@ pub fn graded_box(spec: &BoxSpec) -> Result<Mesh, MeshError> {
     for (axis, line) in lines.iter_mut().enumerate() {
         *line = axis_line(spec, axis)?;
     }
+    let dims = [0, 1, 2].map(|a| lines[a].len().saturating_sub(1));
+    check_size(GENERATOR, "divisions", &[dims], spec.cell_type)?;
     let mut mesh = tensor_body(&spec.body, &lines, &BOX_SIDES)
         .map_err(|reason| spec_error(GENERATOR, "divisions", reason))?;
     alias_set(

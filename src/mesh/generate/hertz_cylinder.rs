@@ -4,7 +4,7 @@ use super::blocks::{subset_set, Block, BodyBuilder, Side};
 use super::graded_box::tensor_body;
 use super::o_grid::{core_line, shell_lines, shell_point, tan_exact, ShellInput, ShellLines};
 use super::spacing::{contact_block_lines, FineZone};
-use super::{check_at_least, finalize, spec_error};
+use super::{check_at_least, check_size, finalize, size_field, spec_error};
 use crate::mesh::{CellType, Mesh, MeshError};
 
 const GENERATOR: &str = "hertz_cylinder";
@@ -81,7 +81,14 @@ pub fn hertz_cylinder(spec: &HertzCylinderSpec) -> Result<Mesh, MeshError> {
         growth: spec.growth,
         level: spec.level,
     })?;
-    let block = block_body(spec)?;
+    let (x, z) = block_lines(spec)?;
+    check_size(
+        GENERATOR,
+        size_field(spec.level),
+        &cell_blocks(&x, &z, &lines),
+        spec.cell_type,
+    )?;
+    let block = block_body(spec, x, z)?;
     let cylinder =
         cylinder_body(spec, &lines).map_err(|r| spec_error(GENERATOR, "fine_size", r))?;
     finalize(block.merge(cylinder)?, spec.cell_type)
@@ -101,14 +108,32 @@ fn check_spec(spec: &HertzCylinderSpec) -> Result<(), MeshError> {
     Ok(())
 }
 
-fn block_body(spec: &HertzCylinderSpec) -> Result<Mesh, MeshError> {
+/// The block's x and z node lines.
+fn block_lines(spec: &HertzCylinderSpec) -> Result<(Vec<f64>, Vec<f64>), MeshError> {
     let fine = FineZone {
         size: spec.fine_size,
         half_width: spec.fine_half_width,
         growth: spec.growth,
     };
-    let (x, z) = contact_block_lines(spec.block_width / 2.0, spec.block_height, &fine, spec.level)
-        .map_err(|r| spec_error(GENERATOR, "fine_size", r))?;
+    contact_block_lines(spec.block_width / 2.0, spec.block_height, &fine, spec.level)
+        .map_err(|r| spec_error(GENERATOR, "fine_size", r))
+}
+
+/// Cells per direction of every block [`hertz_cylinder`] builds: the block,
+/// the cylinder's core box and its left, bottom and right shell patches.
+fn cell_blocks(x: &[f64], z: &[f64], lines: &ShellLines) -> [[usize; 3]; 5] {
+    let n = |v: &[f64]| v.len().saturating_sub(1);
+    let (side, bottom, radial) = (n(&lines.side), n(&lines.bottom), n(&lines.radial));
+    [
+        [n(x), 1, n(z)],
+        [bottom, 1, side],
+        [side, 1, radial],
+        [bottom, 1, radial],
+        [side, 1, radial],
+    ]
+}
+
+fn block_body(spec: &HertzCylinderSpec, x: Vec<f64>, z: Vec<f64>) -> Result<Mesh, MeshError> {
     let y = vec![0.0, spec.thickness];
     let sides = [
         (Side::IMin, "xmin"),

@@ -4,7 +4,7 @@ use super::blocks::{subset_set, Block, BodyBuilder, Side};
 use super::graded_box::tensor_body;
 use super::o_grid::{core_line, shell_lines, shell_point, tan_exact, ShellInput, ShellLines};
 use super::spacing::{contact_block_lines, FineZone};
-use super::{check_at_least, finalize, spec_error};
+use super::{check_at_least, check_size, finalize, size_field, spec_error};
 use crate::mesh::geometry::Vec3;
 use crate::mesh::{CellType, Mesh, MeshError};
 
@@ -86,19 +86,44 @@ pub fn hertz_sphere(spec: &HertzSphereSpec) -> Result<Mesh, MeshError> {
         growth: spec.growth,
         level: spec.level,
     })?;
-    let block = block_body(spec)?;
+    let (xy, z) = block_lines(spec)?;
+    check_size(
+        GENERATOR,
+        size_field(spec.level),
+        &cell_blocks(&xy, &z, &lines),
+        spec.cell_type,
+    )?;
+    let block = block_body(xy, z, spec)?;
     let sphere = sphere_body(spec, &lines).map_err(|r| spec_error(GENERATOR, "fine_size", r))?;
     finalize(block.merge(sphere)?, spec.cell_type)
 }
 
-fn block_body(spec: &HertzSphereSpec) -> Result<Mesh, MeshError> {
+/// The block's x (= y) and z node lines.
+fn block_lines(spec: &HertzSphereSpec) -> Result<(Vec<f64>, Vec<f64>), MeshError> {
     let fine = FineZone {
         size: spec.fine_size,
         half_width: spec.fine_half_width,
         growth: spec.growth,
     };
-    let (xy, z) = contact_block_lines(spec.block_width / 2.0, spec.block_height, &fine, spec.level)
-        .map_err(|r| spec_error(GENERATOR, "fine_size", r))?;
+    contact_block_lines(spec.block_width / 2.0, spec.block_height, &fine, spec.level)
+        .map_err(|r| spec_error(GENERATOR, "fine_size", r))
+}
+
+/// Cells per direction of every block [`hertz_sphere`] builds: the block,
+/// the sphere's core and its five shell patches (see [`patches`]).
+fn cell_blocks(xy: &[f64], z: &[f64], lines: &ShellLines) -> Vec<[usize; 3]> {
+    let n = |v: &[f64]| v.len().saturating_sub(1);
+    let (side, bottom, radial) = (n(&lines.side), n(&lines.bottom), n(&lines.radial));
+    let mut dims = vec![
+        [n(xy), n(xy), n(z)],
+        [bottom, bottom, side],
+        [bottom, bottom, radial],
+    ];
+    dims.extend([[side, bottom, radial]; 4]);
+    dims
+}
+
+fn block_body(xy: Vec<f64>, z: Vec<f64>, spec: &HertzSphereSpec) -> Result<Mesh, MeshError> {
     let sides = [
         (Side::IMin, "xmin"),
         (Side::IMax, "xmax"),

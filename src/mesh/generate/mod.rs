@@ -55,6 +55,59 @@ pub(crate) fn check_at_least(
     }
 }
 
+/// Most cells a generated mesh may have (after a split into tets).
+pub(crate) const MAX_CELLS: usize = blocks::MAX_CELLS;
+
+/// Most nodes a generated mesh may have: 12 million DOFs. Every rank builds
+/// the whole mesh before the partition, and building is serial: `check` of a
+/// 26.3-million-node hertz-sphere (level 3) took 126 s and 6.9 GB on one
+/// rank before any solver memory. Larger models need a partitioned mesh
+/// reader, not a bigger generator.
+pub(crate) const MAX_NODES: usize = 4_000_000;
+
+/// Refuses a mesh of the structured blocks `dims` (cells per direction)
+/// before anything is allocated: the cell count (×6 when split into tets)
+/// and the point count (an upper bound on the nodes: shared block faces
+/// are fused later) must stay within [`MAX_CELLS`] and [`MAX_NODES`].
+/// `field` is the spec field that sets the size.
+pub(crate) fn check_size(
+    generator: &'static str,
+    field: &str,
+    dims: &[[usize; 3]],
+    cell_type: CellType,
+) -> Result<(), MeshError> {
+    let per_hex = match cell_type {
+        CellType::Hex8 => 1,
+        CellType::Tet4 => 6,
+    };
+    let product = |d: [usize; 3]| d.iter().fold(1usize, |a, &n| a.saturating_mul(n));
+    let sum =
+        |f: &dyn Fn([usize; 3]) -> usize| dims.iter().fold(0usize, |a, &d| a.saturating_add(f(d)));
+    let cells = sum(&|d| product(d).saturating_mul(per_hex));
+    let nodes = sum(&|d| product(d.map(|n| n.saturating_add(1))));
+    if cells <= MAX_CELLS && nodes <= MAX_NODES {
+        return Ok(());
+    }
+    Err(spec_error(
+        generator,
+        field,
+        format!(
+            "the mesh would have {cells} {} cells and up to {nodes} nodes, above the limit of {MAX_CELLS} cells and {MAX_NODES} nodes",
+            cell_type.name()
+        ),
+    ))
+}
+
+/// The spec field to blame for too large a Hertz mesh: the refinement level
+/// when one is given, else the fine element size.
+pub(crate) fn size_field(level: u32) -> &'static str {
+    if level > 0 {
+        "level"
+    } else {
+        "fine_size"
+    }
+}
+
 /// Splits into tets when asked, then checks the result, so every generator
 /// hands out only meshes that pass [`Mesh::validate`].
 pub(crate) fn finalize(mesh: Mesh, cell_type: CellType) -> Result<Mesh, MeshError> {

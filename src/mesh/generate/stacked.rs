@@ -3,7 +3,7 @@
 use super::graded_box::{graded_box, BoxSpec};
 use super::perturb::{perturb_interior, Perturbation};
 use super::spacing::Grading;
-use super::{check_at_least, finalize, spec_error};
+use super::{check_at_least, check_size, finalize, spec_error};
 use crate::mesh::{CellType, Mesh, MeshError};
 
 const GENERATOR: &str = "stacked_blocks";
@@ -68,6 +68,16 @@ pub fn stacked_blocks(spec: &StackedSpec) -> Result<Mesh, MeshError> {
             ));
         }
     }
+    // Both blocks together, before either is built.
+    let field = if spec.lower_divisions.iter().product::<usize>()
+        >= spec.upper_divisions.iter().product::<usize>()
+    {
+        "lower_divisions"
+    } else {
+        "upper_divisions"
+    };
+    let dims = [spec.lower_divisions, spec.upper_divisions];
+    check_size(GENERATOR, field, &dims, spec.cell_type)?;
     let block = |body: &str, z0: f64, divisions: [usize; 3]| {
         graded_box(&BoxSpec {
             body: body.to_string(),
