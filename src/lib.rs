@@ -31,6 +31,7 @@ pub mod results;
 pub mod runtime;
 pub mod scene;
 pub mod solve;
+pub mod vec3;
 pub mod verify;
 
 pub use error::{Error, Result};

@@ -2,7 +2,7 @@
 //! linked slave quadrature point), their search, their contributions to the
 //! residual and tangent, and the Uzawa update of their multipliers.
 use super::dual::{dot, norm, sub};
-use super::link::{self, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
+use super::kernel::{self as link, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
 use super::mortar::pair::MortarPair;
 use super::multipliers::{
     updated_multiplier, FrictionRecord, Multipliers, PointFriction, PointState,

@@ -4,7 +4,7 @@
 //! - `surfaces`: the slave and master sides as one rank sees them;
 //! - `search`: spatial index, outer and inner search;
 //! - `projection`: closest-point projection onto a master facet;
-//! - `link`: the kernel of one link: gap, normal, contact pressure
+//! - `kernel`: the kernel of one link: gap, normal, contact pressure
 //!   pN = ⟨λN − εN gN⟩, Coulomb friction (trial traction, stick/slip, return
 //!   map), residual and consistent tangent;
 //! - `multipliers`: λN and the friction state (λT, slip origin, stick/slip)
@@ -15,7 +15,7 @@
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
 pub mod dual;
-pub mod link;
+pub mod kernel;
 pub mod links;
 pub mod mortar;
 pub mod multipliers;

@@ -12,7 +12,7 @@
 //! this step's slip is measured from, stick/slip, traction and slip), in a
 //! second ghosted vector with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
-use super::link::reference_weights;
+use super::kernel::{contact_pressure, reference_weights};
 use super::surfaces::SlaveSurface;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::{Error, Result};
@@ -23,7 +23,7 @@ use crate::petsc::{GhostedVector, PetscInt};
 /// The Uzawa update of one multiplier: the contact pressure of the converged
 /// Newton solution, pN = ⟨λN − εN gN⟩ (never negative: contact cannot pull).
 pub fn updated_multiplier(lambda: f64, penalty: f64, gap: f64) -> f64 {
-    (lambda - penalty * gap).max(0.0)
+    contact_pressure(lambda, penalty, gap)
 }
 
 /// A quadrature point contribution to a node this rank owns: the point's slot

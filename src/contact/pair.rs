@@ -1,7 +1,7 @@
 //! Contact pairs as a scene states them: which surfaces meet, the penalty, and
 //! the Uzawa tolerances.
 use super::dual::{dot, norm, sub};
-use super::link::Master;
+use super::kernel::Master;
 
 /// A rigid analytic master surface (no DOFs), as given at load factor 0.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]

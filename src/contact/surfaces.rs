@@ -4,7 +4,7 @@
 //! their links. Master facets (of a deformable master) are known to every rank:
 //! their nodes are ghosted on every rank (the master halo), so each rank
 //! searches and evaluates its own slave points without further messages.
-use super::link::reference_weights;
+use super::kernel::reference_weights;
 use crate::dofs::{DofMap, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule};

@@ -293,22 +293,7 @@ pub(crate) mod test_util {
 mod tests {
     use super::test_util::{hex8_unit, perturb, tet4_unit, Lcg};
     use super::*;
-
-    fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-    }
-
-    fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    }
-
-    fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-    }
+    use crate::vec3::{cross, dot, sub};
 
     fn corner_normal(x: &[[f64; 3]]) -> [f64; 3] {
         match x.len() {

@@ -5,40 +5,9 @@ use super::{CellType, FacetRef, Mesh, MeshError};
 // The reference hex's corners are its nodes (VTK order): ξ_i = ±1.
 use crate::fem::shape::HEX8_REF_NODES;
 
-pub(crate) type Vec3 = [f64; 3];
-
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-pub(crate) fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-pub(crate) fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// Determinant of the matrix with columns `a`, `b`, `c`.
-pub(crate) fn triple(a: Vec3, b: Vec3, c: Vec3) -> f64 {
-    dot(cross(a, b), c)
-}
+// The 3-vector helpers live in `crate::vec3`; re-exported for the mesh
+// generators, which import them from here.
+pub(crate) use crate::vec3::{add, cross, dot, norm, scale, sub, triple, Vec3};
 
 /// Mean of a set of points (origin for an empty set).
 pub(crate) fn centroid(points: &[Vec3]) -> Vec3 {

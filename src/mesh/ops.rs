@@ -2,8 +2,8 @@
 
 use std::collections::BTreeMap;
 
-use super::geometry::{add, Vec3};
 use super::{FacetRef, Mesh, MeshError};
+use crate::vec3::{add, Vec3};
 
 impl Mesh {
     /// Appends `other` as further bodies: its node, cell and body ids are

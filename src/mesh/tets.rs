@@ -209,7 +209,7 @@ impl Mesh {
 /// used by the tests to check every split is positively oriented.
 #[cfg(test)]
 pub(crate) fn reference_tet_det(tet: [usize; 4], corners: &[[f64; 3]; 8]) -> f64 {
-    use super::geometry::{sub, triple};
+    use crate::vec3::{sub, triple};
     let d = |k: usize| sub(corners[tet[k]], corners[tet[0]]);
     triple(d(1), d(2), d(3))
 }

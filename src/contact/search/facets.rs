@@ -2,7 +2,8 @@
 //! ones, their nodes and neighbours, and distances to their boundary.
 
 use super::grid::Rows;
-use super::{distance, distance2, dot, is_finite3, sub, MasterSurface};
+use super::{is_finite3, MasterSurface};
+use crate::vec3::{distance, distance2, dot, sub};
 
 /// A facet whose node ids are in range and whose coordinates are finite.
 pub(super) struct UsableFacet {

@@ -62,6 +62,7 @@ mod tests;
 
 use crate::contact::projection::Projection;
 use crate::fem::FacetType;
+use crate::vec3::distance2;
 use facets::{
     facet_neighbours, facet_nodes, facet_size, mean_edge_length, merge_sorted_unique,
     usable_facets, used_nodes,
@@ -590,23 +591,6 @@ fn is_finite3(p: [f64; 3]) -> bool {
 
 fn is_finite2(p: [f64; 2]) -> bool {
     p.iter().all(|v| v.is_finite())
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn distance2(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d = sub(a, b);
-    dot(d, d)
-}
-
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    distance2(a, b).sqrt()
 }
 
 /// Squared distance from `x` to a box (0 inside, +∞ for the empty box).

@@ -2,8 +2,9 @@
 //! (nearest valid projection, ties by facet id).
 
 use super::facets::{boundary_distance, facet_nodes, facet_size};
-use super::{distance, is_finite3, MasterSurface, INSIDE_TOL, PRUNE_REL, TIE_REL};
+use super::{is_finite3, MasterSurface, INSIDE_TOL, PRUNE_REL, TIE_REL};
 use crate::contact::projection::{project, Projection};
+use crate::vec3::distance;
 
 pub(super) struct Candidate {
     pub(super) facet: u32,

@@ -5,6 +5,7 @@ use super::facets::{boundary_distance, facet_size};
 use super::*;
 use crate::contact::projection::project;
 use crate::fem::test_util::Lcg;
+use crate::vec3::distance;
 
 type Mesh = (Vec<[f64; 3]>, Vec<[u32; 4]>);
 

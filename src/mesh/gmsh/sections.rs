@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use super::cursor::{bad_number, capacity, shorten, Cursor};
 use super::kind::{gmsh_type_name, Kind};
 use super::{GmshError, GmshErrorKind, Location};
-use crate::mesh::geometry::Vec3;
+use crate::vec3::Vec3;
 
 /// Elements of one accepted kind, flat.
 #[derive(Debug, Default)]

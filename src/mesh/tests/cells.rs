@@ -1,7 +1,8 @@
 //! Reference-cell conventions.
 
-use crate::mesh::geometry::{centroid, dot, polygon_vector_area, sub, Vec3};
+use crate::mesh::geometry::{centroid, polygon_vector_area};
 use crate::mesh::{CellType, FacetType};
+use crate::vec3::{dot, sub, Vec3};
 
 fn reference_nodes(cell: CellType) -> Vec<Vec3> {
     match cell {

@@ -5,10 +5,10 @@ use std::f64::consts::PI;
 use super::{
     assert_conforming_and_covered, assert_set_normal, assert_sets_outward, body_volume, rel_err,
 };
-use crate::mesh::geometry::{dot, norm, sub};
 use crate::mesh::{
     hertz_cylinder, hertz_sphere, CellType, HertzCylinderSpec, HertzSphereSpec, Mesh, MeshError,
 };
+use crate::vec3::{dot, norm, sub};
 
 const CYLINDER_SURFACE: [&str; 10] = [
     "block.top",

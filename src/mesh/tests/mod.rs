@@ -8,9 +8,9 @@ mod tets;
 
 use std::collections::{BTreeSet, HashMap};
 
-use super::geometry::{dot, sub};
 use super::topology::face_key;
 use super::{FacetRef, Mesh};
+use crate::vec3::{dot, sub};
 
 /// Single unit cube hex at the origin, body `b`, with a facet set per face.
 pub(crate) fn unit_hex() -> Mesh {

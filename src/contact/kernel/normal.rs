@@ -1,0 +1,86 @@
+//! The normal part: the contact pressure pN = ⟨λN − εN gN⟩ (the one place
+//! it is written; the Uzawa update of λN calls [`contact_pressure`] too),
+//! open/closed, and the frictionless state and potential of a link.
+
+use super::evaluate;
+use super::input::{check_input, nodes_as, LinkInput, LinkState, Master};
+use super::kinematics::{rigid_kinematics, slave_point};
+use crate::contact::dual::Scalar;
+use crate::contact::projection;
+
+/// `λN − εN gN`, the augmented normal traction: the link is closed when it
+/// is ≥ 0, and it is then the contact pressure. Generic in the scalar type
+/// so that the dual pass of the tangent differentiates this same expression.
+pub fn trial_pressure<T: Scalar>(lambda_n: f64, penalty: f64, gap: T) -> T {
+    -(gap * penalty) + lambda_n
+}
+
+/// The contact pressure `pN = ⟨λN − εN gN⟩`, never negative (contact cannot
+/// pull). It is also the Uzawa update of the multiplier: λN ← pN.
+pub fn contact_pressure(lambda_n: f64, penalty: f64, gap: f64) -> f64 {
+    trial_pressure(lambda_n, penalty, gap).max(0.0)
+}
+
+/// Gap, normal, pressure and open/closed, without the friction state.
+pub(super) fn evaluate_normal(input: &LinkInput) -> LinkState {
+    if check_input(input).is_err() {
+        return LinkState::invalid();
+    }
+    let slave = nodes_as::<f64>(input.slave_x);
+    let x1 = slave_point(
+        input.slave_facet,
+        input.zeta,
+        &slave[..input.slave_facet.nodes()],
+    );
+    let mut state = match input.master {
+        Master::Facet { facet, x } => {
+            let p = projection::project(facet, x, x1, Some(input.xi_start));
+            LinkState {
+                gap: p.gap,
+                normal: p.normal,
+                xi: p.xi,
+                pressure: 0.0,
+                closed: false,
+                slave_point: x1,
+                master_point: p.point,
+                projection_converged: p.converged,
+                outside: p.outside,
+                friction: None,
+            }
+        }
+        _ => match rigid_kinematics::<f64>(&x1, &input.master) {
+            Some(kin) => LinkState {
+                gap: kin.gap,
+                normal: kin.normal,
+                xi: [0.0; 2],
+                pressure: 0.0,
+                closed: false,
+                slave_point: x1,
+                master_point: kin.master_point,
+                projection_converged: true,
+                outside: 0.0,
+                friction: None,
+            },
+            None => LinkState {
+                slave_point: x1,
+                ..LinkState::invalid()
+            },
+        },
+    };
+    if state.projection_converged {
+        state.closed = trial_pressure(input.lambda_n, input.penalty, state.gap) >= 0.0;
+        state.pressure = contact_pressure(input.lambda_n, input.penalty, state.gap);
+    }
+    state
+}
+
+/// The link potential `Πc = (pN² − λN²)/(2 εN) · w` (0 for bad input). Not
+/// needed by Newton; it is what `r` is the gradient of, for line searches
+/// and consistency checks.
+pub fn potential(input: &LinkInput) -> f64 {
+    if check_input(input).is_err() {
+        return 0.0;
+    }
+    let p = evaluate(input).pressure;
+    (p * p - input.lambda_n * input.lambda_n) / (2.0 * input.penalty) * input.weight
+}
