@@ -990,8 +990,9 @@ impl Scene {
             uzawa_forcing: match s.uzawa_forcing.unwrap_or(d.uzawa_forcing) {
                 f if (0.0..1.0).contains(&f) => f,
                 f => {
-                    return Err(format!(
-                        "[solver] uzawa_forcing must be in [0, 1) (got {f})"
+                    return Err(Bad::at(
+                        &key("uzawa_forcing"),
+                        format!("[solver] uzawa_forcing must be in [0, 1) (got {f})"),
                     ))
                 }
             },

@@ -130,7 +130,7 @@ impl MortarPair {
         for &f in &evaluated {
             let nodes = &slave_facets[f as usize][..nf];
             let x: Vec<[f64; 3]> = nodes.iter().map(|&n| slave.x_ref[n as usize]).collect();
-            let weights = crate::contact::link::reference_weights(facet_type, &x, &rule);
+            let weights = crate::contact::kernel::reference_weights(facet_type, &x, &rule);
             let h = shortest_edge(&x);
             for (zeta, w) in weights {
                 let s = facet_shape(facet_type, zeta);
