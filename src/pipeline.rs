@@ -128,7 +128,7 @@ fn read_restart(
     from: &Path,
     output: Option<&Path>,
     model: &Model,
-) -> Result<crate::restart::RestartState> {
+) -> Result<crate::solve::RestartState> {
     let same = |out: &Path| match (out.canonicalize(), from.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => out == from,
@@ -167,7 +167,7 @@ fn run_model_with(
     output: Option<&Path>,
     printing: Printing,
     provenance: Option<&Provenance>,
-    restart: Option<&crate::restart::RestartState>,
+    restart: Option<&crate::solve::RestartState>,
 ) -> Result<RunSummary> {
     let echo = printing.steps;
     if rt.rank() == 0 {

@@ -11,21 +11,8 @@ use crate::contact::links::{FrictionRows, RestartRows};
 use crate::contact::multipliers::FrictionRecord;
 use crate::error::{Error, Result};
 use crate::output::{read_dataset, read_nodal, read_step_attrs, OutputError};
-use crate::solve::Model;
-use std::path::{Path, PathBuf};
-
-/// What a run continues from.
-#[derive(Debug, Clone)]
-pub struct RestartState {
-    pub path: PathBuf,
-    /// Index of the step continued from; the next one written is `step + 1`.
-    pub step: usize,
-    pub load_factor: f64,
-    /// Natural node order, 3 per node.
-    pub displacement: Vec<f64>,
-    /// Per contact pair of the model, in the model's order.
-    pub pairs: Vec<RestartRows>,
-}
+use crate::solve::{Model, RestartState};
+use std::path::Path;
 
 /// Reads the last step of `path` for `model`.
 pub fn read(path: &Path, model: &Model) -> Result<RestartState> {

@@ -9,6 +9,8 @@
 //!   map), residual and consistent tangent;
 //! - `multipliers`: λN and the friction state (λT, slip origin, stick/slip)
 //!   at the slave points, the Uzawa update rule, halo exchange;
+//! - `outcome`: what a pair's evaluation reports (Uzawa statistics, force),
+//!   shared by both formulations;
 //! - `links`: a pair at run time (search per step, assembly, Uzawa update);
 //! - `mortar`: the mortar formulation (nodal dual multipliers, segment-based
 //!   integration of the slave–master overlap).
@@ -19,10 +21,12 @@ pub mod kernel;
 pub mod links;
 pub mod mortar;
 pub mod multipliers;
+pub mod outcome;
 pub mod pair;
 pub mod projection;
 pub mod search;
 pub mod surfaces;
 
-pub use links::{ContactPair, UzawaStats};
+pub use links::ContactPair;
+pub use outcome::{PairForce, UzawaStats};
 pub use pair::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

@@ -13,12 +13,14 @@ pub mod mechanics;
 pub mod natural;
 pub mod newmark;
 pub mod phases;
+mod restart_state;
 pub mod tolerance;
 
 pub use boundary::{Dirichlet, DirichletSpec};
 pub use dynamics::{DynamicsReport, DynamicsSpec};
 pub use mechanics::Mechanics;
 pub use natural::NaturalOrder;
+pub use restart_state::RestartState;
 
 use crate::assembly::{BulkAssembler, FacetLoad, SurfaceLoads};
 use crate::contact::links::PairForce;
@@ -30,7 +32,6 @@ use crate::mesh::Mesh;
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{self, LogStage, Matrix, PatternBuilder, Snes, SnesOutcome, Vector};
-use crate::restart::RestartState;
 use crate::runtime::Runtime;
 use failure::{failure_text, newton_failure, StepFailure};
 use mpi::traits::*;

@@ -13,7 +13,7 @@
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
 use crate::contact::dual::Dual;
-use crate::contact::links::{PairForce, UzawaStats};
+use crate::contact::outcome::{PairForce, UzawaStats};
 use crate::contact::pair::PairSpec;
 use crate::contact::surfaces::MasterSurface;
 use crate::dofs::{DofMap, LocalNode, DIM};
