@@ -16,7 +16,7 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn mpi_env(cmd: &mut Command) -> &mut Command {
+pub fn mpi_env(cmd: &mut Command) -> &mut Command {
     cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_btl", "self,vader")

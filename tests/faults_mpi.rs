@@ -98,11 +98,7 @@ impl Run {
 fn bounded_run(n: usize, fault: Option<&str>, args: &[&str]) -> Run {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let mut cmd = Command::new("mpirun");
-    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_btl", "self,vader")
-        .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
+    mpi_env(&mut cmd)
         .env_remove("CONTACTLINK_FAULT")
         .args([
             "--allow-run-as-root",
