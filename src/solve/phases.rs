@@ -3,8 +3,11 @@
 //! tables the same way). Linear solve is what SNES spends outside our
 //! residual and Jacobian callbacks (KSP, preconditioner set-up, line search
 //! bookkeeping).
+use crate::contact::ContactPair;
 use crate::error::Result;
+use crate::parallel;
 use crate::petsc::LogStage;
+use mpi::traits::Communicator;
 use std::time::Instant;
 
 /// The phases, in report order.
@@ -83,6 +86,20 @@ impl PhaseTimes {
         }
         d
     }
+
+    /// `self + other`, phase by phase.
+    pub fn plus(&self, other: &PhaseTimes) -> PhaseTimes {
+        let mut t = *self;
+        for (x, y) in t.0.iter_mut().zip(other.0) {
+            *x += y;
+        }
+        t
+    }
+
+    /// Collective: the largest time of each phase over the ranks.
+    pub fn max_over_ranks(self, world: &impl Communicator) -> PhaseTimes {
+        PhaseTimes(parallel::max(world, self.0))
+    }
 }
 
 /// The PETSc stage of every phase (registered once per process).
@@ -113,6 +130,43 @@ impl Stages {
         times.add(p, start.elapsed().as_secs_f64());
         out
     }
+}
+
+/// The start of a phase measured around work that may call the residual or
+/// Jacobian (which book their own phases in `callbacks`) or exchange
+/// multipliers (halo): `book` charges the phase with the rest only, so
+/// nothing counts twice.
+pub struct PhaseMark {
+    start: Instant,
+    callbacks: f64,
+    halo: f64,
+}
+
+impl PhaseMark {
+    pub fn new(callbacks: &PhaseTimes, pairs: &[ContactPair]) -> Self {
+        PhaseMark {
+            start: Instant::now(),
+            callbacks: callbacks.total(),
+            halo: multiplier_halo_seconds(pairs),
+        }
+    }
+
+    pub fn book(
+        self,
+        p: Phase,
+        times: &mut PhaseTimes,
+        callbacks: &PhaseTimes,
+        pairs: &[ContactPair],
+    ) {
+        let halo = multiplier_halo_seconds(pairs) - self.halo;
+        let nested = callbacks.total() - self.callbacks + halo;
+        times.add(p, (self.start.elapsed().as_secs_f64() - nested).max(0.0));
+        times.add(Phase::HaloExchange, halo);
+    }
+}
+
+fn multiplier_halo_seconds(pairs: &[ContactPair]) -> f64 {
+    pairs.iter().map(|p| p.multipliers.exchange_seconds).sum()
 }
 
 #[cfg(test)]

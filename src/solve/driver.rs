@@ -1,0 +1,683 @@
+//! A model's run: `Simulation` (set up once, collectively) and its load
+//! steps. Each attempt at a step: the predictor, the contact search (and a
+//! new Jacobian pattern when the couplings changed), the step's tolerance,
+//! the Uzawa loop; a failed attempt is cut back and retried, a converged
+//! step is reported to the `StepSink` and committed.
+//!
+//! Every function here that calls a collective is called by every rank in
+//! the same order: the branches depend on agreed values only.
+use super::boundary::Dirichlet;
+use super::dynamics::{DynamicsReport, TimeStepper};
+use super::failure::{failure_text, StepFailure};
+use super::lagging::PreconditionerLag;
+use super::mechanics::Mechanics;
+use super::natural::NaturalOrder;
+use super::newmark::Coefficients;
+use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
+use super::predictor::Predictor;
+use super::reactions::{reaction_totals, zero_unconstrained};
+use super::report::{
+    contact_reports, nodal_pressure, print_step, PairFields, RunReport, StepReport, StepSink,
+};
+use super::setup::{self, build_jacobian, force_scale, set_solver_defaults, TangentKind};
+use super::uzawa::{uzawa_loop, StepContext, StepResult};
+use super::{Model, RestartState};
+use crate::assembly::{BulkAssembler, SurfaceLoads};
+use crate::contact::links::{PairSnapshot, PointValues};
+use crate::contact::{ContactPair, PairForce, UzawaStats};
+use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::error::{Error, Result};
+use crate::parallel::{self, fault, fault::FaultPhase};
+use crate::petsc::snes::CallbackError;
+use crate::petsc::{self, LogStage, Matrix, Snes, SnesOutcome, Vector};
+use crate::runtime::Runtime;
+use mpi::topology::SimpleCommunicator;
+use std::time::Instant;
+
+/// A model set up on this rank: partition, numbering, element data, contact
+/// pairs, Jacobian storage. Built collectively by every rank.
+pub struct Simulation<'m> {
+    pub(super) model: &'m Model,
+    pub(super) partition: Vec<i32>,
+    pub(super) dofs: DofMap,
+    pub(super) bulk: BulkAssembler,
+    pub(super) loads: SurfaceLoads,
+    pub(super) dirichlet: Dirichlet,
+    pub(super) contact: Vec<ContactPair>,
+    pub(super) jac: Matrix,
+}
+
+impl<'m> Simulation<'m> {
+    /// Partitions (METIS on rank 0, broadcast), numbers the DOFs, precomputes
+    /// element data, resolves contact pairs and allocates the Jacobian.
+    /// Collective; fails on every rank if it fails on one.
+    pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
+        let stage = LogStage::register("Setup")?;
+        stage.scope(|| setup::setup(rt, model))
+    }
+
+    /// Owning rank of every cell (global, natural order).
+    pub fn partition(&self) -> &[i32] {
+        &self.partition
+    }
+
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    pub fn model(&self) -> &Model {
+        self.model
+    }
+
+    pub fn contact(&self) -> &[ContactPair] {
+        &self.contact
+    }
+
+    /// Runs all load steps, calling `sink` after every converged one.
+    /// Runs the load steps, from the start or (`restart`) from a converged
+    /// step read back from a result file.
+    pub fn run(
+        &mut self,
+        rt: &Runtime,
+        sink: &mut dyn StepSink,
+        echo: bool,
+        restart: Option<&RestartState>,
+    ) -> Result<RunReport> {
+        let started = Instant::now();
+        let world = rt.world();
+        let model = self.model;
+        let stage_solve = LogStage::register("Solve")?;
+        let stages = Stages::register()?;
+        let tangent = setup::tangent_kind(&world, model, &self.loads, &self.contact);
+        set_solver_defaults(&model.solver, tangent, DIM * self.dofs.num_global_nodes())?;
+        let Simulation {
+            dofs,
+            bulk,
+            loads,
+            dirichlet,
+            contact,
+            jac,
+            ..
+        } = self;
+        let parts = Parts {
+            dofs,
+            bulk,
+            loads,
+            dirichlet,
+        };
+        let mut mech = mechanics(model, tangent, parts, contact)?;
+        let stepper = time_stepper(model, &mut mech)?;
+        let (x, first_step, done) = initial_state(&world, mech.dofs, restart, mech.contact)?;
+        let r = x.duplicate()?;
+        let x_prev = x.duplicate()?;
+        let predictor = Predictor::new(&x, model.solver.extrapolate)?;
+        let reaction = x.duplicate()?;
+        let (snes, tolerance) = newton_solver(model)?;
+        let base = 1.0 / model.steps.max(1) as f64;
+        let mut steps = LoadSteps {
+            world,
+            model,
+            mech,
+            jac,
+            stepper,
+            snes,
+            tolerance,
+            x,
+            r,
+            x_prev,
+            reaction,
+            predictor,
+            stage_solve,
+            stages,
+            times: PhaseTimes::default(),
+            pattern_builds: 0,
+            reports: Vec::new(),
+            first_step,
+            done,
+            base,
+            increment: base,
+            cutbacks_here: 0,
+            echo: echo && rt.rank() == 0,
+        };
+        while steps.done < 1.0 - 1e-12 {
+            steps.attempt(sink)?;
+        }
+        steps.finish(started)
+    }
+}
+
+/// The parts of a `Simulation` the residual and Jacobian read.
+struct Parts<'a> {
+    dofs: &'a DofMap,
+    bulk: &'a BulkAssembler,
+    loads: &'a SurfaceLoads,
+    dirichlet: &'a Dirichlet,
+}
+
+/// The residual and Jacobian callbacks of the model, with the
+/// preconditioner watch and the fixed body force b(X) when they apply.
+fn mechanics<'a>(
+    model: &Model,
+    tangent: TangentKind,
+    parts: Parts<'a>,
+    contact: &'a mut [ContactPair],
+) -> Result<Mechanics<'a>> {
+    let Parts {
+        dofs,
+        bulk,
+        loads,
+        dirichlet,
+    } = parts;
+    let mut mech = Mechanics::new(
+        dofs,
+        bulk,
+        loads,
+        dirichlet,
+        contact,
+        model.body_force.clone(),
+        model.solver.reuse.linear_stiffness,
+    )?;
+    // Only with linear bodies is the tangent fixed while the active set
+    // is (a hyperelastic tangent changes every iteration anyway).
+    if !mech.contact.is_empty()
+        && tangent.linear_bulk
+        && model.solver.reuse.preconditioner
+        && model.solver.reuse.active_set
+    {
+        mech.lag = Some(PreconditionerLag::default());
+    }
+    if let Some(b) = &model.body_force_fn {
+        let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
+        bulk.add_body_force_fn(
+            &model.mesh.nodes,
+            |l| dofs.natural(LocalNode(l as usize)).0,
+            b.as_ref(),
+            &mut f,
+        )?;
+        mech.fixed_external = Some(f);
+    }
+    Ok(mech)
+}
+
+/// Implicit dynamics: the time stepper, and the inertia term it hands to
+/// the callbacks (None: quasi-static load stepping).
+fn time_stepper(model: &Model, mech: &mut Mechanics) -> Result<Option<TimeStepper>> {
+    let Some(spec) = &model.dynamics else {
+        return Ok(None);
+    };
+    let (stepper, inertia) =
+        TimeStepper::new(spec, model.steps, &model.mesh, mech.dofs, mech.bulk)?;
+    mech.inertia = Some(inertia);
+    Ok(Some(stepper))
+}
+
+/// Collective: the displacement the run starts from, the index of the last
+/// step done and its load factor: zero, or a restart file's step taken over
+/// (with every pair's multipliers and friction history).
+fn initial_state(
+    world: &SimpleCommunicator,
+    dofs: &DofMap,
+    restart: Option<&RestartState>,
+    pairs: &mut [ContactPair],
+) -> Result<(Vector, usize, f64)> {
+    let mut x = Vector::new_mpi(dofs.num_owned_dofs())?;
+    x.set_block_size(DIM)?;
+    x.set_all(0.0)?;
+    let (first_step, done) = match restart {
+        Some(state) => {
+            parallel::agree(world, state.take_over(dofs, &mut x, pairs))?;
+            (state.step, state.load_factor)
+        }
+        None => (0, 0.0),
+    };
+    Ok((x, first_step, done))
+}
+
+/// How each step's absolute Newton tolerance is found.
+struct StepTolerance {
+    /// The user set `-snes_atol`: it stays for every step.
+    user_atol: bool,
+    /// The smallest absolute tolerance, from the model's force scale.
+    atol_floor: f64,
+}
+
+/// Newton (SNES) with the settings' tolerances, the options applied.
+fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
+    let mut snes = Snes::new()?;
+    let user_atol = petsc::options::has("-snes_atol")?;
+    let atol_floor = 1e-14 * force_scale(model);
+    snes.set_tolerances(
+        model.solver.atol.unwrap_or(atol_floor),
+        model.solver.rtol,
+        0.0,
+        model.solver.max_newton,
+    )?;
+    snes.set_from_options()?;
+    Ok((
+        snes,
+        StepTolerance {
+            user_atol,
+            atol_floor,
+        },
+    ))
+}
+
+/// What an attempt at a step starts from, kept to undo it or report it.
+struct StepStart {
+    clock: Instant,
+    /// Every pair's multipliers and history before the attempt.
+    contact: Vec<PairSnapshot>,
+    /// The Newmark coefficients of the time step (dynamics only).
+    coefficients: Option<Coefficients>,
+    /// The phase times before the attempt.
+    times: PhaseTimes,
+}
+
+/// A converged step's Newton outcome, Uzawa iterations and pair figures.
+type Solved = (SnesOutcome, usize, Vec<UzawaStats>);
+
+/// The load-step loop: the solver state, the converged steps so far, and
+/// the increment with its cutbacks.
+struct LoadSteps<'a> {
+    world: SimpleCommunicator,
+    model: &'a Model,
+    mech: Mechanics<'a>,
+    jac: &'a mut Matrix,
+    stepper: Option<TimeStepper>,
+    snes: Snes,
+    tolerance: StepTolerance,
+    x: Vector,
+    r: Vector,
+    x_prev: Vector,
+    reaction: Vector,
+    predictor: Predictor,
+    stage_solve: LogStage,
+    stages: Stages,
+    /// Phases booked here; the callbacks book theirs in `mech.times`.
+    times: PhaseTimes,
+    pattern_builds: usize,
+    reports: Vec<StepReport>,
+    /// Index of the step the run started after (a restart's step, or 0).
+    first_step: usize,
+    /// Load factor of the last converged step.
+    done: f64,
+    /// The scene's increment, and the current (cut back) one.
+    base: f64,
+    increment: f64,
+    cutbacks_here: usize,
+    /// Print step and cutback lines (rank 0 with `-v`).
+    echo: bool,
+}
+
+impl LoadSteps<'_> {
+    /// One attempt at the next load increment: converged, it is reported
+    /// and committed; failed, it is cut back (or the run fails).
+    fn attempt(&mut self, sink: &mut dyn StepSink) -> Result<()> {
+        let target = (self.done + self.increment).min(1.0);
+        let start = self.begin(target)?;
+        self.search_contact(target)?;
+        let first = self.step_tolerance()?;
+        // A step (or its retry) starts with fresh factors.
+        if let Some(lag) = self.mech.lag.as_mut() {
+            lag.reset();
+        }
+        let attempt = first.map_or_else(|f| Ok(Err(f)), |()| self.solve(target));
+        match attempt? {
+            Ok(solved) => self.accept(sink, solved, start, target),
+            Err(failure) => self.cut_back(failure, start.contact, target),
+        }
+    }
+
+    /// The predictor, the new loads and prescribed displacements at `target`,
+    /// and (dynamics) the time step's set-up.
+    fn begin(&mut self, target: f64) -> Result<StepStart> {
+        let clock = Instant::now();
+        self.x_prev.copy_from(&self.x)?;
+        let contact = self.mech.contact.iter().map(|p| p.snapshot()).collect();
+        self.predictor.extrapolate(&mut self.x, self.done, target)?;
+        self.mech.factor = target;
+        let coefficients = match &mut self.stepper {
+            Some(s) => Some(prepare_time_step(s, &mut self.mech, self.done, target)?),
+            None => None,
+        };
+        let dirichlet = self.mech.dirichlet;
+        self.x.with_array_mut(|xa| dirichlet.apply(xa, target))?;
+        Ok(StepStart {
+            clock,
+            contact,
+            coefficients,
+            times: self.times.plus(&self.mech.times),
+        })
+    }
+
+    /// Collective: the contact search at the predicted state, and a new
+    /// Jacobian pattern when any rank's couplings changed.
+    fn search_contact(&mut self, target: f64) -> Result<()> {
+        if !self.mech.contact.is_empty() {
+            let mark = PhaseMark::new(&self.mech.times, self.mech.contact);
+            let (mech, x) = (&mut self.mech, &self.x);
+            let searched = self.stages.scope(Phase::ContactSearch, || {
+                mech.with_state(x, |u, pairs| {
+                    let changed = pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c);
+                    fault::check(FaultPhase::Search)?;
+                    Ok(changed)
+                })
+            });
+            let changed = parallel::agree(&self.world, searched)?;
+            mark.book(
+                Phase::ContactSearch,
+                &mut self.times,
+                &self.mech.times,
+                self.mech.contact,
+            );
+            let rebuild = !self.model.solver.reuse.pattern || self.pattern_builds == 0;
+            if parallel::any_rank(&self.world, changed) || rebuild {
+                let (mech, mesh) = (&self.mech, &self.model.mesh);
+                // A new coupling pattern is contact assembly's cost.
+                *self.jac = self
+                    .stages
+                    .time(Phase::ContactAssembly, &mut self.times, || {
+                        build_jacobian(mech.dofs, mech.bulk, mech.loads, mech.contact, mesh)
+                    })?;
+                self.pattern_builds += 1;
+            }
+        }
+        Ok(())
+    }
+
+    /// The step's absolute tolerance when no atol is given: rtol times the
+    /// step's own force scale, the residual once the new loads and
+    /// prescribed displacements are in place. That first residual fails
+    /// like any other: into the cutback path.
+    fn step_tolerance(&mut self) -> Result<std::result::Result<(), StepFailure>> {
+        let solver = &self.model.solver;
+        if solver.atol.is_some() || self.tolerance.user_atol {
+            return Ok(Ok(()));
+        }
+        match self.mech.residual_norm(&self.x, &mut self.r) {
+            Ok(r0) => self.snes.set_tolerances(
+                (solver.rtol * r0).max(self.tolerance.atol_floor),
+                solver.rtol,
+                0.0,
+                solver.max_newton,
+            )?,
+            Err(CallbackError::Domain(why)) => return Ok(Err(StepFailure::Residual(why))),
+            Err(CallbackError::Fatal(why)) => {
+                return Err(Error::Petsc(petsc::PetscError {
+                    call: "first residual of a step",
+                    code: -1,
+                    message: why,
+                }))
+            }
+        }
+        Ok(Ok(()))
+    }
+
+    /// The Uzawa loop at `target`, inside the Solve stage.
+    fn solve(&mut self, target: f64) -> Result<StepResult> {
+        let solver = &self.model.solver;
+        let (world, mech) = (&self.world, &mut self.mech);
+        let mut ctx = StepContext {
+            snes: &mut self.snes,
+            x: &mut self.x,
+            r: &mut self.r,
+            jac: &mut *self.jac,
+            stages: &self.stages,
+            times: &mut self.times,
+            reuse_preconditioner: solver.reuse.preconditioner,
+            forcing: solver.uzawa_forcing,
+        };
+        self.stage_solve
+            .scope(|| uzawa_loop(world, &mut ctx, mech, target))
+    }
+
+    /// Collective: a failed attempt goes back to the last converged state
+    /// and halves the increment, or fails the run past `max_cutbacks` or
+    /// below the smallest increment.
+    fn cut_back(
+        &mut self,
+        failure: StepFailure,
+        contact: Vec<PairSnapshot>,
+        target: f64,
+    ) -> Result<()> {
+        if failure.linear_solve_failed() {
+            self.snes.reset_preconditioner()?;
+        }
+        self.x.copy_from(&self.x_prev)?;
+        let restored = self
+            .mech
+            .contact
+            .iter_mut()
+            .zip(contact)
+            .try_for_each(|(p, snap)| p.restore(snap));
+        parallel::agree(&self.world, restored)?;
+        self.cutbacks_here += 1;
+        let max_cutbacks = self.model.solver.max_cutbacks;
+        let mut why = failure_text(&failure);
+        // The count restarts after every converged step, so a
+        // load path stuck at a limit point would creep on with
+        // ever smaller increments: they never go below the
+        // scene's increment halved max_cutbacks times.
+        let smallest = self.base * 0.5f64.powi(max_cutbacks as i32);
+        let too_small = self.increment * 0.5 < smallest * (1.0 - 1e-9);
+        if too_small && self.cutbacks_here <= max_cutbacks {
+            why += &format!(
+                "; the next increment would be below the smallest allowed ({smallest:.3e}: the scene's increment halved max_cutbacks = {max_cutbacks} times)"
+            );
+        }
+        if self.cutbacks_here > max_cutbacks || too_small {
+            return Err(Error::NoConvergence {
+                step: self.first_step + self.reports.len() + 1,
+                load_factor: target,
+                cutbacks: self.cutbacks_here - 1,
+                reason: why,
+            });
+        }
+        self.increment *= 0.5;
+        if self.echo {
+            let increment = self.increment;
+            println!("  cutback: load factor {target:.6} failed ({why}); retrying with increment {increment:.3e}");
+        }
+        Ok(())
+    }
+
+    /// Collective: a converged step advances the predictor and the time
+    /// stepper, goes to the sink, and its contact state is committed.
+    fn accept(
+        &mut self,
+        sink: &mut dyn StepSink,
+        solved: Solved,
+        start: StepStart,
+        target: f64,
+    ) -> Result<()> {
+        self.predictor.accept(&self.x_prev, self.done)?;
+        self.done = target;
+        let dynamics = self.dynamics_report(start.coefficients.as_ref())?;
+        self.output(sink, solved, dynamics, &start)?;
+        let committed = self.mech.contact.iter_mut().try_for_each(|p| p.commit());
+        parallel::agree(&self.world, committed)?;
+        self.cutbacks_here = 0;
+        // Grow back towards the scene's increment after a successful cut step.
+        self.increment = (self.increment * 2.0).min(self.base);
+        Ok(())
+    }
+
+    /// Collective (dynamics): the velocity and acceleration at the converged
+    /// step, and its time, energies and momentum.
+    fn dynamics_report(
+        &mut self,
+        coefficients: Option<&Coefficients>,
+    ) -> Result<Option<DynamicsReport>> {
+        let (Some(s), Some(c)) = (&mut self.stepper, coefficients) else {
+            return Ok(None);
+        };
+        s.advance(&self.x, c)?;
+        let bulk = self.mech.bulk;
+        let strain = parallel::agree(
+            &self.world,
+            self.mech.with_state(&self.x, |u, _| bulk.strain_energy(u)),
+        )?;
+        let time = self.done * s.t_end;
+        let inertia = self
+            .mech
+            .inertia
+            .as_mut()
+            .ok_or_else(|| Error::Internal("dynamics without inertia".into()))?;
+        Ok(Some(s.report(&self.world, inertia, strain, time)?))
+    }
+
+    /// Collective: the converged step's reactions, contact values and
+    /// report, handed to the sink (booked as the output phase).
+    fn output(
+        &mut self,
+        sink: &mut dyn StepSink,
+        (outcome, uzawa_iterations, stats): Solved,
+        dynamics: Option<DynamicsReport>,
+        start: &StepStart,
+    ) -> Result<()> {
+        let output_mark = PhaseMark::new(&self.mech.times, self.mech.contact);
+        let reactions = self.reactions()?;
+        let (fields, forces) = self.point_values()?;
+        let contact = contact_reports(&self.world, self.mech.contact, &forces, &stats);
+        let nodal_pressure = parallel::agree(
+            &self.world,
+            nodal_pressure(self.mech.dofs, self.mech.contact),
+        )?;
+        let mut report = StepReport {
+            index: self.first_step + self.reports.len() + 1,
+            load_factor: self.done,
+            newton_iterations: outcome.iterations,
+            uzawa_iterations,
+            linear_iterations: outcome.linear_iterations,
+            residual_norm: outcome.residual_norm,
+            residual_history: outcome.history.clone(),
+            cutbacks: self.cutbacks_here,
+            wall_seconds: start.clock.elapsed().as_secs_f64(),
+            reactions,
+            contact,
+            dynamics,
+            phases: PhaseTimes::default(),
+        };
+        if self.echo {
+            print_step(&report);
+        }
+        let pair_fields: Vec<PairFields> = self
+            .mech
+            .contact
+            .iter()
+            .zip(fields)
+            .map(|(pair, values)| PairFields { pair, values })
+            .collect();
+        report.phases = self.times.plus(&self.mech.times).since(&start.times);
+        let velocity = self.stepper.as_ref().map(|s| s.velocity());
+        let (x, reaction) = (&self.x, &self.reaction);
+        self.stages.scope(Phase::Output, || {
+            sink.step(
+                &report,
+                x,
+                reaction,
+                &pair_fields,
+                &nodal_pressure,
+                velocity,
+            )
+        })?;
+        drop(pair_fields);
+        output_mark.book(
+            Phase::Output,
+            &mut self.times,
+            &self.mech.times,
+            self.mech.contact,
+        );
+        self.reports.push(report);
+        Ok(())
+    }
+
+    /// Collective: the total reaction of every Dirichlet set, and the
+    /// reaction field (constrained rows only) in `self.reaction`.
+    fn reactions(&mut self) -> Result<Vec<(String, [f64; 3])>> {
+        // In dynamics the support also carries the inertia of its rows.
+        parallel::agree(
+            &self.world,
+            self.mech.raw_residual(&self.x, &mut self.reaction),
+        )?;
+        let dirichlet = self.mech.dirichlet;
+        let start = self.mech.dofs.owned_dof_start();
+        let totals = reaction_totals(&self.world, dirichlet, &self.reaction, start)?;
+        zero_unconstrained(&mut self.reaction, dirichlet)?;
+        Ok(totals)
+    }
+
+    /// Collective: every pair's values at its points and its force.
+    fn point_values(&mut self) -> Result<(Vec<PointValues>, Vec<PairForce>)> {
+        let target = self.done;
+        let values = self.mech.with_state(&self.x, |u, pairs| {
+            let values = pairs
+                .iter_mut()
+                .map(|p| p.point_values(u, target))
+                .collect::<Result<Vec<_>>>()?;
+            Ok(values.into_iter().unzip::<_, PairForce, Vec<_>, Vec<_>>())
+        });
+        parallel::agree(&self.world, values)
+    }
+
+    /// Collective: the run's report, with the final displacement on every
+    /// rank and the phase times and halo volumes over the ranks.
+    fn finish(self, started: Instant) -> Result<RunReport> {
+        let LoadSteps {
+            world,
+            mech,
+            reports,
+            times,
+            pattern_builds,
+            x,
+            ..
+        } = self;
+        let dofs = mech.dofs;
+        let mut natural = NaturalOrder::nodal(dofs)?;
+        let displacement = natural.gather_all(&x)?;
+        Ok(RunReport {
+            steps: reports,
+            global_dofs: DIM * dofs.num_global_nodes(),
+            wall_seconds: started.elapsed().as_secs_f64(),
+            displacement,
+            bulk_tangent_assemblies: mech.bulk_tangent_assemblies,
+            pattern_builds,
+            preconditioner_builds: mech.lag.as_ref().map_or(0, |l| l.rebuilds),
+            preconditioner_reuses: mech.lag.as_ref().map_or(0, |l| l.reuses),
+            phases: times.plus(&mech.times).max_over_ranks(&world),
+            halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
+            halo_multipliers: parallel::sum_usize(
+                &world,
+                [mech
+                    .contact
+                    .iter()
+                    .map(|p| p.multipliers.ghost_values())
+                    .sum()],
+            )[0],
+        })
+    }
+}
+
+/// Sets up one time step from load factor `from` to `to`: the Newmark
+/// coefficients for its Δt, the inertia term, and the slip rate of every
+/// frictional pair.
+fn prepare_time_step(
+    stepper: &mut TimeStepper,
+    mech: &mut Mechanics,
+    from: f64,
+    to: f64,
+) -> Result<Coefficients> {
+    let dt = (to - from) * stepper.t_end;
+    let c = stepper.coefficients(to - from);
+    let inertia = mech
+        .inertia
+        .as_mut()
+        .ok_or_else(|| Error::Internal("dynamics without inertia".into()))?;
+    stepper.prepare(&c, inertia)?;
+    for pair in mech.contact.iter_mut().filter(|p| p.has_friction()) {
+        let (a, b) = (pair.rigid_shift(from), pair.rigid_shift(to));
+        let rigid_velocity = [0, 1, 2].map(|i| (b[i] - a[i]) / dt);
+        pair.rate = Some(stepper.slip_rate(&c, dt, rigid_velocity)?);
+    }
+    Ok(c)
+}

@@ -1,0 +1,242 @@
+//! Setting a model up for the solver, collectively on every rank: the
+//! partition (METIS on rank 0, broadcast), DOF numbering, element data,
+//! contact pairs and the Jacobian's storage (sparsity pattern and rigid-body
+//! near-null space); and the PETSc defaults (Newton's line search, the
+//! linear solver and preconditioner) chosen from the kind of tangent.
+use super::boundary::Dirichlet;
+use super::driver::Simulation;
+use super::{Model, SolverSettings};
+use crate::assembly::{BulkAssembler, SurfaceLoads};
+use crate::contact::{ContactPair, MasterSpec};
+use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::error::{Error, Result};
+use crate::fem::Material;
+use crate::mesh::Mesh;
+use crate::parallel;
+use crate::petsc::{self, Matrix, PatternBuilder, Vector};
+use crate::runtime::Runtime;
+use mpi::traits::*;
+
+/// What the default solver choice depends on.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TangentKind {
+    /// No friction, no follower load: LDLᵀ / CG.
+    pub(super) symmetric: bool,
+    /// Every body linear-elastic: the residual is one matrix-vector product.
+    pub(super) linear_bulk: bool,
+    /// The model has contact pairs.
+    pub(super) contact: bool,
+}
+
+/// Collective: the kind of tangent the model has, the same on every rank.
+pub(super) fn tangent_kind(
+    world: &impl Communicator,
+    model: &Model,
+    loads: &SurfaceLoads,
+    contact: &[ContactPair],
+) -> TangentKind {
+    // Frictionless links keep the tangent symmetric (it is the Hessian
+    // of a potential); friction, mortar pairs and follower loads do not.
+    // A follower load's facets may sit on some ranks only: the choice is
+    // agreed, or the ranks would factor one matrix as LU and LDLᵀ at once.
+    let unsymmetric = contact.iter().any(|p| !p.tangent_is_symmetric());
+    let follower = parallel::any_rank(world, loads.has_follower());
+    let symmetric =
+        !follower && !unsymmetric && model.materials.iter().all(Material::tangent_is_symmetric);
+    TangentKind {
+        symmetric,
+        linear_bulk: model.materials.iter().all(Material::is_linear),
+        contact: !contact.is_empty(),
+    }
+}
+
+/// Sets the program's PETSc defaults; the user's options win.
+pub(super) fn set_solver_defaults(
+    settings: &SolverSettings,
+    tangent: TangentKind,
+    dofs: usize,
+) -> Result<()> {
+    let TangentKind {
+        symmetric,
+        linear_bulk,
+        contact,
+    } = tangent;
+    petsc::options::clear_defaults()?;
+    petsc::options::insert_string_defaults(&settings.petsc_options)?;
+    if linear_bulk {
+        // The secant (l2) line search instead of backtracking: a penalty
+        // contact residual is piecewise smooth, and backtracking keeps
+        // shortening steps that cross a change of the contact set
+        // (hertz-cylinder 23 → 18 Newton iterations, hertz-sphere 26 → 25).
+        // It costs two extra residuals per iteration, cheap only when the
+        // bulk residual is K u − f (ironing, Neo-Hookean: 1479 → 1406
+        // iterations but more time), so nonlinear bodies keep backtracking.
+        petsc::options::set_default("-snes_linesearch_type", "l2")?;
+    }
+    if dofs <= settings.direct_max_dofs {
+        // GMRES around the LU factors: one iteration with fresh factors, a
+        // few with the factors an earlier Uzawa iteration left behind.
+        petsc::options::set_default("-ksp_type", "gmres")?;
+        petsc::options::set_default("-ksp_rtol", "1e-10")?;
+        // A symmetric tangent (no friction, no follower load) factors as
+        // LDLᵀ: about 25 % faster than LU on hertz-cylinder, same answer.
+        petsc::options::set_default("-pc_type", if symmetric { "cholesky" } else { "lu" })?;
+        petsc::options::set_default("-pc_factor_mat_solver_type", "mumps")?;
+        return Ok(());
+    }
+    // CG needs a positive definite matrix. A contact tangent is symmetric
+    // without friction but not definite: its geometric terms (pN times the
+    // master's curvature) go negative where a trial iterate penetrates deeply
+    // (hertz-sphere, 167k DOFs: CG stopped with DIVERGED_INDEFINITE_MAT in
+    // the first Newton iterations and the step was cut back twice; GMRES
+    // converged in 76–176 iterations without a cutback).
+    if symmetric && !contact {
+        petsc::options::set_default("-ksp_type", "cg")?;
+    } else {
+        petsc::options::set_default("-ksp_type", "gmres")?;
+        petsc::options::set_default("-ksp_gmres_restart", "100")?;
+    }
+    petsc::options::set_default("-pc_type", "gamg")?;
+    petsc::options::set_default("-ksp_rtol", "1e-10")?;
+    if contact {
+        // Eisenstat–Walker: each linear solve only as tight as Newton's
+        // progress needs (hertz-sphere h = 0.35, 2 ranks: 977 -> 152 GMRES
+        // iterations for 12 -> 31 Newton iterations, 241 s -> 100 s on a
+        // loaded machine, same Hertz errors). A direct solve gains nothing.
+        petsc::options::set_default("-snes_ksp_ew", "true")?;
+    }
+    petsc::options::set_default("-ksp_max_it", "2000")?;
+    Ok(())
+}
+
+/// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
+pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
+    let world = rt.world();
+    let (rank, size) = (rt.rank(), rt.size());
+    let mesh = &model.mesh;
+    let partition = broadcast_partition(&world, mesh, rank, size)?;
+    let mut master_nodes = Vec::new();
+    for pair in &model.contact {
+        if let MasterSpec::Surface { set } = &pair.master {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh, set,
+            )?);
+        }
+        if pair.formulation == crate::contact::Formulation::Mortar {
+            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+                mesh,
+                &pair.slave,
+            )?);
+        }
+    }
+    let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
+    let bulk = parallel::agree(
+        &world,
+        BulkAssembler::new(mesh, &dofs, model.materials.clone()),
+    )?;
+    let mut facet_loads = Vec::new();
+    for (set, load, amplitude) in &model.facet_loads {
+        let facets = mesh.facet_sets.get(set).ok_or_else(|| {
+            Error::scene(
+                "loads",
+                format!("facet set '{set}' does not exist in the mesh"),
+            )
+        })?;
+        facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
+    }
+    let loads = parallel::agree(&world, SurfaceLoads::new(mesh, &dofs, &facet_loads))?;
+    let dirichlet = parallel::agree(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
+    let softest = model
+        .materials
+        .iter()
+        .map(Material::youngs)
+        .fold(f64::INFINITY, f64::min);
+    let contact = parallel::agree(
+        &world,
+        model
+            .contact
+            .iter()
+            .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest))
+            .collect::<Result<Vec<_>>>(),
+    )?;
+    let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
+    Ok(Simulation {
+        model,
+        partition,
+        dofs,
+        bulk,
+        loads,
+        dirichlet,
+        contact,
+        jac,
+    })
+}
+
+/// METIS runs on rank 0 only; every rank receives its answer, so all agree
+/// on one partition.
+fn broadcast_partition(
+    world: &impl Communicator,
+    mesh: &Mesh,
+    rank: usize,
+    size: usize,
+) -> Result<Vec<i32>> {
+    let mine = if rank == 0 {
+        crate::partition::partition_cells(mesh, size)
+    } else {
+        Ok(Vec::new())
+    };
+    let mut part = parallel::agree(world, mine)?;
+    part.resize(mesh.num_cells(), 0);
+    world.process_at_rank(0).broadcast_into(&mut part[..]);
+    Ok(part)
+}
+
+/// The Jacobian's storage for the current contact couplings: bulk cells,
+/// follower loads and every link's candidate master patch.
+pub(super) fn build_jacobian(
+    dofs: &DofMap,
+    bulk: &BulkAssembler,
+    loads: &SurfaceLoads,
+    contact: &[ContactPair],
+    mesh: &Mesh,
+) -> Result<Matrix> {
+    let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
+    bulk.add_pattern(&mut pattern)?;
+    loads.add_pattern(&mut pattern)?;
+    for pair in contact {
+        pair.add_pattern(dofs, &mut pattern)?;
+    }
+    let mut jac = pattern.build()?;
+    let coords = owned_coordinates(mesh, dofs)?;
+    jac.set_rigid_body_near_null_space(&coords)?;
+    Ok(jac)
+}
+
+/// This rank's owned node coordinates, blocked like the displacement (for
+/// the rigid-body near-null space).
+fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
+    let mut v = Vector::new_mpi(dofs.num_owned_dofs())?;
+    v.set_block_size(DIM)?;
+    v.with_array_mut(|a| {
+        for l in 0..dofs.num_owned_nodes() {
+            let p = mesh.nodes[dofs.natural(LocalNode(l)).0];
+            a[DIM * l..DIM * l + DIM].copy_from_slice(&p);
+        }
+    })?;
+    Ok(v)
+}
+
+/// A force scale for the default absolute tolerance: largest Young's modulus
+/// times the squared size of the model.
+pub(super) fn force_scale(model: &Model) -> f64 {
+    let e = model
+        .materials
+        .iter()
+        .map(Material::youngs)
+        .fold(0.0, f64::max);
+    let l = model
+        .mesh
+        .bounding_box()
+        .map_or(1.0, |b| b.size().into_iter().fold(0.0, f64::max));
+    (e * l * l).max(f64::MIN_POSITIVE)
+}

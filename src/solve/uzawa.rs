@@ -1,0 +1,257 @@
+//! The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with
+//! the multipliers λ fixed, then λ ← ⟨λ − εN gN⟩ at every link, until every
+//! pair's penetration and multiplier change are within its tolerances on
+//! every rank. A pair that converges too slowly has its penalty raised (at
+//! most `PENALTY_RAISES` times a step) before the step counts as failed.
+use super::failure::{newton_failure, StepFailure};
+use super::mechanics::Mechanics;
+use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
+use super::tolerance;
+use crate::contact::{ContactPair, UzawaStats};
+use crate::error::Result;
+use crate::parallel::{self, fault, fault::FaultPhase};
+use crate::petsc::{Matrix, Snes, SnesOutcome, Vector};
+use mpi::traits::*;
+
+/// A step's converged Newton outcome (iterations summed over the Uzawa
+/// iterations), its Uzawa iteration count and each pair's figures, or why
+/// it failed.
+pub(super) type StepResult =
+    std::result::Result<(SnesOutcome, usize, Vec<UzawaStats>), StepFailure>;
+
+/// The solver state one Uzawa loop works on.
+pub(super) struct StepContext<'s> {
+    pub(super) snes: &'s mut Snes,
+    pub(super) x: &'s mut Vector,
+    pub(super) r: &'s mut Vector,
+    pub(super) jac: &'s mut Matrix,
+    pub(super) stages: &'s Stages,
+    pub(super) times: &'s mut PhaseTimes,
+    pub(super) reuse_preconditioner: bool,
+    /// Newton's relative forcing in non-final Uzawa iterations.
+    pub(super) forcing: f64,
+}
+
+/// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
+/// λ ← ⟨λ − εN gN⟩ at every link, until the penetration and the multiplier
+/// change meet the tolerances on every rank (or there is no contact).
+/// Newton iterations are summed over the Uzawa iterations.
+pub(super) fn uzawa_loop(
+    world: &impl Communicator,
+    ctx: &mut StepContext,
+    mech: &mut Mechanics,
+    factor: f64,
+) -> Result<StepResult> {
+    // The options' tolerances are the final ones; non-final solves loosen
+    // them, and every way out restores them for the next step.
+    let (atol, rtol, stol, max_it) = ctx.snes.tolerances()?;
+    let tight = tolerance::NewtonTolerance { atol, rtol };
+    // Friction keeps every solve tight: its Uzawa update classifies stick
+    // and slip from the solved state, and loose states misclassify points
+    // (block-slide: 60 -> 74 Newton, 43 -> 63 Uzawa iterations when loose).
+    let frictional = mech.contact.iter().any(ContactPair::has_friction);
+    let forcing = if mech.contact.is_empty() || frictional {
+        0.0
+    } else {
+        ctx.forcing
+    };
+    let inner = tolerance::InnerTolerance::new(tight, forcing);
+    let result = uzawa_rounds(world, ctx, mech, factor, &inner, (stol, max_it));
+    ctx.snes.set_tolerances(atol, rtol, stol, max_it)?;
+    result
+}
+
+/// The Uzawa iterations of one step, in rounds of at most `max_uzawa`; a
+/// round that ends unconverged raises the slow pairs' penalties and starts
+/// the next, up to `PENALTY_RAISES` times.
+fn uzawa_rounds(
+    world: &impl Communicator,
+    ctx: &mut StepContext,
+    mech: &mut Mechanics,
+    factor: f64,
+    inner: &tolerance::InnerTolerance,
+    (stol, max_it): (f64, usize),
+) -> Result<StepResult> {
+    let StepContext {
+        snes,
+        x,
+        r,
+        jac,
+        stages,
+        times,
+        reuse_preconditioner,
+        ..
+    } = ctx;
+    let reuse_preconditioner = *reuse_preconditioner;
+    let max_uzawa = max_uzawa(mech.contact);
+    let mut newton = 0usize;
+    let mut linear = 0usize;
+    let mut history = Vec::new();
+    let mut k = 0;
+    let mut raises = 0;
+    // Uzawa iterations over every round (k counts within one).
+    let mut total = 0;
+    let mut solve_tight = !inner.is_inexact();
+    loop {
+        k += 1;
+        total += 1;
+        let tol = inner.for_solve(solve_tight);
+        snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
+        // Between Uzawa iterations only λ changes, so the tangent barely
+        // does: keep the preconditioner (the LU factors) of the first solve.
+        snes.set_lag_preconditioner(
+            if k == 1 || mech.contact.is_empty() || !reuse_preconditioner {
+                1
+            } else {
+                -1
+            },
+        )?;
+        let mark = PhaseMark::new(&mech.times, mech.contact);
+        let mut outcome = stages.scope(Phase::LinearSolve, || snes.solve(mech, x, r, jac))?;
+        mark.book(Phase::LinearSolve, times, &mech.times, mech.contact);
+        newton += outcome.iterations;
+        linear += outcome.linear_iterations;
+        history.extend_from_slice(&outcome.history);
+        if !outcome.converged {
+            return Ok(Err(newton_failure(world, mech, x, jac, factor, outcome)?));
+        }
+        if mech.contact.is_empty() {
+            return Ok(Ok((outcome, 0, Vec::new())));
+        }
+        let stats = update_multipliers(world, stages, times, mech, x, factor)?;
+        let converged = mech
+            .contact
+            .iter()
+            .zip(&stats)
+            .all(|(p, s)| pair_converged(p, s));
+        match tolerance::round_end(converged, solve_tight) {
+            tolerance::RoundEnd::Converged => {
+                outcome.iterations = newton;
+                outcome.linear_iterations = linear;
+                outcome.history = history;
+                return Ok(Ok((outcome, total, stats)));
+            }
+            tolerance::RoundEnd::Confirm => {
+                solve_tight = true;
+                continue;
+            }
+            tolerance::RoundEnd::Continue => {}
+        }
+        if k >= max_uzawa && raises < PENALTY_RAISES {
+            // Converging too slowly (soft bodies, long sliding): the
+            // augmented Lagrangian keeps its solution for any penalty and
+            // converges faster with a larger one, so raise it for the pairs
+            // still outside their tolerances and give Uzawa another round.
+            raises += 1;
+            raise_slow_penalties(mech.contact, &stats);
+            k = 0;
+            continue;
+        }
+        if k >= max_uzawa {
+            return Ok(Err(StepFailure::Uzawa {
+                iterations: total,
+                stats: worst(&stats),
+            }));
+        }
+    }
+}
+
+/// Uzawa iterations in one round: the largest any pair allows (at least one).
+fn max_uzawa(pairs: &[ContactPair]) -> usize {
+    pairs
+        .iter()
+        .map(|p| p.spec.max_uzawa)
+        .max()
+        .unwrap_or(1)
+        .max(1)
+}
+
+/// Collective: the multiplier update of every pair at the solved state `x`,
+/// agreed, booked as the Uzawa-update phase, and reduced over the ranks.
+fn update_multipliers(
+    world: &impl Communicator,
+    stages: &Stages,
+    times: &mut PhaseTimes,
+    mech: &mut Mechanics,
+    x: &Vector,
+    factor: f64,
+) -> Result<Vec<UzawaStats>> {
+    let mark = PhaseMark::new(&mech.times, mech.contact);
+    let updated = stages.scope(Phase::UzawaUpdate, || {
+        mech.with_state(x, |u, pairs| {
+            let stats = pairs
+                .iter_mut()
+                .map(|p| p.uzawa_update(u, factor))
+                .collect::<Result<Vec<UzawaStats>>>()?;
+            fault::check(FaultPhase::UzawaUpdate)?;
+            Ok(stats)
+        })
+    });
+    let local = parallel::agree(world, updated)?;
+    mark.book(Phase::UzawaUpdate, times, &mech.times, mech.contact);
+    Ok(reduce_stats(world, &local))
+}
+
+/// The penalty policy: raise the penalty of every pair still outside its
+/// tolerances (the raised penalty stays for the run).
+fn raise_slow_penalties(pairs: &mut [ContactPair], stats: &[UzawaStats]) {
+    for (p, s) in pairs.iter_mut().zip(stats) {
+        if !pair_converged(p, s) {
+            p.raise_penalty(PENALTY_RAISE);
+        }
+    }
+}
+
+/// The figures a failed Uzawa loop reports: maxima and counts over the pairs.
+fn worst(stats: &[UzawaStats]) -> UzawaStats {
+    stats
+        .iter()
+        .copied()
+        .fold(UzawaStats::default(), |a, s| UzawaStats {
+            max_penetration: a.max_penetration.max(s.max_penetration),
+            max_change: a.max_change.max(s.max_change),
+            max_force: a.max_force.max(s.max_force),
+            max_multiplier: a.max_multiplier.max(s.max_multiplier),
+            active: a.active + s.active,
+            sliding: a.sliding + s.sliding,
+        })
+}
+
+/// How often, and by how much, a step may raise a slow pair's penalty
+/// before the Uzawa loop gives up (the raised penalty stays for the run).
+pub(super) const PENALTY_RAISES: usize = 2;
+pub(super) const PENALTY_RAISE: f64 = 10.0;
+
+/// The Uzawa test of one pair: penetration and multiplier change within the
+/// pair's tolerances.
+fn pair_converged(p: &ContactPair, s: &UzawaStats) -> bool {
+    s.max_penetration <= p.spec.penetration_tol
+        && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
+}
+
+/// Collective: each pair's Uzawa figures over all ranks.
+fn reduce_stats(world: &impl Communicator, local: &[UzawaStats]) -> Vec<UzawaStats> {
+    local
+        .iter()
+        .map(|s| {
+            let [max_penetration, max_change, max_force, max_multiplier] = parallel::max(
+                world,
+                [
+                    s.max_penetration,
+                    s.max_change,
+                    s.max_force,
+                    s.max_multiplier,
+                ],
+            );
+            let [active, sliding] = parallel::sum_usize(world, [s.active, s.sliding]);
+            UzawaStats {
+                max_penetration,
+                max_change,
+                max_force,
+                max_multiplier,
+                active,
+                sliding,
+            }
+        })
+        .collect()
+}
