@@ -19,7 +19,9 @@ use super::reactions::{reaction_totals, zero_unconstrained};
 use super::report::{
     contact_reports, nodal_pressure, print_step, PairFields, RunReport, StepReport, StepSink,
 };
-use super::setup::{self, build_jacobian, force_scale, set_solver_defaults, TangentKind};
+use super::setup::{
+    self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance, TangentKind,
+};
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
 use super::{Model, RestartState};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
@@ -73,9 +75,9 @@ impl<'m> Simulation<'m> {
         &self.contact
     }
 
-    /// Runs all load steps, calling `sink` after every converged one.
     /// Runs the load steps, from the start or (`restart`) from a converged
-    /// step read back from a result file.
+    /// step read back from a result file, calling `sink` after every
+    /// converged one.
     pub fn run(
         &mut self,
         rt: &Runtime,
@@ -231,35 +233,6 @@ fn initial_state(
         None => (0, 0.0),
     };
     Ok((x, first_step, done))
-}
-
-/// How each step's absolute Newton tolerance is found.
-struct StepTolerance {
-    /// The user set `-snes_atol`: it stays for every step.
-    user_atol: bool,
-    /// The smallest absolute tolerance, from the model's force scale.
-    atol_floor: f64,
-}
-
-/// Newton (SNES) with the settings' tolerances, the options applied.
-fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
-    let mut snes = Snes::new()?;
-    let user_atol = petsc::options::has("-snes_atol")?;
-    let atol_floor = 1e-14 * force_scale(model);
-    snes.set_tolerances(
-        model.solver.atol.unwrap_or(atol_floor),
-        model.solver.rtol,
-        0.0,
-        model.solver.max_newton,
-    )?;
-    snes.set_from_options()?;
-    Ok((
-        snes,
-        StepTolerance {
-            user_atol,
-            atol_floor,
-        },
-    ))
 }
 
 /// What an attempt at a step starts from, kept to undo it or report it.

@@ -1,8 +1,9 @@
 //! Setting a model up for the solver, collectively on every rank: the
 //! partition (METIS on rank 0, broadcast), DOF numbering, element data,
 //! contact pairs and the Jacobian's storage (sparsity pattern and rigid-body
-//! near-null space); and the PETSc defaults (Newton's line search, the
-//! linear solver and preconditioner) chosen from the kind of tangent.
+//! near-null space); the PETSc defaults (Newton's line search, the linear
+//! solver and preconditioner) chosen from the kind of tangent, and Newton
+//! (SNES) with the settings' tolerances.
 use super::boundary::Dirichlet;
 use super::driver::Simulation;
 use super::{Model, SolverSettings};
@@ -13,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
 use crate::parallel;
-use crate::petsc::{self, Matrix, PatternBuilder, Vector};
+use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
 use crate::runtime::Runtime;
 use mpi::traits::*;
 
@@ -224,6 +225,35 @@ fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
         }
     })?;
     Ok(v)
+}
+
+/// How each step's absolute Newton tolerance is found.
+pub(super) struct StepTolerance {
+    /// The user set `-snes_atol`: it stays for every step.
+    pub(super) user_atol: bool,
+    /// The smallest absolute tolerance, from the model's force scale.
+    pub(super) atol_floor: f64,
+}
+
+/// Newton (SNES) with the settings' tolerances, the options applied.
+pub(super) fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
+    let mut snes = Snes::new()?;
+    let user_atol = petsc::options::has("-snes_atol")?;
+    let atol_floor = 1e-14 * force_scale(model);
+    snes.set_tolerances(
+        model.solver.atol.unwrap_or(atol_floor),
+        model.solver.rtol,
+        0.0,
+        model.solver.max_newton,
+    )?;
+    snes.set_from_options()?;
+    Ok((
+        snes,
+        StepTolerance {
+            user_atol,
+            atol_floor,
+        },
+    ))
 }
 
 /// A force scale for the default absolute tolerance: largest Young's modulus
