@@ -21,6 +21,7 @@ pub mod dofs;
 pub mod error;
 pub mod fem;
 pub mod mesh;
+pub mod model;
 pub mod output;
 pub mod parallel;
 pub mod partition;

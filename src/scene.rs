@@ -4,16 +4,16 @@
 //! body, Dirichlet conditions, loads, load steps, solver options and the
 //! output path. Built-in scenes live in `scenes/` and are compiled in.
 //! Every error names the key (and, for syntax errors, the line).
-use crate::assembly::FacetLoad;
-use crate::contact::{MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
 use crate::error::{Error, Result};
 use crate::fem::{CellType, Material};
 use crate::mesh::generate::{
     self, BoxSpec, Grading, HertzCylinderSpec, HertzSphereSpec, StackedSpec,
 };
 use crate::mesh::Mesh;
-use crate::solve::newmark::Newmark;
-use crate::solve::{DirichletSpec, DynamicsSpec, Model, SolverSettings};
+use crate::model::{
+    DirichletSpec, DynamicsSpec, FacetLoad, Formulation, FrictionSpec, MasterSpec, Model, Newmark,
+    PairSpec, Reuse, RigidSurface, SlaveQuadrature, SolverSettings,
+};
 use crate::verify::{HertzCheck, HertzKind};
 use serde::Deserialize;
 use std::path::Path;
@@ -980,7 +980,7 @@ impl Scene {
             )?,
             direct_max_dofs: s.direct_max_dofs.unwrap_or(d.direct_max_dofs),
             petsc_options,
-            reuse: crate::solve::Reuse {
+            reuse: Reuse {
                 linear_stiffness: s.reuse_linear_stiffness.unwrap_or(d.reuse.linear_stiffness),
                 pattern: s.reuse_pattern.unwrap_or(d.reuse.pattern),
                 preconditioner: s.lag_preconditioner.unwrap_or(d.reuse.preconditioner),
@@ -1343,7 +1343,7 @@ fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Checked<PairSp
             format!("{at}: tangential_penalty is set but friction is not; give friction = μ"),
         ));
     }
-    spec.friction = c.friction.map(|mu| crate::contact::pair::FrictionSpec {
+    spec.friction = c.friction.map(|mu| FrictionSpec {
         mu,
         penalty: tangential_penalty,
     });
@@ -1366,8 +1366,7 @@ fn formulation(
     c: &ContactSection,
     spec: &PairSpec,
     at: &str,
-) -> std::result::Result<crate::contact::Formulation, String> {
-    use crate::contact::Formulation;
+) -> std::result::Result<Formulation, String> {
     let f = match c.formulation.as_deref() {
         None | Some("links") => return Ok(Formulation::Links),
         Some("mortar") => Formulation::Mortar,
