@@ -4,14 +4,14 @@
 //! Each figure is the median of several repetitions, maximised over ranks
 //! (the slowest rank is what the run waits for). Output: CSV on rank 0.
 use contactlink::assembly::BulkAssembler;
-use contactlink::assembly::FacetLoad;
 use contactlink::dofs::{DofMap, DIM};
 use contactlink::fem::Material;
 use contactlink::mesh::generate::{self, BoxSpec};
+use contactlink::model::FacetLoad;
+use contactlink::model::{DirichletSpec, Model, SolverSettings};
 use contactlink::petsc::{GhostedVector, PatternBuilder};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
-use contactlink::solve::{DirichletSpec, Model, SolverSettings};
 use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use std::time::Instant;

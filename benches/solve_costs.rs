@@ -11,9 +11,9 @@
 //! machine's load of the moment as much as two separate runs would.
 //! `SOLVE_COSTS_SPHERE=0` leaves the sphere out, `SOLVE_COSTS_SAVINGS=0`
 //! the reuse table.
+use contactlink::model::Model;
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
-use contactlink::solve::Model;
 use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use std::time::Instant;

@@ -17,15 +17,15 @@
 //! mpirun -n 2 target/release/examples/block_slide 20 out/examples/block_slide.h5
 //! ```
 use contactlink::amplitude::Amplitude;
-use contactlink::assembly::FacetLoad;
-use contactlink::contact::{FrictionSpec, MasterSpec, PairSpec, RigidSurface};
 use contactlink::fem::Material;
 use contactlink::mesh::generate::{graded_box, BoxSpec};
+use contactlink::model::FacetLoad;
+use contactlink::model::{DirichletSpec, Model, SolverSettings};
+use contactlink::model::{FrictionSpec, MasterSpec, PairSpec, RigidSurface};
 use contactlink::output::{read_nodal, read_step_attrs};
 use contactlink::pipeline;
 use contactlink::results::{open_steps, PairPoints};
 use contactlink::runtime::Runtime;
-use contactlink::solve::{DirichletSpec, Model, SolverSettings};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

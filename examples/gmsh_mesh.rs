@@ -16,12 +16,12 @@
 //! Another MESH.msh (format 4.1) works when it has the same physical names:
 //! volumes `block` and `sphere`, surfaces `block.bottom`, `block.top`,
 //! `sphere.top` and `sphere.curved`.
-use contactlink::contact::{MasterSpec, PairSpec, SlaveQuadrature};
 use contactlink::fem::{FacetType, Material};
 use contactlink::mesh::{read_gmsh, Mesh};
+use contactlink::model::{DirichletSpec, Model, SolverSettings};
+use contactlink::model::{MasterSpec, PairSpec, SlaveQuadrature};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
-use contactlink::solve::{DirichletSpec, Model, SolverSettings};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -16,13 +16,13 @@
 //! FINE_SIZE is the element size in the contact zone (default 0.25, about a
 //! second; the built-in `hertz-cylinder` scene uses 0.1). With OUT.h5 the
 //! result file is written (`examples/plot_pressure.py` plots it).
-use contactlink::contact::{MasterSpec, PairSpec};
 use contactlink::fem::Material;
 use contactlink::mesh::generate::{hertz_cylinder, HertzCylinderSpec};
 use contactlink::mesh::Mesh;
+use contactlink::model::{DirichletSpec, Model, SolverSettings};
+use contactlink::model::{MasterSpec, PairSpec};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
-use contactlink::solve::{DirichletSpec, Model, SolverSettings};
 use contactlink::verify::{effective_modulus, HertzCheck, HertzKind};
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -1,13 +1,11 @@
 //! `contactlink check SCENE`: validate a scene and describe what a run would
 //! solve (bodies, conditions, loads, contact pairs, steps), without MPI or
 //! PETSc, so a scene can be checked before a long run is queued.
-use crate::assembly::FacetLoad;
-use crate::contact::MasterSpec;
 use crate::error::Result;
 use crate::fem::Material;
 use crate::mesh::Mesh;
+use crate::model::{FacetLoad, MasterSpec, Model};
 use crate::scene::{self, MeshReport, SceneSource};
-use crate::solve::Model;
 
 /// A scene's model, its output path and what reading its mesh found.
 pub struct Checked {

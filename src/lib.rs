@@ -10,6 +10,8 @@
 //!      ──► output (parallel HDF5 + XDMF)
 //! ```
 //!
+//! `model` is the problem as plain data between `scene` and `solve` (a program
+//! may build it in code instead of reading a scene).
 //! `parallel` is where rank-local outcomes become one decision of all ranks.
 //! `pipeline` strings these together for one run; `petsc` and `runtime` are
 //! the only places that touch C libraries directly.
@@ -21,6 +23,7 @@ pub mod dofs;
 pub mod error;
 pub mod fem;
 pub mod mesh;
+pub mod model;
 pub mod output;
 pub mod parallel;
 pub mod partition;

@@ -3,13 +3,14 @@
 use crate::dofs::even_block;
 use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::model::Model;
 use crate::output::paths::{check_not_input, Input};
 use crate::output::{BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
 use crate::solve::phases::Phase;
-use crate::solve::{Model, NaturalOrder, PairFields, RunReport, Simulation, StepReport, StepSink};
+use crate::solve::{NaturalOrder, PairFields, RunReport, Simulation, StepReport, StepSink};
 use crate::verify::{HertzCheck, HertzComparison, HertzKind};
 use mpi::traits::{Communicator, CommunicatorCollectives};
 use std::collections::BTreeMap;

@@ -10,8 +10,9 @@
 use crate::contact::links::{FrictionRows, RestartRows};
 use crate::contact::multipliers::FrictionRecord;
 use crate::error::{Error, Result};
+use crate::model::Model;
 use crate::output::{read_dataset, read_nodal, read_step_attrs, OutputError};
-use crate::solve::{Model, RestartState};
+use crate::solve::RestartState;
 use std::path::Path;
 
 /// Reads the last step of `path` for `model`.

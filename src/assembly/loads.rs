@@ -5,16 +5,8 @@ use crate::dofs::{DofMap, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
 use crate::mesh::{FacetRef, Mesh};
+use crate::model::FacetLoad;
 use crate::petsc::{Matrix, PatternBuilder, PetscInt};
-
-/// One load on a facet set, at full load factor.
-#[derive(Debug, Clone)]
-pub enum FacetLoad {
-    /// Pressure p > 0 pushes into the body, normal to the deformed facet.
-    Pressure(f64),
-    /// Force per unit reference area, fixed in direction.
-    Traction([f64; 3]),
-}
 
 struct LocalFacet {
     /// Natural id of the cell the facet belongs to (for error messages).

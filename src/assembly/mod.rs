@@ -9,7 +9,7 @@ pub mod bulk;
 pub mod loads;
 
 pub use bulk::BulkAssembler;
-pub use loads::{FacetLoad, SurfaceLoads};
+pub use loads::SurfaceLoads;
 
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::petsc::PetscInt;

@@ -8,12 +8,12 @@ use super::multipliers::{
     updated_multiplier, FrictionRecord, Multipliers, PointFriction, PointState,
 };
 pub use super::outcome::{PairForce, UzawaStats};
-use super::pair::{Formulation, MasterSpec, PairSpec, RigidSurface};
 use super::search::{self, SearchIndex};
 use super::surfaces::{MasterSurface, SlaveSurface};
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::model::{Formulation, MasterSpec, PairSpec, RigidSurface};
 use crate::petsc::{BlockSink, PatternBuilder, PetscInt};
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};

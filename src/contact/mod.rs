@@ -1,6 +1,5 @@
 //! Contact: the ContactLink3D condition (docs/formulation.md §2–§5, §9).
 //!
-//! - `pair`: what a scene says about a pair;
 //! - `surfaces`: the slave and master sides as one rank sees them;
 //! - `search`: spatial index, outer and inner search;
 //! - `projection`: closest-point projection onto a master facet;
@@ -22,11 +21,9 @@ pub mod links;
 pub mod mortar;
 pub mod multipliers;
 pub mod outcome;
-pub mod pair;
 pub mod projection;
 pub mod search;
 pub mod surfaces;
 
 pub use links::ContactPair;
 pub use outcome::{PairForce, UzawaStats};
-pub use pair::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};

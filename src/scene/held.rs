@@ -4,9 +4,8 @@
 //! slave of a pair with a rigid master, or when a contact pair joins it to
 //! a body that is held (transitively). Contact between two bodies that
 //! nothing holds does not hold either of them: together they still float.
-use crate::contact::{MasterSpec, PairSpec};
 use crate::mesh::Mesh;
-use crate::solve::DirichletSpec;
+use crate::model::{DirichletSpec, MasterSpec, PairSpec};
 
 /// What holds nothing: the bodies (indices, ascending) of the first group
 /// joined by contact in which no body is held.
@@ -111,8 +110,8 @@ impl Groups {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::RigidSurface;
     use crate::mesh::generate::{graded_box, stacked_blocks, BoxSpec, StackedSpec};
+    use crate::model::RigidSurface;
 
     fn fixed(mesh: &Mesh, set: &str) -> DirichletSpec {
         DirichletSpec::uniform(set, mesh.node_sets[set].clone(), vec![0, 1, 2], [0.0; 3])

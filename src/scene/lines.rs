@@ -1,6 +1,6 @@
 //! Where a scene key was written, for error messages.
 //!
-//! The serde structs of `scene.rs` keep no spans, and wrapping every field in
+//! The serde structs of `sections.rs` keep no spans, and wrapping every field in
 //! `toml::Spanned` would change every struct and every use. Errors are rare,
 //! so instead the scene text is parsed a second time, with `toml_edit`'s
 //! span-keeping `ImDocument`, only when an error needs its line.

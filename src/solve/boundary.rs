@@ -2,34 +2,8 @@
 use crate::amplitude::Amplitude;
 use crate::dofs::{DofMap, NaturalNode, DIM};
 use crate::error::{Error, Result};
+use crate::model::DirichletSpec;
 use std::collections::BTreeMap;
-
-/// One Dirichlet condition: a node set, the components it fixes, and their
-/// displacement at full load (ramped with the load factor), per node.
-#[derive(Debug, Clone)]
-pub struct DirichletSpec {
-    pub set: String,
-    pub nodes: Vec<usize>,
-    pub components: Vec<usize>,
-    /// Full-load displacement of each node in `nodes` (only `components` used).
-    pub values: Vec<[f64; 3]>,
-    /// How the values follow the load factor (default: linear ramp).
-    pub amplitude: Amplitude,
-}
-
-impl DirichletSpec {
-    /// The same displacement for every node of the set.
-    pub fn uniform(set: &str, nodes: Vec<usize>, components: Vec<usize>, value: [f64; 3]) -> Self {
-        let values = vec![value; nodes.len()];
-        DirichletSpec {
-            set: set.to_owned(),
-            nodes,
-            components,
-            values,
-            amplitude: Amplitude::ramp(),
-        }
-    }
-}
 
 /// A constrained DOF this rank owns.
 #[derive(Debug, Clone, Copy)]

@@ -23,12 +23,13 @@ use super::setup::{
     self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance, TangentKind,
 };
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
-use super::{Model, RestartState};
+use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::links::{PairSnapshot, PointValues};
 use crate::contact::{ContactPair, PairForce, UzawaStats};
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
+use crate::model::Model;
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{self, LogStage, Matrix, Snes, SnesOutcome, Vector};

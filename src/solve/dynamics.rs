@@ -7,25 +7,15 @@
 //! integrator makes affine in `u` (`v = γ/(βΔt) u + …`): the links get that
 //! map ([`SlipRateMap`]) and their tangent then carries the friction damping
 //! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
-use super::newmark::{Coefficients, Newmark};
+use super::newmark::Coefficients;
 use crate::assembly::BulkAssembler;
 use crate::contact::links::SlipRateMap;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::model::DynamicsSpec;
 use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
 use mpi::traits::*;
-
-/// What a scene says about dynamics.
-#[derive(Debug, Clone)]
-pub struct DynamicsSpec {
-    pub time_step: f64,
-    pub newmark: Newmark,
-    /// Mass density of each body (indexed like `mesh.bodies`).
-    pub density: Vec<f64>,
-    /// Initial velocity of each body.
-    pub initial_velocity: Vec<[f64; 3]>,
-}
 
 /// The inertia term of the current step: `M (a_u u + offset)` with
 /// `offset = a_v v_n + a_a a_n − a_u u_n`.
@@ -128,7 +118,7 @@ impl TimeStepper {
     }
 
     pub fn coefficients(&self, load_increment: f64) -> Coefficients {
-        self.spec.newmark.coefficients(load_increment * self.t_end)
+        Coefficients::new(&self.spec.newmark, load_increment * self.t_end)
     }
 
     /// Sets the inertia term for a step with coefficients `c`.

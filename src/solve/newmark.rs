@@ -25,81 +25,7 @@
 //! can rise by a tiny amount in single steps; it is non-increasing only over
 //! whole oscillations. Energy-balance checks should use `Ê`.
 
-/// Newmark-β in displacement form.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Newmark {
-    pub beta: f64,
-    pub gamma: f64,
-}
-
-impl Newmark {
-    /// `β = ¼, γ = ½`: the average-acceleration (trapezoidal) rule.
-    pub fn trapezoidal() -> Self {
-        Newmark {
-            beta: 0.25,
-            gamma: 0.5,
-        }
-    }
-
-    /// `β = (γ + ½)² / 4`: for a given `γ > ½` the choice that maximises
-    /// high-frequency damping while staying unconditionally stable (it is
-    /// `2β ≥ γ` with equality only at `γ = ½`).
-    pub fn with_dissipation(gamma: f64) -> Self {
-        Newmark {
-            beta: (gamma + 0.5).powi(2) / 4.0,
-            gamma,
-        }
-    }
-
-    /// Accepts only the unconditionally stable range `2β ≥ γ ≥ ½`,
-    /// `0 < β ≤ ½`: an implicit contact solve takes steps far beyond any
-    /// explicit stability limit, and `β = 0` (explicit) has no displacement
-    /// form at all since `a(u)` carries `1/β`.
-    pub fn validate(&self) -> Result<(), String> {
-        let Newmark { beta, gamma } = *self;
-        if !beta.is_finite() || beta <= 0.0 || beta > 0.5 {
-            return Err(format!("Newmark beta = {beta}: must be in (0, 1/2]"));
-        }
-        if !gamma.is_finite() || gamma < 0.5 {
-            return Err(format!(
-                "Newmark gamma = {gamma}: must be finite and >= 1/2"
-            ));
-        }
-        // A few ulps of slack: `with_dissipation(γ)` has 2β − γ = (γ − ½)²/2,
-        // which rounding can push just below zero for γ within 1e-8 of ½.
-        if 2.0 * beta - gamma < -4.0 * f64::EPSILON {
-            return Err(format!(
-                "Newmark beta = {beta}, gamma = {gamma}: beta must be >= gamma/2 for \
-                 unconditional stability"
-            ));
-        }
-        Ok(())
-    }
-
-    /// Rejects time steps that would make the coefficients non-finite.
-    pub fn validate_dt(dt: f64) -> Result<(), String> {
-        if dt.is_finite() && dt > 0.0 {
-            Ok(())
-        } else {
-            Err(format!("time step dt = {dt}: must be finite and > 0"))
-        }
-    }
-
-    /// The affine maps `a(u)`, `v(u)` for a step of length `dt`. Call
-    /// [`Newmark::validate`] and [`Newmark::validate_dt`] first: invalid
-    /// parameters give non-finite or meaningless coefficients, not a panic.
-    pub fn coefficients(&self, dt: f64) -> Coefficients {
-        let Newmark { beta, gamma } = *self;
-        Coefficients {
-            a_u: 1.0 / (beta * dt * dt),
-            a_v: -1.0 / (beta * dt),
-            a_a: 1.0 - 1.0 / (2.0 * beta),
-            v_u: gamma / (beta * dt),
-            v_v: 1.0 - gamma / beta,
-            v_a: dt * (1.0 - gamma / (2.0 * beta)),
-        }
-    }
-}
+use crate::model::Newmark;
 
 /// End-of-step acceleration and velocity as affine functions of the
 /// end-of-step displacement `u`, given the previous state `(u_n, v_n, a_n)`:
@@ -129,6 +55,21 @@ pub struct Coefficients {
 }
 
 impl Coefficients {
+    /// The affine maps `a(u)`, `v(u)` for a step of length `dt`. Call
+    /// [`Newmark::validate`] and [`Newmark::validate_dt`] first: invalid
+    /// parameters give non-finite or meaningless coefficients, not a panic.
+    pub fn new(newmark: &Newmark, dt: f64) -> Self {
+        let Newmark { beta, gamma } = *newmark;
+        Coefficients {
+            a_u: 1.0 / (beta * dt * dt),
+            a_v: -1.0 / (beta * dt),
+            a_a: 1.0 - 1.0 / (2.0 * beta),
+            v_u: gamma / (beta * dt),
+            v_v: 1.0 - gamma / beta,
+            v_a: dt * (1.0 - gamma / (2.0 * beta)),
+        }
+    }
+
     /// `a(u)` for one entry.
     pub fn acceleration(&self, u: f64, u_n: f64, v_n: f64, a_n: f64) -> f64 {
         self.a_u * (u - u_n) + self.a_v * v_n + self.a_a * a_n
@@ -267,7 +208,7 @@ mod tests {
         let (u_n, v_n, a_n, u) = (0.3, -1.2, 4.5, 0.29);
         for nm in [Newmark::trapezoidal(), Newmark::with_dissipation(0.65)] {
             let Newmark { beta, gamma } = nm;
-            let c = nm.coefficients(dt);
+            let c = Coefficients::new(&nm, dt);
             let a = c.acceleration(u, u_n, v_n, a_n);
             let v = c.velocity(u, u_n, v_n, a_n);
             // The textbook form: u from (u_n, v_n, a_n, a), v from (v_n, a_n, a).
@@ -290,7 +231,7 @@ mod tests {
 
     #[test]
     fn slice_versions_match_scalars_and_check_lengths() {
-        let c = Newmark::with_dissipation(0.6).coefficients(0.1);
+        let c = Coefficients::new(&Newmark::with_dissipation(0.6), 0.1);
         let u = [1.0, 2.0, -3.0];
         let u_n = [0.5, 2.5, -2.0];
         let v_n = [0.1, -0.2, 0.3];
@@ -320,7 +261,7 @@ mod tests {
         // A coarse step (ωΔt = 0.5) and a huge one (ωΔt = 20): conservation
         // is exact for any Δt, not a small-step property.
         for dt in [0.5 / omega, 20.0 / omega] {
-            let c = nm.coefficients(dt);
+            let c = Coefficients::new(&nm, dt);
             let mut s = released(m, k);
             let e0 = energy(m, k, s);
             let mut worst = 0.0f64;
@@ -342,7 +283,7 @@ mod tests {
         let (m, k) = (1.0, 4.0 * PI * PI); // period 1
         let omega = (k / m).sqrt();
         let dt = 1.0 / steps_per_period as f64;
-        let c = Newmark::trapezoidal().coefficients(dt);
+        let c = Coefficients::new(&Newmark::trapezoidal(), dt);
         let mut s = released(m, k);
         for _ in 0..steps_per_period * n_periods {
             s = step(&c, m, k, s);
@@ -376,7 +317,7 @@ mod tests {
         nm.validate().unwrap();
         for steps_per_period in [20.0, 7.0, 0.3] {
             let dt = 1.0 / steps_per_period;
-            let c = nm.coefficients(dt);
+            let c = Coefficients::new(&nm, dt);
             let mut s = released(m, k);
             let e0 = energy(m, k, s);
             let mut prev_hat = algorithmic_energy(&nm, dt, m, k, s);
@@ -413,7 +354,7 @@ mod tests {
         let (m, k) = (1.0, 4.0 * PI * PI);
         let nm = Newmark::with_dissipation(0.6);
         let steps_per_period = 20;
-        let c = nm.coefficients(1.0 / steps_per_period as f64);
+        let c = Coefficients::new(&nm, 1.0 / steps_per_period as f64);
         let mut s = released(m, k);
         let mut prev = energy(m, k, s);
         for period in 0..50 {
@@ -439,7 +380,7 @@ mod tests {
     /// through `γ/(βΔt)` into the velocity.
     fn two_mass_momentum_drift(nm: Newmark, from_increment: bool) -> f64 {
         let (m1, m2, k) = (1.5, 0.4, 30.0);
-        let c = nm.coefficients(0.05);
+        let c = Coefficients::new(&nm, 0.05);
         // Stretched spring plus a drift, so the momentum is not zero.
         let mut u = [0.0, 0.3];
         let mut v = [1.0, -0.5];

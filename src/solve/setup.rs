@@ -6,13 +6,14 @@
 //! (SNES) with the settings' tolerances.
 use super::boundary::Dirichlet;
 use super::driver::Simulation;
-use super::{Model, SolverSettings};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
-use crate::contact::{ContactPair, MasterSpec};
+use crate::contact::ContactPair;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
+use crate::model::MasterSpec;
+use crate::model::{Model, SolverSettings};
 use crate::parallel;
 use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
 use crate::runtime::Runtime;
@@ -123,7 +124,7 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
                 mesh, set,
             )?);
         }
-        if pair.formulation == crate::contact::Formulation::Mortar {
+        if pair.formulation == crate::model::Formulation::Mortar {
             master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
                 mesh,
                 &pair.slave,

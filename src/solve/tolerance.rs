@@ -17,10 +17,6 @@
 //! are kept and Newton runs once more to the final tolerance, followed by
 //! the usual update and test: the step's answer is as tight as before.
 
-/// The default `[solver] uzawa_forcing`: a non-final Newton solve stops
-/// at 1e-3 of its starting residual.
-pub const DEFAULT_FORCING: f64 = 1e-3;
-
 /// SNES's stopping rule for one Newton solve: |R| ≤ max(atol, rtol·|R0|).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonTolerance {

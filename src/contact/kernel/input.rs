@@ -8,6 +8,7 @@ use thiserror::Error;
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+use crate::model::RigidSurface;
 
 /// The master side of a link.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +26,27 @@ pub enum Master<'a> {
         axis: [f64; 3],
         radius: f64,
     },
+}
+
+// The scene's rigid surface is plain data in `model`; its view as a link
+// master belongs beside `Master`, which `model` must not know.
+impl RigidSurface {
+    /// The link kernel's view of the surface.
+    pub fn as_master(&self) -> Master<'static> {
+        match *self {
+            RigidSurface::Plane { point, normal } => Master::Plane { point, normal },
+            RigidSurface::Sphere { centre, radius } => Master::Sphere { centre, radius },
+            RigidSurface::Cylinder {
+                point,
+                axis,
+                radius,
+            } => Master::Cylinder {
+                point,
+                axis,
+                radius,
+            },
+        }
+    }
 }
 
 /// Where slip is measured from, and the tangential multiplier λT (held

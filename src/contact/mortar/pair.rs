@@ -14,12 +14,12 @@ use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
-use crate::contact::pair::PairSpec;
 use crate::contact::surfaces::MasterSurface;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
 use crate::mesh::Mesh;
+use crate::model::PairSpec;
 use crate::petsc::{BlockSink, PatternBuilder, PetscInt};
 
 /// The nodal fields the output writes, one entry per owned mesh node of

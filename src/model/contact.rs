@@ -1,7 +1,9 @@
-//! Contact pairs as a scene states them: which surfaces meet, the penalty, and
-//! the Uzawa tolerances.
-use super::dual::{dot, norm, sub};
-use super::kernel::Master;
+//! Contact pairs as a scene states them: which surfaces meet (facet sets or
+//! rigid analytic surfaces), the formulation, the penalty, friction and the
+//! Uzawa tolerances. The pair at run time is `contact::links`.
+use crate::amplitude::Amplitude;
+use crate::fem::{FacetType, QuadRule};
+use crate::vec3::{dot, norm, sub};
 
 /// A rigid analytic master surface (no DOFs), as given at load factor 0.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
@@ -23,7 +25,7 @@ impl RigidSurface {
     /// Why the surface is unusable, if it is.
     pub fn validate(&self) -> Result<(), String> {
         let nonzero = |v: [f64; 3], key: &str| {
-            let n = norm(&v);
+            let n = norm(v);
             if n > 0.0 && n.is_finite() {
                 Ok(())
             } else {
@@ -76,37 +78,20 @@ impl RigidSurface {
         }
     }
 
-    /// The link kernel's view of the surface.
-    pub fn as_master(&self) -> Master<'static> {
-        match *self {
-            RigidSurface::Plane { point, normal } => Master::Plane { point, normal },
-            RigidSurface::Sphere { centre, radius } => Master::Sphere { centre, radius },
-            RigidSurface::Cylinder {
-                point,
-                axis,
-                radius,
-            } => Master::Cylinder {
-                point,
-                axis,
-                radius,
-            },
-        }
-    }
-
     /// The point of the surface nearest `x` (for a surface placed by `moved`;
     /// `x` itself where the nearest point is not unique).
     pub fn closest_point(&self, x: [f64; 3]) -> [f64; 3] {
         let d = self.distance(x);
         let n = match *self {
             RigidSurface::Plane { normal, .. } => normal,
-            RigidSurface::Sphere { centre, .. } => sub(&x, &centre),
+            RigidSurface::Sphere { centre, .. } => sub(x, centre),
             RigidSurface::Cylinder { point, axis, .. } => {
-                let v = sub(&x, &point);
-                let along = dot(&v, &axis);
-                sub(&v, &axis.map(|a| along * a))
+                let v = sub(x, point);
+                let along = dot(v, axis);
+                sub(v, axis.map(|a| along * a))
             }
         };
-        let len = norm(&n);
+        let len = norm(n);
         if len.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return x;
         }
@@ -117,23 +102,23 @@ impl RigidSurface {
     /// for a surface placed by `moved`.
     pub fn distance(&self, x: [f64; 3]) -> f64 {
         match *self {
-            RigidSurface::Plane { point, normal } => dot(&sub(&x, &point), &normal),
-            RigidSurface::Sphere { centre, radius } => norm(&sub(&x, &centre)) - radius,
+            RigidSurface::Plane { point, normal } => dot(sub(x, point), normal),
+            RigidSurface::Sphere { centre, radius } => norm(sub(x, centre)) - radius,
             RigidSurface::Cylinder {
                 point,
                 axis,
                 radius,
             } => {
-                let d = sub(&x, &point);
-                let along = dot(&d, &axis);
-                norm(&sub(&d, &axis.map(|a| along * a))) - radius
+                let d = sub(x, point);
+                let along = dot(d, axis);
+                norm(sub(d, axis.map(|a| along * a))) - radius
             }
         }
     }
 }
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
-    let n = norm(&v);
+    let n = norm(v);
     [v[0] / n, v[1] / n, v[2] / n]
 }
 
@@ -170,14 +155,15 @@ pub enum SlaveQuadrature {
 }
 
 impl SlaveQuadrature {
-    pub fn rule(self, facet: crate::fem::FacetType) -> crate::fem::QuadRule {
+    pub fn rule(self, facet: FacetType) -> QuadRule {
         match self {
-            SlaveQuadrature::Nodal => crate::fem::QuadRule::nodal_for_facet(facet),
-            SlaveQuadrature::Gauss => crate::fem::QuadRule::default_for_facet(facet),
+            SlaveQuadrature::Nodal => QuadRule::nodal_for_facet(facet),
+            SlaveQuadrature::Gauss => QuadRule::default_for_facet(facet),
             SlaveQuadrature::Centroid => match facet {
-                crate::fem::FacetType::Quad4 => crate::fem::QuadRule::quad_gauss(1)
-                    .unwrap_or_else(|_| crate::fem::QuadRule::quad_2x2()),
-                crate::fem::FacetType::Tri3 => crate::fem::QuadRule::tri_1(),
+                FacetType::Quad4 => {
+                    QuadRule::quad_gauss(1).unwrap_or_else(|_| QuadRule::quad_2x2())
+                }
+                FacetType::Tri3 => QuadRule::tri_1(),
             },
         }
     }
@@ -196,13 +182,10 @@ pub enum Formulation {
 
 impl Formulation {
     /// Whether the formulation handles slave and master facets of this type.
-    pub fn supports(self, facet: crate::fem::FacetType) -> bool {
+    pub fn supports(self, facet: FacetType) -> bool {
         match self {
             Formulation::Links => true,
-            Formulation::Mortar => matches!(
-                facet,
-                crate::fem::FacetType::Quad4 | crate::fem::FacetType::Tri3
-            ),
+            Formulation::Mortar => matches!(facet, FacetType::Quad4 | FacetType::Tri3),
         }
     }
 }
@@ -228,7 +211,7 @@ pub struct PairSpec {
     /// Translation of a rigid master at full amplitude ...
     pub motion: [f64; 3],
     /// ... and how it follows the load factor (default: a linear ramp).
-    pub motion_amplitude: crate::amplitude::Amplitude,
+    pub motion_amplitude: Amplitude,
     /// εN; None: 10·E/h with E the softest body's modulus and h the mean slave facet size.
     pub penalty: Option<f64>,
     /// Uzawa stops when every link's penetration is at most this fraction of its facet's size ...
@@ -259,7 +242,7 @@ impl PairSpec {
             formulation: Formulation::default(),
             quadrature: SlaveQuadrature::default(),
             motion: [0.0; 3],
-            motion_amplitude: crate::amplitude::Amplitude::ramp(),
+            motion_amplitude: Amplitude::ramp(),
             penalty: None,
             penetration_tol: 1e-3,
             multiplier_tol: 1e-3,
