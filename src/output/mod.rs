@@ -62,16 +62,22 @@
 mod collective;
 mod fingerprint;
 mod header;
+mod history_csv;
 pub mod paths;
 mod reader;
+mod result_sink;
+mod tee;
 mod writer;
 pub mod xdmf;
 
 use std::path::{Path, PathBuf};
 
+pub use history_csv::HistoryCsv;
 pub use reader::{
     list_steps, read_dataset, read_f64_attr, read_nodal, read_step_attrs, read_string_attr,
 };
+pub use result_sink::{create_result_file, Hdf5Sink, Provenance};
+pub use tee::Tee;
 pub use writer::ResultFile;
 
 /// One rank's contiguous block `[start, start + data.len() / cols)` of the rows
