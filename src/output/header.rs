@@ -4,20 +4,20 @@ use std::path::Path;
 
 use super::collective::to_h5_string;
 use super::xdmf::{self, MeshDesc};
-use super::{check_name, facet_nodes, CellKind, MeshHeader, OutputError};
+use super::{check_name, facet_nodes, layout, CellKind, MeshHeader, OutputError};
 
 /// What the XDMF writer needs, after all local checks of the header.
 pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc, OutputError> {
     let invalid = |object: &str, reason: String| Err(OutputError::invalid(path, object, reason));
     let Some(kind) = CellKind::parse(mesh.cell_type) else {
         return invalid(
-            "/mesh/cells",
+            layout::MESH_CELLS,
             format!("cell_type '{}' is not hex8 or tet4", mesh.cell_type),
         );
     };
     let Some(facet_k) = facet_nodes(mesh.facet_type) else {
         return invalid(
-            "/mesh/facet_sets",
+            layout::MESH_FACET_SETS,
             format!("facet_type '{}' is not quad4 or tri3", mesh.facet_type),
         );
     };
@@ -25,13 +25,13 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
     let n_cells = mesh.cells.global_rows;
     if mesh.nodes.cols != 3 {
         return invalid(
-            "/mesh/nodes",
+            layout::MESH_NODES,
             format!("has {} columns, expected 3", mesh.nodes.cols),
         );
     }
     if mesh.cells.cols != kind.nodes() {
         return invalid(
-            "/mesh/cells",
+            layout::MESH_CELLS,
             format!(
                 "has {} columns, {} cells have {}",
                 mesh.cells.cols,
@@ -41,8 +41,8 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
         );
     }
     for (object, b) in [
-        ("/mesh/partition", &mesh.partition),
-        ("/mesh/cell_body", &mesh.cell_body),
+        (layout::MESH_PARTITION, &mesh.partition),
+        (layout::MESH_CELL_BODY, &mesh.cell_body),
     ] {
         if b.cols != 1 || b.global_rows != n_cells {
             return invalid(
@@ -70,7 +70,7 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
         .find(|&&id| usize::try_from(id).map_or(true, |i| i >= n_nodes))
     {
         return invalid(
-            "/mesh/cells",
+            layout::MESH_CELLS,
             format!("node id {bad} is outside 0..{n_nodes}"),
         );
     }
@@ -82,26 +82,26 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
         .find(|&&b| usize::try_from(b).map_or(true, |i| i >= n_bodies))
     {
         return invalid(
-            "/mesh/cell_body",
+            layout::MESH_CELL_BODY,
             format!("body index {bad} is outside 0..{n_bodies} (the bodies list)"),
         );
     }
     if let Some(bad) = mesh.partition.data.iter().find(|&&r| r < 0) {
-        return invalid("/mesh/partition", format!("negative rank {bad}"));
+        return invalid(layout::MESH_PARTITION, format!("negative rank {bad}"));
     }
     for body in mesh.bodies {
-        to_h5_string(path, "/mesh/cell_body", body)?;
+        to_h5_string(path, layout::MESH_CELL_BODY, body)?;
     }
 
     for (name, ids) in mesh.node_sets {
-        let object = format!("/mesh/node_sets/{name}");
+        let object = layout::node_set(name);
         check_name(path, &object, name)?;
         if let Some(bad) = ids.iter().find(|&&i| i >= n_nodes) {
             return invalid(&object, format!("node id {bad} is outside 0..{n_nodes}"));
         }
     }
     for (name, fs) in mesh.facet_sets {
-        let object = format!("/mesh/facet_sets/{name}");
+        let object = layout::facet_set(name);
         check_name(path, &object, name)?;
         let f = fs.cell.len();
         if fs.k != facet_k {

@@ -63,6 +63,7 @@ mod collective;
 mod fingerprint;
 mod header;
 mod history_csv;
+pub mod layout;
 pub mod paths;
 mod reader;
 mod result_sink;
@@ -241,10 +242,7 @@ impl OutputError {
     }
 }
 
-/// The group name of step `index`: six digits, zero-padded.
-pub fn step_group_name(index: usize) -> String {
-    format!("{index:06}")
-}
+pub use layout::step_group_name;
 
 /// Element kinds this module can describe to XDMF; the string is the
 /// `cell_type` attribute value.

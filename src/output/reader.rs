@@ -6,7 +6,7 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 use hdf5::{File, H5Type};
 
-use super::{step_group_name, OutputError, StepInfo};
+use super::{layout, OutputError, StepInfo};
 
 fn open(path: &Path) -> Result<File, OutputError> {
     File::open(path).map_err(|source| OutputError::Open {
@@ -37,7 +37,7 @@ pub fn read_nodal(
     step: usize,
     name: &str,
 ) -> Result<(Vec<f64>, usize, usize), OutputError> {
-    let object = format!("/steps/{}/{name}", step_group_name(step));
+    let object = layout::step_dataset(step, name);
     let (data, shape) = read_dataset::<f64>(path, &object)?;
     match shape[..] {
         [rows] => Ok((data, rows, 1)),
@@ -54,14 +54,18 @@ pub fn read_nodal(
 pub fn list_steps(path: &Path) -> Result<Vec<usize>, OutputError> {
     let file = open(path)?;
     let names = file
-        .group("steps")
+        .group(layout::STEPS_NAME)
         .and_then(|g| g.member_names())
-        .map_err(|e| OutputError::hdf5(path, "/steps", "list", e))?;
+        .map_err(|e| OutputError::hdf5(path, layout::STEPS, "list", e))?;
     let mut steps = names
         .iter()
         .map(|n| {
             n.parse::<usize>().map_err(|_| {
-                OutputError::invalid(path, &format!("/steps/{n}"), "is not a step index")
+                OutputError::invalid(
+                    path,
+                    &format!("{}/{n}", layout::STEPS),
+                    "is not a step index",
+                )
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
@@ -123,7 +127,7 @@ pub fn read_f64_attr(path: &Path, object: &str, name: &str) -> Result<Option<f64
 
 /// The attributes of `/steps/<NNNNNN>` as a [`StepInfo`].
 pub fn read_step_attrs(path: &Path, step: usize) -> Result<StepInfo, OutputError> {
-    let object = format!("/steps/{}", step_group_name(step));
+    let object = layout::step_group(step);
     let file = open(path)?;
     let g = file
         .group(&object)
@@ -137,15 +141,15 @@ pub fn read_step_attrs(path: &Path, step: usize) -> Result<StepInfo, OutputError
     };
     Ok(StepInfo {
         index: step,
-        time: f64_attr("time")?,
-        load_factor: f64_attr("load_factor")?,
-        newton_iterations: count("newton_iterations")?,
-        uzawa_iterations: count("uzawa_iterations")?,
+        time: f64_attr(layout::TIME_ATTR)?,
+        load_factor: f64_attr(layout::LOAD_FACTOR_ATTR)?,
+        newton_iterations: count(layout::NEWTON_ATTR)?,
+        uzawa_iterations: count(layout::UZAWA_ATTR)?,
         converged: g
-            .attr("converged")
+            .attr(layout::CONVERGED_ATTR)
             .and_then(|a| a.read_scalar::<u8>())
             .map_err(h)?
             != 0,
-        wall_seconds: f64_attr("wall_seconds")?,
+        wall_seconds: f64_attr(layout::WALL_SECONDS_ATTR)?,
     })
 }

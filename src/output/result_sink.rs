@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::{BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
+use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::dofs::even_block;
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -73,32 +73,35 @@ impl Hdf5Sink {
         let name = &fields.pair.spec.name;
         let v = &fields.values;
         let flat = |a: &[[f64; 3]]| -> Vec<f64> { a.iter().flatten().copied().collect() };
-        let mut vectors = vec![("points", flat(&v.points))];
+        let mut vectors = vec![(layout::PAIR_POINTS, flat(&v.points))];
         let mut scalars = vec![
-            ("pressure", v.pressure.clone()),
-            ("gap", v.gap.clone()),
-            ("lambda_n", v.lambda.clone()),
-            ("weight", v.weight.clone()),
+            (layout::PAIR_PRESSURE, v.pressure.clone()),
+            (layout::PAIR_GAP, v.gap.clone()),
+            (layout::PAIR_LAMBDA_N, v.lambda.clone()),
+            (layout::PAIR_WEIGHT, v.weight.clone()),
         ];
         // Decided by the pair, not by this rank's points: a rank may own no
         // slave point, and every rank must write the same datasets.
         if fields.pair.has_friction() {
-            vectors.push(("traction_t", flat(&v.traction)));
-            vectors.push(("slip", flat(&v.slip)));
+            vectors.push((layout::PAIR_TRACTION_T, flat(&v.traction)));
+            vectors.push((layout::PAIR_SLIP, flat(&v.slip)));
             // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
-            scalars.push(("state", v.state.iter().map(|&s| f64::from(s)).collect()));
+            scalars.push((
+                layout::PAIR_STATE,
+                v.state.iter().map(|&s| f64::from(s)).collect(),
+            ));
             // The friction history, so `run --restart` continues exactly.
             let records = &v.records;
             vectors.push((
-                "lambda_t",
+                layout::PAIR_LAMBDA_T,
                 flat(&records.iter().map(|r| r.lambda).collect::<Vec<_>>()),
             ));
             vectors.push((
-                "slip_origin",
+                layout::PAIR_SLIP_ORIGIN,
                 flat(&records.iter().map(|r| r.origin).collect::<Vec<_>>()),
             ));
             vectors.push((
-                "history_ids",
+                layout::PAIR_HISTORY_IDS,
                 flat(&records.iter().map(|r| r.ids).collect::<Vec<_>>()),
             ));
         }
@@ -117,7 +120,7 @@ impl Hdf5Sink {
             let (start, data) = scatter.block_of_owned(values)?;
             self.file.write_step_block(
                 step,
-                &format!("contact/{name}/{label}"),
+                &layout::pair_dataset(name, label),
                 BlockRows {
                     global_rows: rows,
                     start,
@@ -130,12 +133,15 @@ impl Hdf5Sink {
             self.write_mortar_nodes(step, name, m)?;
         }
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
-        self.file
-            .write_step_small(step, &format!("contact/{name}/force"), &force)?;
+        self.file.write_step_small(
+            step,
+            &layout::pair_dataset(name, layout::PAIR_FORCE),
+            &force,
+        )?;
         // The pair's penalty (raised when Uzawa was slow), for a restart.
         self.file.write_step_small(
             step,
-            &format!("contact/{name}/penalty"),
+            &layout::pair_dataset(name, layout::PAIR_PENALTY),
             &[fields.pair.penalty],
         )?;
         Ok(())
@@ -153,9 +159,9 @@ impl Hdf5Sink {
     ) -> Result<()> {
         let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
         for (label, cols, values) in [
-            ("node_lambda", 1, &m.lambda),
-            ("node_weighted_gap", 1, &m.weighted_gap),
-            ("node_traction", 3, &traction),
+            (layout::PAIR_NODE_LAMBDA, 1, &m.lambda),
+            (layout::PAIR_NODE_WEIGHTED_GAP, 1, &m.weighted_gap),
+            (layout::PAIR_NODE_TRACTION, 3, &traction),
         ] {
             let order = if cols == 3 {
                 &mut self.natural
@@ -165,7 +171,7 @@ impl Hdf5Sink {
             let (start, data) = order.block_of_owned(values)?;
             self.file.write_step_block(
                 step,
-                &format!("contact/{name}/{label}"),
+                &layout::pair_dataset(name, label),
                 BlockRows {
                     global_rows: self.nodes,
                     start,
@@ -206,9 +212,12 @@ impl StepSink for Hdf5Sink {
             cols: 3,
             data,
         };
-        let mut fields = vec![("displacement", nodal(&u)), ("reaction", nodal(&r))];
+        let mut fields = vec![
+            (layout::DISPLACEMENT, nodal(&u)),
+            (layout::REACTION, nodal(&r)),
+        ];
         if let Some((_, v)) = &v {
-            fields.push(("velocity", nodal(v)));
+            fields.push((layout::VELOCITY, nodal(v)));
         }
         let p = if contact.is_empty() {
             None
@@ -217,7 +226,7 @@ impl StepSink for Hdf5Sink {
         };
         if let Some((pstart, p)) = &p {
             fields.push((
-                "contact_pressure",
+                layout::CONTACT_PRESSURE,
                 BlockRows {
                     global_rows: self.nodes,
                     start: *pstart,
@@ -229,9 +238,9 @@ impl StepSink for Hdf5Sink {
         self.file.write_step(&info, &fields, &[])?;
         if let Some(d) = &report.dynamics {
             self.file
-                .write_step_small(report.index, "energy", &[d.kinetic, d.strain])?;
+                .write_step_small(report.index, layout::ENERGY, &[d.kinetic, d.strain])?;
             self.file
-                .write_step_small(report.index, "momentum", &d.momentum)?;
+                .write_step_small(report.index, layout::MOMENTUM, &d.momentum)?;
         }
         for (i, fields) in contact.iter().enumerate() {
             self.write_pair(report.index, i, fields, report)?;
@@ -304,7 +313,10 @@ pub fn create_result_file(
         let overrides = p.overrides.join("\n");
         file.write_attributes(
             "/",
-            &[("scene", &p.scene), ("scene_overrides", &overrides)],
+            &[
+                (layout::SCENE_ATTR, &p.scene),
+                (layout::SCENE_OVERRIDES_ATTR, &overrides),
+            ],
             &[],
         )?;
     }
@@ -316,7 +328,7 @@ pub fn create_result_file(
             .iter()
             .map(|p| (p.name.as_str(), p.slave.as_str()))
             .collect();
-        file.write_attributes("/contact_pairs", &slaves, &[])?;
+        file.write_attributes(layout::CONTACT_PAIRS, &slaves, &[])?;
     }
     if let Some(h) = &model.hertz {
         write_hertz_setup(&mut file, h)?;
@@ -336,7 +348,11 @@ fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
         ("effective_modulus", h.effective_modulus),
     ];
     numbers.extend(thickness.map(|t| ("thickness", t)));
-    file.write_attributes("/hertz", &[("kind", kind), ("pair", &h.pair)], &numbers)?;
+    file.write_attributes(
+        layout::HERTZ,
+        &[("kind", kind), ("pair", &h.pair)],
+        &numbers,
+    )?;
     Ok(())
 }
 

@@ -12,6 +12,7 @@ use mpi::traits::{AsRaw, Communicator};
 use super::collective::{attr_scalar, attr_string, to_h5_string, to_i64, Coll};
 use super::fingerprint::{header_fingerprint, step_fingerprint, Fingerprint};
 use super::header::validate_header;
+use super::layout;
 use super::xdmf::{self, Center, FieldDesc, MeshDesc, StepDesc};
 use super::{check_name, step_group_name, BlockRows, MeshHeader, OutputError, StepInfo};
 
@@ -52,8 +53,8 @@ impl ResultFile {
     ) -> Result<Self, OutputError> {
         let comm = comm.duplicate();
         let coll = Coll { comm: &comm, path };
-        let desc = coll.agree("/mesh", validate_header(path, mesh))?;
-        coll.same_everywhere("/mesh", header_fingerprint(mesh))?;
+        let desc = coll.agree(layout::MESH, validate_header(path, mesh))?;
+        coll.same_everywhere(layout::MESH, header_fingerprint(mesh))?;
 
         let created = File::with_options()
             .with_fapl(|p| p.mpio(comm.as_raw(), None))
@@ -90,27 +91,43 @@ impl ResultFile {
         let c = self.coll();
         let p = c.path;
         let root: &Group = &self.file;
-        let gmesh = c.open_or_create_group(root, "/mesh", "mesh")?;
-        let gnode_sets = c.open_or_create_group(&gmesh, "/mesh/node_sets", "node_sets")?;
-        let gfacet_sets = c.open_or_create_group(&gmesh, "/mesh/facet_sets", "facet_sets")?;
-        c.open_or_create_group(root, "/steps", "steps")?;
+        let gmesh = c.open_or_create_group(root, layout::MESH, layout::MESH_NAME)?;
+        let gnode_sets =
+            c.open_or_create_group(&gmesh, layout::MESH_NODE_SETS, layout::NODE_SETS)?;
+        let gfacet_sets =
+            c.open_or_create_group(&gmesh, layout::MESH_FACET_SETS, layout::FACET_SETS)?;
+        c.open_or_create_group(root, layout::STEPS, layout::STEPS_NAME)?;
 
         let n_nodes = self.mesh.n_nodes;
         let n_cells = self.mesh.n_cells;
-        c.write_block(&gmesh, "/mesh", "nodes", &mesh.nodes, false, Some(n_nodes))?;
-        c.write_block(&gmesh, "/mesh", "cells", &mesh.cells, false, Some(n_cells))?;
         c.write_block(
             &gmesh,
-            "/mesh",
-            "partition",
+            layout::MESH,
+            layout::NODES,
+            &mesh.nodes,
+            false,
+            Some(n_nodes),
+        )?;
+        c.write_block(
+            &gmesh,
+            layout::MESH,
+            layout::CELLS,
+            &mesh.cells,
+            false,
+            Some(n_cells),
+        )?;
+        c.write_block(
+            &gmesh,
+            layout::MESH,
+            layout::PARTITION,
             &mesh.partition,
             true,
             Some(n_cells),
         )?;
         c.write_block(
             &gmesh,
-            "/mesh",
-            "cell_body",
+            layout::MESH,
+            layout::CELL_BODY,
             &mesh.cell_body,
             true,
             Some(n_cells),
@@ -118,51 +135,57 @@ impl ResultFile {
 
         let attrs = (|| {
             let cells = gmesh
-                .dataset("cells")
-                .map_err(|e| OutputError::hdf5(p, "/mesh/cells", "open", e))?;
+                .dataset(layout::CELLS)
+                .map_err(|e| OutputError::hdf5(p, layout::MESH_CELLS, "open", e))?;
             attr_string(
                 p,
                 &cells,
-                "/mesh/cells",
-                "cell_type",
+                layout::MESH_CELLS,
+                layout::CELL_TYPE_ATTR,
                 self.mesh.cell_kind.name(),
             )?;
             let body = gmesh
-                .dataset("cell_body")
-                .map_err(|e| OutputError::hdf5(p, "/mesh/cell_body", "open", e))?;
+                .dataset(layout::CELL_BODY)
+                .map_err(|e| OutputError::hdf5(p, layout::MESH_CELL_BODY, "open", e))?;
             let names = mesh
                 .bodies
                 .iter()
-                .map(|b| to_h5_string(p, "/mesh/cell_body", b))
+                .map(|b| to_h5_string(p, layout::MESH_CELL_BODY, b))
                 .collect::<Result<Vec<_>, _>>()?;
             body.new_attr::<VarLenUnicode>()
                 .shape([names.len()])
-                .create("bodies")
+                .create(layout::BODIES_ATTR)
                 .and_then(|a| a.write_raw(&names))
                 .map_err(|e| {
-                    OutputError::hdf5(p, "/mesh/cell_body", "write attribute 'bodies' of", e)
+                    OutputError::hdf5(p, layout::MESH_CELL_BODY, "write attribute 'bodies' of", e)
                 })
         })();
-        c.agree("/mesh/cells", attrs)?;
+        c.agree(layout::MESH_CELLS, attrs)?;
 
         for (name, ids) in mesh.node_sets {
-            let object = format!("/mesh/node_sets/{name}");
+            let object = layout::node_set(name);
             let ids = c.agree(
                 &object,
                 ids.iter()
                     .map(|&i| to_i64(p, &object, i))
                     .collect::<Result<Vec<_>, _>>(),
             )?;
-            c.write_root(&gnode_sets, "/mesh/node_sets", name, &[ids.len()], &ids)?;
+            c.write_root(
+                &gnode_sets,
+                layout::MESH_NODE_SETS,
+                name,
+                &[ids.len()],
+                &ids,
+            )?;
         }
         for (name, fs) in mesh.facet_sets {
-            let object = format!("/mesh/facet_sets/{name}");
+            let object = layout::facet_set(name);
             let g = c.open_or_create_group(&gfacet_sets, &object, name)?;
             let f = fs.cell.len();
-            c.write_root(&g, &object, "nodes", &[f, fs.k], &fs.nodes)?;
-            c.write_root(&g, &object, "cell", &[f], &fs.cell)?;
-            c.write_root(&g, &object, "face", &[f], &fs.face)?;
-            let a = attr_string(p, &g, &object, "cell_type", mesh.facet_type);
+            c.write_root(&g, &object, layout::FACET_NODES, &[f, fs.k], &fs.nodes)?;
+            c.write_root(&g, &object, layout::FACET_CELL, &[f], &fs.cell)?;
+            c.write_root(&g, &object, layout::FACET_FACE, &[f], &fs.face)?;
+            let a = attr_string(p, &g, &object, layout::CELL_TYPE_ATTR, mesh.facet_type);
             c.agree(&object, a)?;
         }
         Ok(())
@@ -183,7 +206,7 @@ impl ResultFile {
         cell: &[(&str, BlockRows<f64>)],
     ) -> Result<(), OutputError> {
         let group = step_group_name(info.index);
-        let gpath = format!("/steps/{group}");
+        let gpath = layout::step_group(info.index);
         let c = self.coll();
         let p = c.path;
         let checked = self.check_step(&gpath, info, nodal, cell).and_then(|()| {
@@ -217,9 +240,9 @@ impl ResultFile {
 
         let gsteps = self
             .file
-            .group("steps")
-            .map_err(|e| OutputError::hdf5(p, "/steps", "open group", e));
-        let gsteps = c.agree("/steps", gsteps)?;
+            .group(layout::STEPS_NAME)
+            .map_err(|e| OutputError::hdf5(p, layout::STEPS, "open group", e));
+        let gsteps = c.agree(layout::STEPS, gsteps)?;
         let g = gsteps
             .create_group(&group)
             .map_err(|e| OutputError::hdf5(p, &gpath, "create group", e));
@@ -229,12 +252,12 @@ impl ResultFile {
                 let h = |e| OutputError::hdf5(p, &gpath, "write attributes of", e);
                 let newton = to_i64(p, &gpath, info.newton_iterations)?;
                 let uzawa = to_i64(p, &gpath, info.uzawa_iterations)?;
-                attr_scalar(&g, "time", &info.time).map_err(h)?;
-                attr_scalar(&g, "load_factor", &info.load_factor).map_err(h)?;
-                attr_scalar(&g, "newton_iterations", &newton).map_err(h)?;
-                attr_scalar(&g, "uzawa_iterations", &uzawa).map_err(h)?;
-                attr_scalar(&g, "converged", &u8::from(info.converged)).map_err(h)?;
-                attr_scalar(&g, "wall_seconds", &wall).map_err(h)
+                attr_scalar(&g, layout::TIME_ATTR, &info.time).map_err(h)?;
+                attr_scalar(&g, layout::LOAD_FACTOR_ATTR, &info.load_factor).map_err(h)?;
+                attr_scalar(&g, layout::NEWTON_ATTR, &newton).map_err(h)?;
+                attr_scalar(&g, layout::UZAWA_ATTR, &uzawa).map_err(h)?;
+                attr_scalar(&g, layout::CONVERGED_ATTR, &u8::from(info.converged)).map_err(h)?;
+                attr_scalar(&g, layout::WALL_SECONDS_ATTR, &wall).map_err(h)
             })();
             c.agree(&gpath, attrs)?;
             for (object, name, block, _, layout) in &layouts {
@@ -297,7 +320,7 @@ impl ResultFile {
                 ));
             }
         }
-        for required in ["displacement", "reaction"] {
+        for required in [layout::DISPLACEMENT, layout::REACTION] {
             match nodal.iter().find(|(n, _)| *n == required) {
                 Some((_, b)) if b.cols == 3 => {}
                 Some((_, b)) => {
@@ -422,7 +445,7 @@ impl ResultFile {
         let c = self.coll();
         let p = c.path;
         let group = step_group_name(step);
-        let object = format!("/steps/{group}/{rel_path}");
+        let object = layout::step_dataset(step, rel_path);
         let mut dirs: Vec<String> = rel_path.split('/').map(str::to_string).collect();
         let name = dirs.pop().unwrap_or_default();
         let local = (|| {
@@ -454,7 +477,7 @@ impl ResultFile {
     /// intermediate groups of `target`, returning the dataset's parent.
     fn open_parent(&self, target: &StepTarget) -> Result<Group, OutputError> {
         let c = self.coll();
-        let mut gpath = format!("/steps/{}", target.group);
+        let mut gpath = format!("{}/{}", layout::STEPS, target.group);
         let g = self
             .file
             .group(&gpath)
