@@ -146,8 +146,15 @@ fn read_back(path: &Path) -> Result<Vec<Row>, String> {
     for step in open_steps(path).map_err(|e| e.to_string())? {
         let info = read_step_attrs(path, step).map_err(|e| e.to_string())?;
         let points = PairPoints::read(path, step, PAIR).map_err(|e| e.to_string())?;
-        let (state, _, _) =
-            read_nodal(path, step, &format!("contact/{PAIR}/state")).map_err(|e| e.to_string())?;
+        let (state, _, _) = read_nodal(
+            path,
+            step,
+            &contactlink::output::layout::pair_dataset(
+                PAIR,
+                contactlink::output::layout::PAIR_STATE,
+            ),
+        )
+        .map_err(|e| e.to_string())?;
         let f = points.force;
         let n = (0..3).map(|i| f[i] * NORMAL[i]).sum::<f64>();
         let ft = (0..3)

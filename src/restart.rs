@@ -11,7 +11,7 @@ use crate::contact::links::{FrictionRows, RestartRows};
 use crate::contact::multipliers::FrictionRecord;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::output::{read_dataset, read_nodal, read_step_attrs, OutputError};
+use crate::output::{layout, read_dataset, read_nodal, read_step_attrs, OutputError};
 use crate::solve::RestartState;
 use std::path::Path;
 
@@ -39,7 +39,7 @@ pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
         )));
     }
     let n = model.mesh.num_nodes();
-    let displacement = read_columns(path, step, "displacement", n, 3)?;
+    let displacement = read_columns(path, step, layout::DISPLACEMENT, n, 3)?;
     let pairs = model
         .contact
         .iter()
@@ -57,7 +57,8 @@ pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
 /// The file's mesh must be the model's: same cells and nodes, same places.
 fn check_mesh(path: &Path, model: &Model) -> std::result::Result<(), String> {
     let mesh = &model.mesh;
-    let (nodes, shape) = read_dataset::<f64>(path, "/mesh/nodes").map_err(|e| e.to_string())?;
+    let (nodes, shape) =
+        read_dataset::<f64>(path, layout::MESH_NODES).map_err(|e| e.to_string())?;
     if shape != [mesh.num_nodes(), 3] {
         return Err(format!(
             "written for another mesh: {} nodes, this scene has {}",
@@ -65,7 +66,7 @@ fn check_mesh(path: &Path, model: &Model) -> std::result::Result<(), String> {
             mesh.num_nodes()
         ));
     }
-    let (_, cells) = read_dataset::<i64>(path, "/mesh/cells").map_err(|e| e.to_string())?;
+    let (_, cells) = read_dataset::<i64>(path, layout::MESH_CELLS).map_err(|e| e.to_string())?;
     if cells.first() != Some(&mesh.num_cells()) {
         return Err(format!(
             "written for another mesh: {} cells, this scene has {}",
@@ -93,18 +94,18 @@ fn check_mesh(path: &Path, model: &Model) -> std::result::Result<(), String> {
 }
 
 fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<RestartRows> {
-    let dir = format!("contact/{name}");
-    let lambda = read_any_rows(path, step, &format!("{dir}/lambda_n"), 1)?;
+    let field = |f: &str| layout::pair_dataset(name, f);
+    let lambda = read_any_rows(path, step, &field(layout::PAIR_LAMBDA_N), 1)?;
     let friction = if friction {
         let rows = lambda.len();
-        let triples = |field: &str| -> Result<Vec<[f64; 3]>> {
-            let v = read_columns(path, step, &format!("{dir}/{field}"), rows, 3)?;
+        let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
+            let v = read_columns(path, step, &field(f), rows, 3)?;
             Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
         };
         let (lambda_t, origin, ids) = (
-            triples("lambda_t")?,
-            triples("slip_origin")?,
-            triples("history_ids")?,
+            triples(layout::PAIR_LAMBDA_T)?,
+            triples(layout::PAIR_SLIP_ORIGIN)?,
+            triples(layout::PAIR_HISTORY_IDS)?,
         );
         let records = lambda_t
             .into_iter()
@@ -118,14 +119,14 @@ fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<Res
             .collect();
         Some(FrictionRows {
             records,
-            state: read_columns(path, step, &format!("{dir}/state"), rows, 1)?,
-            traction: triples("traction_t")?,
+            state: read_columns(path, step, &field(layout::PAIR_STATE), rows, 1)?,
+            traction: triples(layout::PAIR_TRACTION_T)?,
         })
     } else {
         None
     };
     // Files from before penalties were written have none: keep the scene's.
-    let penalty = read_nodal(path, step, &format!("{dir}/penalty"))
+    let penalty = read_nodal(path, step, &field(layout::PAIR_PENALTY))
         .ok()
         .and_then(|(v, _, _)| v.first().copied());
     Ok(RestartRows {

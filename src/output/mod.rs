@@ -59,16 +59,27 @@
 //! failure is agreed on, so when one rank fails all ranks return an error
 //! instead of leaving the others blocked in the next collective call.
 
-mod hdf5_file;
+mod collective;
+mod fingerprint;
+mod header;
+mod history_csv;
+pub mod layout;
 pub mod paths;
+mod reader;
+mod result_sink;
+mod tee;
+mod writer;
 pub mod xdmf;
 
 use std::path::{Path, PathBuf};
 
-pub use hdf5_file::{
+pub use history_csv::HistoryCsv;
+pub use reader::{
     list_steps, read_dataset, read_f64_attr, read_nodal, read_step_attrs, read_string_attr,
-    ResultFile,
 };
+pub use result_sink::{create_result_file, Hdf5Sink, Provenance};
+pub use tee::Tee;
+pub use writer::ResultFile;
 
 /// One rank's contiguous block `[start, start + data.len() / cols)` of the rows
 /// of a `(global_rows, cols)` array, row-major.
@@ -231,10 +242,7 @@ impl OutputError {
     }
 }
 
-/// The group name of step `index`: six digits, zero-padded.
-pub fn step_group_name(index: usize) -> String {
-    format!("{index:06}")
-}
+pub use layout::step_group_name;
 
 /// Element kinds this module can describe to XDMF; the string is the
 /// `cell_type` attribute value.
@@ -290,61 +298,4 @@ pub(crate) fn check_name(path: &Path, object: &str, name: &str) -> Result<(), Ou
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn step_names_are_six_digits_and_sort() {
-        assert_eq!(step_group_name(0), "000000");
-        assert_eq!(step_group_name(42), "000042");
-        assert_eq!(step_group_name(1_234_567), "1234567");
-        let mut v = vec![
-            step_group_name(10),
-            step_group_name(2),
-            step_group_name(100),
-        ];
-        v.sort();
-        assert_eq!(v, ["000002", "000010", "000100"]);
-    }
-
-    #[test]
-    fn names_are_checked() {
-        let p = Path::new("x.h5");
-        assert!(check_name(p, "o", "top").is_ok());
-        for bad in ["", ".", "..", "a/b", "a\0b"] {
-            let err = check_name(p, "o", bad).err();
-            assert!(err.is_some(), "{bad:?} accepted");
-        }
-    }
-
-    #[test]
-    fn errors_name_path_and_object() {
-        let e = OutputError::invalid(Path::new("/tmp/run/out.h5"), "/mesh/nodes", "bad");
-        let msg = e.to_string();
-        assert!(
-            msg.contains("/tmp/run/out.h5") && msg.contains("/mesh/nodes"),
-            "{msg}"
-        );
-    }
-
-    #[test]
-    fn block_rows_helpers() {
-        let d = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
-        let b = BlockRows::whole(&d, 3);
-        assert_eq!((b.global_rows, b.start, b.cols), (2, 0, 3));
-        let z = BlockRows::whole(&d, 0);
-        assert_eq!(z.global_rows, 0);
-        let e: BlockRows<f64> = BlockRows::empty(7, 7, 3);
-        assert!(e.data.is_empty());
-    }
-
-    #[test]
-    fn cell_kinds() {
-        assert_eq!(CellKind::parse("hex8").map(CellKind::nodes), Some(8));
-        assert_eq!(CellKind::parse("tet4").map(CellKind::nodes), Some(4));
-        assert_eq!(CellKind::parse("hex20"), None);
-        assert_eq!(facet_nodes("quad4"), Some(4));
-        assert_eq!(facet_nodes("tri3"), Some(3));
-        assert_eq!(facet_nodes("tri6"), None);
-    }
-}
+mod tests;

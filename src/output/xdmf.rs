@@ -25,7 +25,7 @@ use std::io;
 use std::os::unix::fs::FileExt as _;
 use std::path::{Path, PathBuf};
 
-use super::CellKind;
+use super::{layout, CellKind};
 
 /// The mesh part of the sidecar: what every grid references.
 #[derive(Debug, Clone)]
@@ -140,7 +140,7 @@ fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
         8,
         &dims(mesh.n_cells, k, false),
         &h5,
-        "/mesh/cells",
+        layout::MESH_CELLS,
     );
     s.push_str("        </Topology>\n");
     s.push_str("        <Geometry GeometryType=\"XYZ\">\n");
@@ -150,7 +150,7 @@ fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
         8,
         &dims(mesh.n_nodes, 3, false),
         &h5,
-        "/mesh/nodes",
+        layout::MESH_NODES,
     );
     s.push_str("        </Geometry>\n");
     for f in &step.fields {
@@ -164,16 +164,16 @@ fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
             escape(&f.name),
             attribute_type(f.cols)
         );
-        let h5path = format!("/steps/{group}/{}", escape(&f.name));
+        let h5path = format!("{}/{group}/{}", layout::STEPS, escape(&f.name));
         data_item(s, "Float", 8, &dims(rows, f.cols, false), &h5, &h5path);
         s.push_str("        </Attribute>\n");
     }
-    for name in ["partition", "cell_body"] {
+    for name in [layout::PARTITION, layout::CELL_BODY] {
         let _ = writeln!(
             s,
             "        <Attribute Name=\"{name}\" AttributeType=\"Scalar\" Center=\"Cell\">"
         );
-        let h5path = format!("/mesh/{name}");
+        let h5path = format!("{}/{name}", layout::MESH);
         data_item(s, "Int", 4, &dims(mesh.n_cells, 1, true), &h5, &h5path);
         s.push_str("        </Attribute>\n");
     }

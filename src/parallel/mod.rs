@@ -7,11 +7,14 @@
 //! [`agree`] and [`agree_failure`] turn a rank-local result into the same
 //! result on every rank, carrying the lowest failing rank's message, and
 //! [`any_rank`], [`all_ranks`], [`sum`] and [`max`] are the reductions the
-//! run loop steers by. [`fault`] makes one rank fail on purpose (tests only).
+//! run loop steers by; [`gather_all`] concatenates every rank's slice on
+//! every rank. [`fault`] makes one rank fail on purpose (tests only).
 pub mod agree;
 pub mod fault;
+mod gather;
 
 pub use agree::{
     agree, agree_failure, all_ranks, any_rank, broadcast_text, lowest_rank, max, sum, sum_usize,
     RankFailure,
 };
+pub use gather::gather_all;

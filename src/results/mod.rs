@@ -5,7 +5,7 @@
 pub mod plot;
 pub mod summary;
 
-use crate::output::{list_steps, read_nodal, step_group_name, OutputError};
+use crate::output::{layout, list_steps, read_nodal, OutputError};
 use std::path::{Path, PathBuf};
 
 /// Why a result file could not be summarised or plotted. Each message is one
@@ -39,7 +39,7 @@ pub fn open_steps(path: &Path) -> Result<Vec<usize>, ResultsError> {
     }
     let file = hdf5::File::open(path)
         .map_err(|_| ResultsError::file(path, "not an HDF5 file (or not readable)"))?;
-    if !(file.link_exists("mesh") && file.link_exists("steps")) {
+    if !(file.link_exists(layout::MESH_NAME) && file.link_exists(layout::STEPS_NAME)) {
         return Err(ResultsError::file(
             path,
             "not a contactlink result file (no /mesh and /steps groups)",
@@ -59,7 +59,7 @@ pub fn open_steps(path: &Path) -> Result<Vec<usize>, ResultsError> {
 /// The contact pairs written at `step` (the members of
 /// `/steps/<step>/contact`), sorted; none when the model has no contact.
 pub fn pair_names(path: &Path, step: usize) -> Result<Vec<String>, ResultsError> {
-    let object = format!("/steps/{}/contact", step_group_name(step));
+    let object = layout::step_dataset(step, layout::CONTACT);
     let file = hdf5::File::open(path).map_err(|source| OutputError::Open {
         path: path.to_path_buf(),
         source,
@@ -88,12 +88,12 @@ pub struct PairPoints {
 
 impl PairPoints {
     pub fn read(path: &Path, step: usize, pair: &str) -> Result<Self, ResultsError> {
-        let rel = |name: &str| format!("contact/{pair}/{name}");
-        let (flat, rows, cols) = read_nodal(path, step, &rel("points"))?;
-        let (pressure, prow, _) = read_nodal(path, step, &rel("pressure"))?;
-        let (force, _, _) = read_nodal(path, step, &rel("force"))?;
-        let weight = if has_dataset(path, step, &rel("weight")) {
-            let (w, wrows, _) = read_nodal(path, step, &rel("weight"))?;
+        let rel = |name: &str| layout::pair_dataset(pair, name);
+        let (flat, rows, cols) = read_nodal(path, step, &rel(layout::PAIR_POINTS))?;
+        let (pressure, prow, _) = read_nodal(path, step, &rel(layout::PAIR_PRESSURE))?;
+        let (force, _, _) = read_nodal(path, step, &rel(layout::PAIR_FORCE))?;
+        let weight = if has_dataset(path, step, &rel(layout::PAIR_WEIGHT)) {
+            let (w, wrows, _) = read_nodal(path, step, &rel(layout::PAIR_WEIGHT))?;
             Some((w, wrows))
         } else {
             None
@@ -127,19 +127,19 @@ impl PairPoints {
 /// The nodal contact pressure of `step` (one value per mesh node); None
 /// when the step has none (a model without contact).
 pub fn nodal_pressure(path: &Path, step: usize) -> Result<Option<Vec<f64>>, ResultsError> {
-    if !has_dataset(path, step, "contact_pressure") {
+    if !has_dataset(path, step, layout::CONTACT_PRESSURE) {
         return Ok(None);
     }
-    Ok(Some(read_nodal(path, step, "contact_pressure")?.0))
+    Ok(Some(read_nodal(path, step, layout::CONTACT_PRESSURE)?.0))
 }
 
 /// The nodes of a pair's slave surface (sorted, unique), from the
 /// `/contact_pairs` map to its facet set; None in files without the map.
 pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<usize>>, ResultsError> {
-    let Some(set) = crate::output::read_string_attr(path, "/contact_pairs", pair)? else {
+    let Some(set) = crate::output::read_string_attr(path, layout::CONTACT_PAIRS, pair)? else {
         return Ok(None);
     };
-    let object = format!("/mesh/facet_sets/{set}/nodes");
+    let object = format!("{}/{}", layout::facet_set(&set), layout::FACET_NODES);
     let (ids, _) = crate::output::read_dataset::<i64>(path, &object)?;
     let mut nodes = ids
         .into_iter()
@@ -153,6 +153,6 @@ pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<usize>>, Result
 
 /// Whether `/steps/<step>/<rel>` exists (optional datasets).
 fn has_dataset(path: &Path, step: usize, rel: &str) -> bool {
-    let object = format!("/steps/{}/{rel}", step_group_name(step));
+    let object = layout::step_dataset(step, rel);
     hdf5::File::open(path).is_ok_and(|f| f.link_exists(&object))
 }

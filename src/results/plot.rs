@@ -3,7 +3,7 @@
 //! from the file's `/hertz` group (written by `run` when the scene has a
 //! [hertz] check), the load from the step's total contact force.
 use super::{open_steps, slave_nodes, PairPoints, ResultsError};
-use crate::output::{read_dataset, read_f64_attr, read_nodal, read_string_attr};
+use crate::output::{layout, read_dataset, read_f64_attr, read_nodal, read_string_attr};
 use crate::verify::{self, HertzCheck, HertzKind};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -75,8 +75,8 @@ pub fn read_hertz_setup(path: &Path) -> Result<HertzCheck, ResultsError> {
             path.display()
         ))
     };
-    let text = |k: &str| read_string_attr(path, "/hertz", k);
-    let number = |k: &str| read_f64_attr(path, "/hertz", k);
+    let text = |k: &str| read_string_attr(path, layout::HERTZ, k);
+    let number = |k: &str| read_f64_attr(path, layout::HERTZ, k);
     let kind = text("kind")?.ok_or_else(missing)?;
     let kind = match kind.as_str() {
         "line" => HertzKind::Line {
@@ -107,8 +107,8 @@ struct NodalPressure {
 
 impl NodalPressure {
     fn read(path: &Path, step: usize, pair: &str) -> Result<Self, ResultsError> {
-        let (nodes, _) = read_dataset::<f64>(path, "/mesh/nodes")?;
-        let (pressure, rows, _) = read_nodal(path, step, "contact_pressure")?;
+        let (nodes, _) = read_dataset::<f64>(path, layout::MESH_NODES)?;
+        let (pressure, rows, _) = read_nodal(path, step, layout::CONTACT_PRESSURE)?;
         if nodes.len() != 3 * rows {
             return Err(ResultsError::file(
                 path,

@@ -1,0 +1,149 @@
+//! The names of the result file: every group, dataset and attribute a writer
+//! creates and a reader looks up is spelled here once (the file layout itself
+//! is described in the module docs of [`crate::output`] and in
+//! docs/architecture.md).
+
+/// `/mesh`: the mesh, written once.
+pub const MESH: &str = "/mesh";
+/// `/steps`: one group per converged step.
+pub const STEPS: &str = "/steps";
+/// The same two groups' link names under the root.
+pub const MESH_NAME: &str = "mesh";
+pub const STEPS_NAME: &str = "steps";
+
+/// Members of `/mesh` (leaf names).
+pub const NODES: &str = "nodes";
+pub const CELLS: &str = "cells";
+pub const PARTITION: &str = "partition";
+pub const CELL_BODY: &str = "cell_body";
+pub const NODE_SETS: &str = "node_sets";
+pub const FACET_SETS: &str = "facet_sets";
+
+/// Full paths of the mesh datasets.
+pub const MESH_NODES: &str = "/mesh/nodes";
+pub const MESH_CELLS: &str = "/mesh/cells";
+pub const MESH_PARTITION: &str = "/mesh/partition";
+pub const MESH_CELL_BODY: &str = "/mesh/cell_body";
+pub const MESH_NODE_SETS: &str = "/mesh/node_sets";
+pub const MESH_FACET_SETS: &str = "/mesh/facet_sets";
+
+/// Members of a facet set group `/mesh/facet_sets/<name>/`.
+pub const FACET_NODES: &str = "nodes";
+pub const FACET_CELL: &str = "cell";
+pub const FACET_FACE: &str = "face";
+
+/// Attributes of the mesh datasets and facet set groups.
+pub const CELL_TYPE_ATTR: &str = "cell_type";
+pub const BODIES_ATTR: &str = "bodies";
+
+/// Attributes of a step group.
+pub const TIME_ATTR: &str = "time";
+pub const LOAD_FACTOR_ATTR: &str = "load_factor";
+pub const NEWTON_ATTR: &str = "newton_iterations";
+pub const UZAWA_ATTR: &str = "uzawa_iterations";
+pub const CONVERGED_ATTR: &str = "converged";
+pub const WALL_SECONDS_ATTR: &str = "wall_seconds";
+
+/// Nodal step fields (`/steps/<NNNNNN>/<name>`, `(N,c)`).
+pub const DISPLACEMENT: &str = "displacement";
+pub const REACTION: &str = "reaction";
+pub const VELOCITY: &str = "velocity";
+pub const CONTACT_PRESSURE: &str = "contact_pressure";
+/// Dynamics: `[kinetic, strain]` and the momentum vector, `(2,)` and `(3,)`.
+pub const ENERGY: &str = "energy";
+pub const MOMENTUM: &str = "momentum";
+
+/// `/steps/<NNNNNN>/contact/`: one group per contact pair.
+pub const CONTACT: &str = "contact";
+
+/// Members of a pair group `contact/<pair>/`: per-point arrays...
+pub const PAIR_POINTS: &str = "points";
+pub const PAIR_PRESSURE: &str = "pressure";
+pub const PAIR_GAP: &str = "gap";
+pub const PAIR_LAMBDA_N: &str = "lambda_n";
+pub const PAIR_WEIGHT: &str = "weight";
+/// ...with friction...
+pub const PAIR_TRACTION_T: &str = "traction_t";
+pub const PAIR_SLIP: &str = "slip";
+pub const PAIR_STATE: &str = "state";
+pub const PAIR_LAMBDA_T: &str = "lambda_t";
+pub const PAIR_SLIP_ORIGIN: &str = "slip_origin";
+pub const PAIR_HISTORY_IDS: &str = "history_ids";
+/// ...mortar nodal fields (mesh-node rows)...
+pub const PAIR_NODE_LAMBDA: &str = "node_lambda";
+pub const PAIR_NODE_WEIGHTED_GAP: &str = "node_weighted_gap";
+pub const PAIR_NODE_TRACTION: &str = "node_traction";
+/// ...and the pair's totals, `(3,)` and `(1,)`.
+pub const PAIR_FORCE: &str = "force";
+pub const PAIR_PENALTY: &str = "penalty";
+
+/// Root attributes: the scene text and its `--set` overrides.
+pub const SCENE_ATTR: &str = "scene";
+pub const SCENE_OVERRIDES_ATTR: &str = "scene_overrides";
+/// `/contact_pairs`: attribute pair name → slave facet set.
+pub const CONTACT_PAIRS: &str = "/contact_pairs";
+/// `/hertz`: the closed-form setup `contactlink plot` draws.
+pub const HERTZ: &str = "/hertz";
+
+/// The group name of step `index`: six digits, zero-padded, so the groups
+/// sort in step order under a plain name sort.
+pub fn step_group_name(index: usize) -> String {
+    format!("{index:06}")
+}
+
+/// `/steps/<NNNNNN>`.
+pub fn step_group(step: usize) -> String {
+    format!("{STEPS}/{}", step_group_name(step))
+}
+
+/// `/steps/<NNNNNN>/<rel>`; `rel` may be a relative path such as
+/// [`pair_dataset`]'s.
+pub fn step_dataset(step: usize, rel: &str) -> String {
+    format!("{}/{rel}", step_group(step))
+}
+
+/// `contact/<pair>`, relative to a step group.
+pub fn pair_group(pair: &str) -> String {
+    format!("{CONTACT}/{pair}")
+}
+
+/// `contact/<pair>/<name>`, relative to a step group.
+pub fn pair_dataset(pair: &str, name: &str) -> String {
+    format!("{CONTACT}/{pair}/{name}")
+}
+
+/// `/mesh/node_sets/<name>`.
+pub fn node_set(name: &str) -> String {
+    format!("{MESH_NODE_SETS}/{name}")
+}
+
+/// `/mesh/facet_sets/<name>`.
+pub fn facet_set(name: &str) -> String {
+    format!("{MESH_FACET_SETS}/{name}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_paths_join_their_parts() {
+        for (full, leaf) in [
+            (MESH_NODES, NODES),
+            (MESH_CELLS, CELLS),
+            (MESH_PARTITION, PARTITION),
+            (MESH_CELL_BODY, CELL_BODY),
+            (MESH_NODE_SETS, NODE_SETS),
+            (MESH_FACET_SETS, FACET_SETS),
+        ] {
+            assert_eq!(full, format!("{MESH}/{leaf}"));
+        }
+        assert_eq!(MESH, format!("/{MESH_NAME}"));
+        assert_eq!(STEPS, format!("/{STEPS_NAME}"));
+        assert_eq!(
+            step_dataset(3, "contact/a/gap"),
+            "/steps/000003/contact/a/gap"
+        );
+        assert_eq!(pair_dataset("a", PAIR_GAP), "contact/a/gap");
+    }
+}

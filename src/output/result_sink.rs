@@ -1,0 +1,378 @@
+//! The run's result file: created with the mesh and run metadata before the
+//! first step, then written by [`Hdf5Sink`] after every converged step.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
+use crate::dofs::even_block;
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::petsc::Vector;
+use crate::runtime::Runtime;
+use crate::solve::{NaturalOrder, PairFields, Simulation, StepReport, StepSink};
+use crate::verify::{HertzCheck, HertzKind};
+
+/// Where a run came from, stored in the result file (`/scene`,
+/// `/scene_overrides`) so a result can be traced to its input.
+#[derive(Debug, Clone, Default)]
+pub struct Provenance {
+    /// The scene's TOML text as loaded (before overrides).
+    pub scene: String,
+    /// The `--set key=value` overrides, in order.
+    pub overrides: Vec<String>,
+}
+
+/// Scatters of one contact pair's point arrays into output order.
+struct PairOrder {
+    scalar: NaturalOrder,
+    vector: NaturalOrder,
+    rows: usize,
+}
+
+/// Writes every converged step to the HDF5 file, in natural (input) order.
+pub struct Hdf5Sink {
+    file: ResultFile,
+    natural: NaturalOrder,
+    natural_scalar: NaturalOrder,
+    pairs: Vec<PairOrder>,
+    nodes: usize,
+}
+
+impl Hdf5Sink {
+    pub fn new(file: ResultFile, sim: &Simulation) -> Result<Self> {
+        let dofs = sim.dofs();
+        let mut pairs = Vec::new();
+        for p in sim.contact() {
+            let nqp = p.slave.nqp;
+            let rows = p.slave.global_facets * nqp;
+            let petsc_row = |nat: usize| p.multipliers.petsc_point(nat / nqp, nat % nqp, nqp);
+            let owned = p.slave.num_qps();
+            pairs.push(PairOrder {
+                scalar: NaturalOrder::new(rows, 1, owned, petsc_row, dofs.rank, dofs.nranks)?,
+                vector: NaturalOrder::new(rows, 3, owned, petsc_row, dofs.rank, dofs.nranks)?,
+                rows,
+            });
+        }
+        Ok(Hdf5Sink {
+            file,
+            natural: NaturalOrder::nodal(dofs)?,
+            natural_scalar: NaturalOrder::nodal_scalar(dofs)?,
+            pairs,
+            nodes: sim.model().mesh.num_nodes(),
+        })
+    }
+
+    fn write_pair(
+        &mut self,
+        step: usize,
+        i: usize,
+        fields: &PairFields,
+        report: &StepReport,
+    ) -> Result<()> {
+        let name = &fields.pair.spec.name;
+        let v = &fields.values;
+        let flat = |a: &[[f64; 3]]| -> Vec<f64> { a.iter().flatten().copied().collect() };
+        let mut vectors = vec![(layout::PAIR_POINTS, flat(&v.points))];
+        let mut scalars = vec![
+            (layout::PAIR_PRESSURE, v.pressure.clone()),
+            (layout::PAIR_GAP, v.gap.clone()),
+            (layout::PAIR_LAMBDA_N, v.lambda.clone()),
+            (layout::PAIR_WEIGHT, v.weight.clone()),
+        ];
+        // Decided by the pair, not by this rank's points: a rank may own no
+        // slave point, and every rank must write the same datasets.
+        if fields.pair.has_friction() {
+            vectors.push((layout::PAIR_TRACTION_T, flat(&v.traction)));
+            vectors.push((layout::PAIR_SLIP, flat(&v.slip)));
+            // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
+            scalars.push((
+                layout::PAIR_STATE,
+                v.state.iter().map(|&s| f64::from(s)).collect(),
+            ));
+            // The friction history, so `run --restart` continues exactly.
+            let records = &v.records;
+            vectors.push((
+                layout::PAIR_LAMBDA_T,
+                flat(&records.iter().map(|r| r.lambda).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                layout::PAIR_SLIP_ORIGIN,
+                flat(&records.iter().map(|r| r.origin).collect::<Vec<_>>()),
+            ));
+            vectors.push((
+                layout::PAIR_HISTORY_IDS,
+                flat(&records.iter().map(|r| r.ids).collect::<Vec<_>>()),
+            ));
+        }
+        let order = &mut self.pairs[i];
+        let rows = order.rows;
+        for (cols, label, values) in vectors
+            .iter()
+            .map(|(l, d)| (3, l, d))
+            .chain(scalars.iter().map(|(l, d)| (1, l, d)))
+        {
+            let scatter = if cols == 3 {
+                &mut order.vector
+            } else {
+                &mut order.scalar
+            };
+            let (start, data) = scatter.block_of_owned(values)?;
+            self.file.write_step_block(
+                step,
+                &layout::pair_dataset(name, label),
+                BlockRows {
+                    global_rows: rows,
+                    start,
+                    cols,
+                    data: &data,
+                },
+            )?;
+        }
+        if let Some(m) = &v.mortar {
+            self.write_mortar_nodes(step, name, m)?;
+        }
+        let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
+        self.file.write_step_small(
+            step,
+            &layout::pair_dataset(name, layout::PAIR_FORCE),
+            &force,
+        )?;
+        // The pair's penalty (raised when Uzawa was slow), for a restart.
+        self.file.write_step_small(
+            step,
+            &layout::pair_dataset(name, layout::PAIR_PENALTY),
+            &[fields.pair.penalty],
+        )?;
+        Ok(())
+    }
+}
+
+impl Hdf5Sink {
+    /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
+    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`.
+    fn write_mortar_nodes(
+        &mut self,
+        step: usize,
+        name: &str,
+        m: &crate::contact::mortar::pair::NodeFields,
+    ) -> Result<()> {
+        let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
+        for (label, cols, values) in [
+            (layout::PAIR_NODE_LAMBDA, 1, &m.lambda),
+            (layout::PAIR_NODE_WEIGHTED_GAP, 1, &m.weighted_gap),
+            (layout::PAIR_NODE_TRACTION, 3, &traction),
+        ] {
+            let order = if cols == 3 {
+                &mut self.natural
+            } else {
+                &mut self.natural_scalar
+            };
+            let (start, data) = order.block_of_owned(values)?;
+            self.file.write_step_block(
+                step,
+                &layout::pair_dataset(name, label),
+                BlockRows {
+                    global_rows: self.nodes,
+                    start,
+                    cols,
+                    data: &data,
+                },
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl StepSink for Hdf5Sink {
+    fn step(
+        &mut self,
+        report: &StepReport,
+        displacement: &Vector,
+        reaction: &Vector,
+        contact: &[PairFields],
+        nodal_pressure: &[f64],
+        velocity: Option<&Vector>,
+    ) -> Result<()> {
+        let (start, u) = self.natural.block_of(displacement)?;
+        let (_, r) = self.natural.block_of(reaction)?;
+        let v = velocity.map(|v| self.natural.block_of(v)).transpose()?;
+        let info = StepInfo {
+            index: report.index,
+            time: report.dynamics.map_or(report.load_factor, |d| d.time),
+            load_factor: report.load_factor,
+            newton_iterations: report.newton_iterations,
+            uzawa_iterations: report.uzawa_iterations,
+            converged: true,
+            wall_seconds: report.wall_seconds,
+        };
+        let nodal = |data| BlockRows {
+            global_rows: self.nodes,
+            start,
+            cols: 3,
+            data,
+        };
+        let mut fields = vec![
+            (layout::DISPLACEMENT, nodal(&u)),
+            (layout::REACTION, nodal(&r)),
+        ];
+        if let Some((_, v)) = &v {
+            fields.push((layout::VELOCITY, nodal(v)));
+        }
+        let p = if contact.is_empty() {
+            None
+        } else {
+            Some(self.natural_scalar.block_of_owned(nodal_pressure)?)
+        };
+        if let Some((pstart, p)) = &p {
+            fields.push((
+                layout::CONTACT_PRESSURE,
+                BlockRows {
+                    global_rows: self.nodes,
+                    start: *pstart,
+                    cols: 1,
+                    data: p,
+                },
+            ));
+        }
+        self.file.write_step(&info, &fields, &[])?;
+        if let Some(d) = &report.dynamics {
+            self.file
+                .write_step_small(report.index, layout::ENERGY, &[d.kinetic, d.strain])?;
+            self.file
+                .write_step_small(report.index, layout::MOMENTUM, &d.momentum)?;
+        }
+        for (i, fields) in contact.iter().enumerate() {
+            self.write_pair(report.index, i, fields, report)?;
+        }
+        self.file.flush()?;
+        Ok(())
+    }
+}
+
+pub fn create_result_file(
+    rt: &Runtime,
+    sim: &Simulation,
+    path: &Path,
+    provenance: Option<&Provenance>,
+) -> Result<ResultFile> {
+    let model = sim.model();
+    let mesh = &model.mesh;
+    let (rank, size) = (rt.rank(), rt.size());
+    let node_block = even_block(mesh.num_nodes(), rank, size);
+    let cell_block = even_block(mesh.num_cells(), rank, size);
+    let nodes: Vec<f64> = mesh.nodes[node_block.clone()]
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
+    let npc = mesh.cell_type.nodes();
+    let cells: Vec<i64> = cell_block
+        .clone()
+        .flat_map(|c| mesh.cell(c).iter().map(|&v| v as i64))
+        .collect();
+    let partition: Vec<i32> = sim.partition()[cell_block.clone()].to_vec();
+    let cell_body: Vec<i32> = mesh.cell_body[cell_block.clone()]
+        .iter()
+        .map(|&b| b as i32)
+        .collect();
+    let facet_sets = facet_sets_out(mesh)?;
+    let header = MeshHeader {
+        cell_type: mesh.cell_type.name(),
+        facet_type: mesh.cell_type.facet_type().name(),
+        nodes: BlockRows {
+            global_rows: mesh.num_nodes(),
+            start: node_block.start,
+            cols: 3,
+            data: &nodes,
+        },
+        cells: BlockRows {
+            global_rows: mesh.num_cells(),
+            start: cell_block.start,
+            cols: npc,
+            data: &cells,
+        },
+        partition: BlockRows {
+            global_rows: mesh.num_cells(),
+            start: cell_block.start,
+            cols: 1,
+            data: &partition,
+        },
+        cell_body: BlockRows {
+            global_rows: mesh.num_cells(),
+            start: cell_block.start,
+            cols: 1,
+            data: &cell_body,
+        },
+        bodies: &mesh.bodies,
+        node_sets: &mesh.node_sets,
+        facet_sets: &facet_sets,
+    };
+    let mut file = ResultFile::create(&rt.world(), path, &header)?;
+    if let Some(p) = provenance {
+        let overrides = p.overrides.join("\n");
+        file.write_attributes(
+            "/",
+            &[
+                (layout::SCENE_ATTR, &p.scene),
+                (layout::SCENE_OVERRIDES_ATTR, &overrides),
+            ],
+            &[],
+        )?;
+    }
+    if !model.contact.is_empty() {
+        // Pair name → slave facet set: lets a reader pick a pair's nodes out
+        // of the nodal contact_pressure field (`contactlink summary`).
+        let slaves: Vec<(&str, &str)> = model
+            .contact
+            .iter()
+            .map(|p| (p.name.as_str(), p.slave.as_str()))
+            .collect();
+        file.write_attributes(layout::CONTACT_PAIRS, &slaves, &[])?;
+    }
+    if let Some(h) = &model.hertz {
+        write_hertz_setup(&mut file, h)?;
+    }
+    Ok(file)
+}
+
+/// `/hertz`: what `contactlink plot` needs to draw the closed-form profile
+/// (the load comes from each step's contact force).
+fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
+    let (kind, thickness) = match h.kind {
+        HertzKind::Line { thickness } => ("line", Some(thickness)),
+        HertzKind::Point => ("point", None),
+    };
+    let mut numbers = vec![
+        ("radius", h.radius),
+        ("effective_modulus", h.effective_modulus),
+    ];
+    numbers.extend(thickness.map(|t| ("thickness", t)));
+    file.write_attributes(
+        layout::HERTZ,
+        &[("kind", kind), ("pair", &h.pair)],
+        &numbers,
+    )?;
+    Ok(())
+}
+
+fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
+    let k = mesh.cell_type.facet_type().nodes();
+    let mut out = BTreeMap::new();
+    for (name, facets) in &mesh.facet_sets {
+        let mut nodes = Vec::with_capacity(facets.len() * k);
+        for f in facets {
+            nodes.extend(mesh.facet_nodes(f)?.into_iter().map(|v| v as i64));
+        }
+        out.insert(
+            name.clone(),
+            FacetSetOut {
+                nodes,
+                k,
+                cell: facets.iter().map(|f| f.cell as i64).collect(),
+                face: facets.iter().map(|f| f.face as i8).collect(),
+            },
+        );
+    }
+    Ok(out)
+}

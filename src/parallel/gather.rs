@@ -1,0 +1,24 @@
+//! Gathering rank-local arrays onto every rank.
+
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::{Communicator, CommunicatorCollectives};
+
+/// Concatenates every rank's slice, in rank order, on every rank.
+pub fn gather_all(world: &SimpleCommunicator, local: &[f64]) -> Vec<f64> {
+    use mpi::datatype::PartitionMut;
+    let n = local.len() as i32;
+    let mut counts = vec![0i32; world.size() as usize];
+    world.all_gather_into(&n, &mut counts[..]);
+    let displs: Vec<i32> = counts
+        .iter()
+        .scan(0, |acc, &c| {
+            let d = *acc;
+            *acc += c;
+            Some(d)
+        })
+        .collect();
+    let mut all = vec![0.0; counts.iter().sum::<i32>() as usize];
+    let mut partition = PartitionMut::new(&mut all[..], counts, displs);
+    world.all_gather_varcount_into(local, &mut partition);
+    all
+}
