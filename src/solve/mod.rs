@@ -23,7 +23,7 @@ pub use natural::NaturalOrder;
 pub use restart_state::RestartState;
 
 use crate::assembly::{BulkAssembler, FacetLoad, SurfaceLoads};
-use crate::contact::links::PairForce;
+use crate::contact::pair_state::PairForce;
 use crate::contact::{ContactPair, MasterSpec, PairSpec, UzawaStats};
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
@@ -217,7 +217,7 @@ pub struct RunReport {
 /// This rank's contact values of one pair at a converged step, for output.
 pub struct PairFields<'a> {
     pub pair: &'a ContactPair,
-    pub values: crate::contact::links::PointValues,
+    pub values: crate::contact::pair_state::PointValues,
 }
 
 /// Receives every converged step (the output file, a progress printer, ...).
