@@ -5,11 +5,10 @@
 //! their nodes are ghosted on every rank (the master halo), so each rank
 //! searches and evaluates its own slave points without further messages.
 use super::kernel::reference_weights;
-use crate::dofs::{DofMap, LocalNode, NaturalNode, DIM};
+use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule};
 use crate::mesh::{FacetRef, Mesh};
-use crate::petsc::PetscInt;
 
 /// A slave facet this rank evaluates.
 #[derive(Debug, Clone)]
@@ -18,7 +17,7 @@ pub struct SlaveFacet {
     pub set_index: usize,
     pub nodes: Vec<u32>,
     pub x_ref: Vec<[f64; 3]>,
-    pub dofs: Vec<PetscInt>,
+    pub dofs: Vec<GlobalDof>,
     /// Shortest edge: the local element size for the penalty and tolerance.
     pub h: f64,
 }
@@ -82,7 +81,7 @@ impl SlaveSurface {
             let facet_dofs = nodes
                 .iter()
                 .flat_map(|&l| (0..DIM).map(move |c| (l, c)))
-                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c).0)
+                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c))
                 .collect();
             facets.push(SlaveFacet {
                 set_index,
@@ -194,11 +193,11 @@ impl MasterSurface {
         &self.facets[facet as usize][..self.facet_type.nodes()]
     }
 
-    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<PetscInt>) {
+    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<GlobalDof>) {
         for &m in self.facet_nodes(facet) {
             let l = LocalNode(self.node_local[m as usize] as usize);
             for c in 0..DIM {
-                out.push(dofs.dof(l, c).0);
+                out.push(dofs.dof(l, c));
             }
         }
     }

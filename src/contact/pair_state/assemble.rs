@@ -1,10 +1,10 @@
 //! What the links add to the Jacobian pattern, the residual and the tangent.
 use super::links::Link;
 use super::{ContactPair, MasterSide};
+use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::kernel::{self as link, Friction, LinkInput, LinkState, Master, SlipRate};
-use crate::dofs::{DofMap, DIM};
+use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
-use crate::petsc::{BlockSink, PatternBuilder, PetscInt};
 
 /// Scratch space for one link's input (no allocation per link).
 #[derive(Default)]
@@ -22,7 +22,7 @@ const MAX_LINK_DOFS: usize = DIM * MAX_LINK_NODES;
 impl ContactPair {
     /// Records every entry the links of this step may couple: each slave
     /// facet with itself and with every master node in its links' patches.
-    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut PatternBuilder) -> Result<()> {
+    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
         if let Some(m) = &self.mortar {
             return m.add_pattern(dofs, pattern);
         }
@@ -36,7 +36,7 @@ impl ContactPair {
                 }
             }
         }
-        let mut d: Vec<PetscInt> = Vec::new();
+        let mut d: Vec<GlobalDof> = Vec::new();
         for (facet, mut master_nodes) in by_facet {
             d.clear();
             d.extend_from_slice(&self.slave.facets[facet].dofs);
@@ -45,7 +45,7 @@ impl ContactPair {
                 master_nodes.dedup();
                 for &n in &master_nodes {
                     let l = crate::dofs::LocalNode(m.node_local[n as usize] as usize);
-                    d.extend((0..DIM).map(|c| dofs.dof(l, c).0));
+                    d.extend((0..DIM).map(|c| dofs.dof(l, c)));
                 }
             }
             pattern.add_square(&d)?;
@@ -60,7 +60,7 @@ impl ContactPair {
         u_local: &[f64],
         factor: f64,
         with_tangent: bool,
-        mut sink: impl FnMut(&[u32], &[PetscInt], &[f64], Option<&[f64]>, &LinkState) -> Result<()>,
+        mut sink: impl FnMut(&[u32], &[GlobalDof], &[f64], Option<&[f64]>, &LinkState) -> Result<()>,
         dofs: &DofMap,
     ) -> Result<()> {
         self.follow(u_local);
@@ -68,7 +68,7 @@ impl ContactPair {
         let mut r = [0.0; MAX_LINK_DOFS];
         let mut k = vec![0.0; MAX_LINK_DOFS * MAX_LINK_DOFS];
         let mut nodes: Vec<u32> = Vec::with_capacity(MAX_LINK_NODES);
-        let mut link_dofs: Vec<PetscInt> = Vec::with_capacity(MAX_LINK_DOFS);
+        let mut link_dofs: Vec<GlobalDof> = Vec::with_capacity(MAX_LINK_DOFS);
         for li in 0..self.links.len() {
             let link = &self.links[li];
             let sf = link.qp as usize / self.slave.nqp;
@@ -222,7 +222,7 @@ impl ContactPair {
         dofs: &DofMap,
         u_local: &[f64],
         factor: f64,
-        k: &mut dyn BlockSink,
+        k: &mut dyn MatrixSink,
     ) -> Result<()> {
         if self.mortar.is_some() {
             // No active-set hash for mortar pairs yet: a new signature at
@@ -245,7 +245,7 @@ impl ContactPair {
                     use std::hash::Hash;
                     d.hash(&mut signature);
                     s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
-                    Ok(k.add_block(d, d, ke)?)
+                    k.add_block(d, d, ke)
                 }
                 None => Ok(()),
             },
