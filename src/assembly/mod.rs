@@ -7,10 +7,12 @@
 //! accumulated there and summed into owners by a reverse ghost update, so only
 //! the matrix goes through PETSc's off-rank stash.
 pub mod bulk;
+pub mod halo;
 pub mod loads;
 pub mod sink;
 
 pub use bulk::BulkAssembler;
+pub use halo::{Halo, HaloFactory};
 pub use loads::{FacetLoad, SurfaceLoads};
 pub use sink::{MatrixSink, PatternSink};
 

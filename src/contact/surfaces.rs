@@ -25,6 +25,8 @@ pub struct SlaveFacet {
 /// The slave side: this rank's facets and their quadrature points.
 #[derive(Debug, Clone)]
 pub struct SlaveSurface {
+    /// Name of the slave facet set.
+    pub set: String,
     pub facet_type: FacetType,
     pub facets: Vec<SlaveFacet>,
     /// Quadrature points per facet (same rule on every facet).
@@ -93,6 +95,7 @@ impl SlaveSurface {
         }
         let global_facets = facet_refs.len();
         Ok(SlaveSurface {
+            set: set.to_owned(),
             facet_type,
             facets,
             nqp: rule.len(),

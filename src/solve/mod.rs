@@ -8,6 +8,7 @@
 pub mod boundary;
 pub mod dynamics;
 mod failure;
+pub mod halo;
 pub mod lagging;
 pub mod mechanics;
 pub mod natural;
@@ -1124,7 +1125,7 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         model
             .contact
             .iter()
-            .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest))
+            .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest, &halo::PetscHalos))
             .collect::<Result<Vec<_>>>(),
     )?;
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;

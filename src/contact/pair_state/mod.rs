@@ -29,6 +29,7 @@ use super::multipliers::Multipliers;
 use super::pair::{Formulation, MasterSpec, PairSpec, RigidSurface};
 use super::search;
 use super::surfaces::{MasterSurface, SlaveSurface};
+use crate::assembly::HaloFactory;
 use crate::dofs::DofMap;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -89,6 +90,7 @@ impl ContactPair {
         partition: &[i32],
         spec: &PairSpec,
         softest_youngs: f64,
+        halos: &dyn HaloFactory,
     ) -> Result<Self> {
         let rule = spec.quadrature.rule(mesh.cell_type.facet_type());
         let slave = SlaveSurface::new(mesh, dofs, &spec.slave, &rule)?;
@@ -103,10 +105,10 @@ impl ContactPair {
             mesh,
             dofs,
             partition,
-            &spec.slave,
             &slave,
             &rule,
             friction_spec.is_some(),
+            halos,
         )?;
         let penalty = spec.penalty.unwrap_or(10.0 * softest_youngs / slave.h);
         let facet_penalty: Vec<f64> = slave
