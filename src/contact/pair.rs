@@ -1,7 +1,7 @@
 //! Contact pairs as a scene states them: which surfaces meet, the penalty, and
 //! the Uzawa tolerances.
 use super::dual::{dot, norm, sub};
-use super::kernel::Master;
+use super::kernel::LinkMaster;
 
 /// A rigid analytic master surface (no DOFs), as given at load factor 0.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
@@ -77,15 +77,15 @@ impl RigidSurface {
     }
 
     /// The link kernel's view of the surface.
-    pub fn as_master(&self) -> Master<'static> {
+    pub fn as_master(&self) -> LinkMaster<'static> {
         match *self {
-            RigidSurface::Plane { point, normal } => Master::Plane { point, normal },
-            RigidSurface::Sphere { centre, radius } => Master::Sphere { centre, radius },
+            RigidSurface::Plane { point, normal } => LinkMaster::Plane { point, normal },
+            RigidSurface::Sphere { centre, radius } => LinkMaster::Sphere { centre, radius },
             RigidSurface::Cylinder {
                 point,
                 axis,
                 radius,
-            } => Master::Cylinder {
+            } => LinkMaster::Cylinder {
                 point,
                 axis,
                 radius,

@@ -134,10 +134,12 @@ impl SlaveSurface {
     }
 }
 
-/// The master side of a deformable pair: every facet of the set, with its
-/// nodes numbered compactly (0..n) for the search, and their local indices.
+/// A facet set every rank sees in full (its nodes are ghosted on every
+/// rank): the master of a deformable pair, and both sides of a mortar pair.
+/// Every facet of the set, with its nodes numbered compactly (0..n) for the
+/// search, and their local indices.
 #[derive(Debug, Clone)]
-pub struct MasterSurface {
+pub struct SharedSurface {
     pub facet_type: FacetType,
     /// Local node index (owned or ghost) of each master node.
     pub node_local: Vec<u32>,
@@ -146,7 +148,7 @@ pub struct MasterSurface {
     pub facets: Vec<[u32; 4]>,
 }
 
-impl MasterSurface {
+impl SharedSurface {
     /// The natural ids of the master nodes, which every rank must ghost.
     pub fn natural_nodes(mesh: &Mesh, set: &str) -> Result<Vec<usize>> {
         let mut nodes: Vec<usize> = Vec::new();
@@ -177,7 +179,7 @@ impl MasterSurface {
             }
             facets.push(ids);
         }
-        Ok(MasterSurface {
+        Ok(SharedSurface {
             facet_type: mesh.cell_type.facet_type(),
             node_local,
             x_ref,

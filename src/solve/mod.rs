@@ -1087,12 +1087,12 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
     let mut master_nodes = Vec::new();
     for pair in &model.contact {
         if let MasterSpec::Surface { set } = &pair.master {
-            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh, set,
             )?);
         }
         if pair.formulation == crate::contact::Formulation::Mortar {
-            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh,
                 &pair.slave,
             )?);

@@ -16,7 +16,7 @@ use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
 use crate::contact::pair::PairSpec;
-use crate::contact::surfaces::MasterSurface;
+use crate::contact::surfaces::SharedSurface;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
@@ -85,8 +85,8 @@ impl MortarPair {
         search_distance: f64,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
-        let slave = MasterSurface::new(mesh, dofs, &spec.slave)?;
-        let master = MasterSurface::new(mesh, dofs, master_set)?;
+        let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
+        let master = SharedSurface::new(mesh, dofs, master_set)?;
         let n_slave = slave.x_ref.len();
         let offset = n_slave as u32;
         let nf = facet_type.nodes();

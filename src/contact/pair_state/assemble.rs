@@ -2,7 +2,7 @@
 use super::links::Link;
 use super::{ContactPair, MasterSide};
 use crate::assembly::{MatrixSink, PatternSink};
-use crate::contact::kernel::{self as link, Friction, LinkInput, LinkState, Master, SlipRate};
+use crate::contact::kernel::{self, Friction, LinkInput, LinkMaster, LinkState, SlipRate};
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
 
@@ -84,9 +84,9 @@ impl ContactPair {
             let input = self.link_input(link, u_local, factor, &mut buf);
             let n = link_dofs.len();
             let state = if with_tangent {
-                link::residual_tangent(&input, &mut r[..n], Some(&mut k[..n * n]))
+                kernel::residual_tangent(&input, &mut r[..n], Some(&mut k[..n * n]))
             } else {
-                link::residual_tangent(&input, &mut r[..n], None)
+                kernel::residual_tangent(&input, &mut r[..n], None)
             };
             self.links[li].xi = state.xi;
             if state.closed {
@@ -116,7 +116,7 @@ impl ContactPair {
         let sf = qp / self.slave.nqp;
         let ns = self.slave.facet_type.nodes();
         self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
-        let (master, master_nodes): (Master, &[u32]) = match &self.master {
+        let (master, master_nodes): (LinkMaster, &[u32]) = match &self.master {
             MasterSide::Deformable(m) => {
                 let fnodes = m.facet_nodes(link.facet);
                 for (x, &n) in xm.iter_mut().zip(fnodes) {
@@ -124,7 +124,7 @@ impl ContactPair {
                 }
                 let x: &'b [[f64; 3]] = &xm[..fnodes.len()];
                 (
-                    Master::Facet {
+                    LinkMaster::Facet {
                         facet: m.facet_type,
                         x,
                     },

@@ -2,7 +2,7 @@
 //! step, and the following of sliding during its Newton iterations.
 use super::assemble::LinkBuffers;
 use super::{ContactPair, MasterSide};
-use crate::contact::kernel::{self as link, LinkState};
+use crate::contact::kernel::{self, LinkState};
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
 use std::collections::hash_map::DefaultHasher;
@@ -45,7 +45,7 @@ impl ContactPair {
         match &self.master {
             MasterSide::Deformable(m) => {
                 self.positions = m.positions(u_local);
-                let surface = search::MasterSurface {
+                let surface = search::SearchSurface {
                     facet_type: m.facet_type,
                     positions: &self.positions,
                     facets: &m.facets,
@@ -119,7 +119,7 @@ impl ContactPair {
             return;
         };
         self.positions = m.positions(u_local);
-        let surface = search::MasterSurface {
+        let surface = search::SearchSurface {
             facet_type: m.facet_type,
             positions: &self.positions,
             facets: &m.facets,
@@ -148,7 +148,7 @@ impl ContactPair {
         let mut buf = LinkBuffers::default();
         self.links
             .iter()
-            .map(|l| link::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
+            .map(|l| kernel::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
             .collect()
     }
 }
@@ -156,7 +156,7 @@ impl ContactPair {
 /// The projection onto `facet` when it is valid and inside the facet (with a
 /// small hysteresis beyond the search's own tolerance).
 fn still_inside(
-    surface: &search::MasterSurface,
+    surface: &search::SearchSurface,
     facet: u32,
     x: [f64; 3],
     xi: [f64; 2],

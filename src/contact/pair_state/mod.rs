@@ -28,7 +28,7 @@ use super::mortar::pair::MortarPair;
 use super::multipliers::Multipliers;
 use super::pair::{Formulation, MasterSpec, PairSpec, RigidSurface};
 use super::search;
-use super::surfaces::{MasterSurface, SlaveSurface};
+use super::surfaces::{SharedSurface, SlaveSurface};
 use crate::assembly::HaloFactory;
 use crate::dofs::DofMap;
 use crate::error::{Error, Result};
@@ -36,7 +36,7 @@ use crate::mesh::Mesh;
 
 /// The master side at run time.
 pub enum MasterSide {
-    Deformable(MasterSurface),
+    Deformable(SharedSurface),
     Rigid(RigidSurface),
 }
 
@@ -96,7 +96,7 @@ impl ContactPair {
         let slave = SlaveSurface::new(mesh, dofs, &spec.slave, &rule)?;
         let master = match &spec.master {
             MasterSpec::Surface { set } => {
-                MasterSide::Deformable(MasterSurface::new(mesh, dofs, set)?)
+                MasterSide::Deformable(SharedSurface::new(mesh, dofs, set)?)
             }
             MasterSpec::Rigid(r) => MasterSide::Rigid(*r),
         };

@@ -8,7 +8,7 @@ use crate::contact::dual::dot;
 use crate::contact::kernel::{LinkState, SlipHistory};
 use crate::contact::multipliers::{PointFriction, PointState};
 use crate::contact::projection;
-use crate::contact::surfaces::MasterSurface;
+use crate::contact::surfaces::SharedSurface;
 
 impl ContactPair {
     /// The point's slip origin and λT in the terms of the link's current
@@ -143,7 +143,7 @@ impl ContactPair {
 }
 
 /// Tangents `∂x/∂ξ_α` of a facet with nodes `x` at `xi`.
-fn facet_tangents(m: &MasterSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
+fn facet_tangents(m: &SharedSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
     let s = crate::fem::shape::facet_shape(m.facet_type, xi);
     let mut t = [[0.0; 3]; 2];
     for (xb, dn) in x.iter().zip(&s.dn) {
@@ -155,7 +155,7 @@ fn facet_tangents(m: &MasterSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3];
     t
 }
 
-fn facet_points(m: &MasterSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
+fn facet_points(m: &SharedSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
     m.facet_nodes(facet)
         .iter()
         .map(|&n| positions[n as usize])
@@ -165,7 +165,7 @@ fn facet_points(m: &MasterSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f
 /// ξ̄ₙ stored on facet `from`, expressed on facet `to`: the same point of the
 /// reference surface (history data is material, so the conversion is
 /// independent of the current displacements).
-fn rebase_origin(m: &MasterSurface, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
+fn rebase_origin(m: &SharedSurface, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
     let from_x = facet_points(m, from, &m.x_ref);
     let s = crate::fem::shape::facet_shape(m.facet_type, xi);
     let mut p = [0.0; 3];
@@ -181,7 +181,7 @@ fn rebase_origin(m: &MasterSurface, from: u32, xi: [f64; 2], to: u32, guess: [f6
 /// λT's covariant components on facet `from` carried to facet `to` as the
 /// same vector (tangents of `from` at its centre, of `to` at `xi`).
 fn rebase_lambda(
-    m: &MasterSurface,
+    m: &SharedSurface,
     positions: &[[f64; 3]],
     from: u32,
     lambda: [f64; 2],
@@ -214,8 +214,8 @@ mod tests {
     /// Two unit quads side by side in z = 0 (x ∈ [0, 1] and [1, 2]), the
     /// second one's nodes listed from a different corner so its ξ axes are
     /// turned against the first's.
-    fn two_quads() -> MasterSurface {
-        MasterSurface {
+    fn two_quads() -> SharedSurface {
+        SharedSurface {
             facet_type: FacetType::Quad4,
             node_local: (0..6).collect(),
             x_ref: vec![
@@ -230,7 +230,7 @@ mod tests {
         }
     }
 
-    fn point_on(m: &MasterSurface, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
+    fn point_on(m: &SharedSurface, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
         let s = crate::fem::shape::facet_shape(m.facet_type, xi);
         let mut p = [0.0; 3];
         for (&n, nb) in m.facet_nodes(facet).iter().zip(s.n) {
