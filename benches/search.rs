@@ -6,7 +6,7 @@
 //! index build time, search time (median of 3), points per second and
 //! nanoseconds per point. The search must grow like n log n or better: flat
 //! ns/point means linear. Output: CSV on stdout.
-use contactlink::contact::search::{MasterSurface, SearchIndex};
+use contactlink::contact::search::{SearchIndex, SearchSurface};
 use contactlink::fem::FacetType;
 use std::time::Instant;
 
@@ -70,7 +70,7 @@ fn main() {
     );
     for warp in WARPS {
         let (x, facets) = master(m, warp);
-        let surface = MasterSurface {
+        let surface = SearchSurface {
             facet_type: FacetType::Quad4,
             positions: &x,
             facets: &facets,

@@ -7,8 +7,8 @@
 //! from the same scene: same mesh (node count and coordinates, cell count),
 //! same contact pairs; anything else is an error naming the file and what
 //! differs, raised before any solve.
-use crate::contact::links::{FrictionRows, RestartRows};
 use crate::contact::multipliers::FrictionRecord;
+use crate::contact::pair_state::{FrictionRows, RestartRows};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::output::{layout, read_dataset, read_nodal, read_step_attrs, OutputError};

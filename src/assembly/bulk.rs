@@ -1,11 +1,11 @@
 //! Bulk (volume) contributions of every local cell: internal force, stiffness,
 //! consistent mass and stored energy.
 use super::{element_dofs, gather_nodal, scatter_add};
-use crate::dofs::{DofMap, DIM};
+use super::{MatrixSink, PatternSink};
+use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
 use crate::mesh::Mesh;
-use crate::petsc::{Matrix, PatternBuilder, PetscInt};
 
 /// Everything a rank needs to evaluate its cells, computed once: reference
 /// geometry (shape gradients at the quadrature points), materials and DOFs.
@@ -17,8 +17,8 @@ pub struct BulkAssembler {
     materials: Vec<Material>,
     /// Local node indices per local cell, flat.
     cell_nodes: Vec<u32>,
-    /// PETSc DOFs per local cell, flat (3 per node).
-    cell_dofs: Vec<PetscInt>,
+    /// Global DOFs per local cell, flat (3 per node).
+    cell_dofs: Vec<GlobalDof>,
     /// Natural cell ids, for error messages.
     natural_cell: Vec<usize>,
 }
@@ -79,7 +79,7 @@ impl BulkAssembler {
         &self.cell_nodes[i * n..(i + 1) * n]
     }
 
-    fn dofs(&self, i: usize) -> &[PetscInt] {
+    fn dofs(&self, i: usize) -> &[GlobalDof] {
         let n = 3 * self.npc();
         &self.cell_dofs[i * n..(i + 1) * n]
     }
@@ -108,7 +108,7 @@ impl BulkAssembler {
     }
 
     /// Adds the consistent tangent of every local cell into `k` (not assembled).
-    pub fn add_tangent(&self, u_local: &[f64], k: &mut Matrix) -> Result<()> {
+    pub fn add_tangent(&self, u_local: &[f64], k: &mut dyn MatrixSink) -> Result<()> {
         let n = self.npc();
         let mut u = [[0.0; 3]; 8];
         let mut r = [0.0; 24];
@@ -136,8 +136,8 @@ impl BulkAssembler {
     /// `materials[b]` is its material. The blocks land on the tangent's
     /// pattern, so `m` may be a matrix built from [`Self::add_pattern`] or the
     /// tangent itself. A body of density 0 adds nothing.
-    pub fn add_mass(&self, density: &[f64], m: &mut Matrix) -> Result<()> {
-        self.for_each_cell_mass(density, |dofs, me| Ok(m.add_block(dofs, dofs, me)?))
+    pub fn add_mass(&self, density: &[f64], m: &mut dyn MatrixSink) -> Result<()> {
+        self.for_each_cell_mass(density, |dofs, me| m.add_block(dofs, dofs, me))
     }
 
     /// Calls `add(dofs, mass)` for every local cell of non-zero density;
@@ -145,7 +145,7 @@ impl BulkAssembler {
     fn for_each_cell_mass(
         &self,
         density: &[f64],
-        mut add: impl FnMut(&[PetscInt], &[f64]) -> Result<()>,
+        mut add: impl FnMut(&[GlobalDof], &[f64]) -> Result<()>,
     ) -> Result<()> {
         // Checked up front rather than per cell: a rank without cells must
         // fail as well, or the others would wait for it in assembly.
@@ -243,7 +243,7 @@ impl BulkAssembler {
     }
 
     /// Records the entries every local cell couples.
-    pub fn add_pattern(&self, pattern: &mut PatternBuilder) -> Result<()> {
+    pub fn add_pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
         for i in 0..self.geometry.len() {
             pattern.add_square(self.dofs(i))?;
         }

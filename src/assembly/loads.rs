@@ -1,19 +1,18 @@
 //! Surface loads on facet sets: dead tractions and follower pressures.
-use super::{element_dofs, gather_nodal, scatter_add};
+use super::{element_dofs, gather_nodal, scatter_add, MatrixSink, PatternSink};
 use crate::amplitude::Amplitude;
-use crate::dofs::{DofMap, NaturalNode};
+use crate::dofs::{DofMap, GlobalDof, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
 use crate::mesh::{FacetRef, Mesh};
 use crate::model::FacetLoad;
-use crate::petsc::{Matrix, PatternBuilder, PetscInt};
 
 struct LocalFacet {
     /// Natural id of the cell the facet belongs to (for error messages).
     cell: usize,
     nodes: Vec<u32>,
     x_ref: Vec<[f64; 3]>,
-    dofs: Vec<PetscInt>,
+    dofs: Vec<GlobalDof>,
     load: FacetLoad,
     amplitude: Amplitude,
 }
@@ -124,7 +123,7 @@ impl SurfaceLoads {
     }
 
     /// Records the entries follower loads couple.
-    pub fn add_pattern(&self, pattern: &mut PatternBuilder) -> Result<()> {
+    pub fn add_pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
         for facet in self
             .facets
             .iter()
@@ -136,7 +135,7 @@ impl SurfaceLoads {
     }
 
     /// Adds −a(factor)·∂f_ext/∂u of follower loads into the tangent `k`.
-    pub fn add_tangent(&self, u_local: &[f64], factor: f64, k: &mut Matrix) -> Result<()> {
+    pub fn add_tangent(&self, u_local: &[f64], factor: f64, k: &mut dyn MatrixSink) -> Result<()> {
         let n = self.facet_type.nodes();
         let mut u = [[0.0; 3]; 4];
         let mut fe = [0.0; 12];

@@ -1,18 +1,22 @@
 //! Assembly: element and facet kernels (from `fem`) gathered from this rank's
-//! local arrays and added into PETSc storage.
+//! local arrays and added into a matrix or pattern through the traits of
+//! `sink` (which the PETSc types implement).
 //!
 //! Local arrays are PETSc ghosted-vector local forms: entry 3·l + c is
 //! component c of local node l (owned nodes first, then ghosts). Residuals are
 //! accumulated there and summed into owners by a reverse ghost update, so only
 //! the matrix goes through PETSc's off-rank stash.
 pub mod bulk;
+pub mod halo;
 pub mod loads;
+pub mod sink;
 
 pub use bulk::BulkAssembler;
+pub use halo::{Halo, HaloFactory};
 pub use loads::SurfaceLoads;
+pub use sink::{MatrixSink, PatternSink};
 
-use crate::dofs::{DofMap, LocalNode, DIM};
-use crate::petsc::PetscInt;
+use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 
 /// The displacement of `nodes` (local indices) read out of a local-form array.
 pub(crate) fn gather_nodal(local: &[f64], nodes: &[u32], out: &mut [[f64; 3]]) {
@@ -32,12 +36,12 @@ pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign
     }
 }
 
-/// PETSc DOF numbers of `nodes` (local indices), node-major.
-pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[u32], out: &mut Vec<PetscInt>) {
+/// Global DOFs of `nodes` (local indices), node-major.
+pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[u32], out: &mut Vec<GlobalDof>) {
     out.clear();
     for &l in nodes {
         for c in 0..DIM {
-            out.push(dofs.dof(LocalNode(l as usize), c).0);
+            out.push(dofs.dof(LocalNode(l as usize), c));
         }
     }
 }

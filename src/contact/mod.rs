@@ -10,20 +10,21 @@
 //!   at the slave points, the Uzawa update rule, halo exchange;
 //! - `outcome`: what a pair's evaluation reports (Uzawa statistics, force),
 //!   shared by both formulations;
-//! - `links`: a pair at run time (search per step, assembly, Uzawa update);
+//! - `pair_state`: a pair at run time ([`ContactPair`]: search per step,
+//!   assembly, Uzawa update, snapshots and restart, output values);
 //! - `mortar`: the mortar formulation (nodal dual multipliers, segment-based
 //!   integration of the slave–master overlap).
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
 pub mod dual;
 pub mod kernel;
-pub mod links;
 pub mod mortar;
 pub mod multipliers;
 pub mod outcome;
+pub mod pair_state;
 pub mod projection;
 pub mod search;
 pub mod surfaces;
 
-pub use links::ContactPair;
 pub use outcome::{PairForce, UzawaStats};
+pub use pair_state::ContactPair;

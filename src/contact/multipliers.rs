@@ -2,7 +2,7 @@
 //! rule λN ← ⟨λN − εN gN⟩.
 //!
 //! A slave quadrature point belongs to the rank that owns its facet's cell.
-//! The multipliers live in an owned + ghost layout (a PETSc ghosted vector in a
+//! The multipliers live in an owned + ghost layout (a [`Halo`] in a
 //! quadrature-point numbering that is contiguous per rank): ghosts are the
 //! points of other ranks' slave facets that touch a node this rank owns, so
 //! nodal quantities (the nodal contact pressure) need no further messages.
@@ -10,15 +10,15 @@
 //!
 //! With friction every point also carries its tangential state (λT, where
 //! this step's slip is measured from, stick/slip, traction and slip), in a
-//! second ghosted vector with the same owned + ghost layout, exchanged with
+//! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use super::kernel::{contact_pressure, reference_weights};
 use super::surfaces::SlaveSurface;
+use crate::assembly::{Halo, HaloFactory};
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, QuadRule};
 use crate::mesh::Mesh;
-use crate::petsc::{GhostedVector, PetscInt};
 
 /// The Uzawa update of one multiplier: the contact pressure of the converged
 /// Newton solution, pN = ⟨λN − εN gN⟩ (never negative: contact cannot pull).
@@ -133,7 +133,7 @@ const FRICTION_WIDTH: usize = 10;
 /// The friction state of every owned point and its halo.
 pub struct Tangential {
     pub points: Vec<PointFriction>,
-    halo: GhostedVector,
+    halo: Box<dyn Halo>,
 }
 
 impl Tangential {
@@ -160,13 +160,14 @@ pub struct Multipliers {
     pub tangential: Option<Tangential>,
     /// Wall time spent in halo exchanges, for the phase report.
     pub exchange_seconds: f64,
-    halo: GhostedVector,
+    halo: Box<dyn Halo>,
     n_owned: usize,
     n_ghost: usize,
     /// For the nodal pressure: contributions of owned and ghost points to owned nodes.
     nodal: Vec<NodalWeight>,
-    /// PETSc number of every slave facet of the set (by set index).
-    petsc_facet: Vec<usize>,
+    /// Global number of every slave facet of the set (by set index):
+    /// contiguous per rank, like the DOFs.
+    global_facet: Vec<usize>,
     /// Owned slave nodes: local index and reference position.
     owned_nodes: Vec<(u32, [f64; 3])>,
 }
@@ -176,18 +177,19 @@ impl Multipliers {
         mesh: &Mesh,
         dofs: &DofMap,
         partition: &[i32],
-        set: &str,
         slave: &SlaveSurface,
         rule: &QuadRule,
         friction: bool,
+        halos: &dyn HaloFactory,
     ) -> Result<Self> {
+        let set = &slave.set;
         let facets = mesh
             .facet_sets
             .get(set)
             .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
         let nqp = slave.nqp;
         let owner: Vec<usize> = facets.iter().map(|f| partition[f.cell] as usize).collect();
-        let petsc_facet = contiguous_numbering(&owner, dofs.nranks);
+        let global_facet = contiguous_numbering(&owner, dofs.nranks);
         let rank = dofs.rank;
         let owned_node = |nat: usize| dofs.local(NaturalNode(nat)).filter(|&l| dofs.is_owned(l));
         // Ghost facets: other ranks' facets with a node this rank owns.
@@ -202,15 +204,15 @@ impl Multipliers {
                 ghost_facets.push(i);
             }
         }
-        let ghosts: Vec<PetscInt> = ghost_facets
+        let ghosts: Vec<usize> = ghost_facets
             .iter()
             .flat_map(|&i| {
-                let first = petsc_facet[i] * nqp;
-                (0..nqp).map(move |q| (first + q) as PetscInt)
+                let first = global_facet[i] * nqp;
+                (0..nqp).map(move |q| first + q)
             })
             .collect();
         let n_owned = slave.num_qps();
-        let halo = GhostedVector::new(n_owned, &ghosts)?;
+        let halo = halos.halo(n_owned, &ghosts)?;
         let mut nodal = Vec::new();
         let mut owned_nodes: Vec<(u32, [f64; 3])> = Vec::new();
         let mut slot_of: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
@@ -244,15 +246,13 @@ impl Multipliers {
             add_facet(i, n_owned + k * nqp)?;
         }
         let tangential = if friction {
-            let wide: Vec<PetscInt> = ghosts
+            let wide: Vec<usize> = ghosts
                 .iter()
-                .flat_map(|&g| {
-                    (0..FRICTION_WIDTH as PetscInt).map(move |c| g * FRICTION_WIDTH as PetscInt + c)
-                })
+                .flat_map(|&g| (0..FRICTION_WIDTH).map(move |c| g * FRICTION_WIDTH + c))
                 .collect();
             Some(Tangential {
                 points: vec![PointFriction::default(); n_owned],
-                halo: GhostedVector::new(n_owned * FRICTION_WIDTH, &wide)?,
+                halo: halos.halo(n_owned * FRICTION_WIDTH, &wide)?,
             })
         } else {
             None
@@ -265,7 +265,7 @@ impl Multipliers {
             n_owned,
             n_ghost: ghosts.len(),
             nodal,
-            petsc_facet,
+            global_facet,
             owned_nodes,
         })
     }
@@ -279,23 +279,17 @@ impl Multipliers {
     }
 
     fn exchange_now(&mut self) -> Result<()> {
-        let lambda = &self.lambda;
-        self.halo
-            .global_mut()
-            .with_array_mut(|a| a.copy_from_slice(lambda))?;
-        self.halo.update_ghosts()?;
+        self.halo.exchange(&self.lambda)?;
         if let Some(t) = &mut self.tangential {
-            let points = &t.points;
-            t.halo.global_mut().with_array_mut(|a| {
-                for (chunk, p) in a.chunks_exact_mut(FRICTION_WIDTH).zip(points) {
-                    let origin = p.origin.map_or([f64::NAN; 3], |(o, _)| o);
-                    chunk[..3].copy_from_slice(&p.traction);
-                    chunk[3..6].copy_from_slice(&p.lambda);
-                    chunk[6..9].copy_from_slice(&origin);
-                    chunk[9] = p.state as i32 as f64;
-                }
-            })?;
-            t.halo.update_ghosts()?;
+            let mut owned = vec![0.0; FRICTION_WIDTH * t.points.len()];
+            for (chunk, p) in owned.chunks_exact_mut(FRICTION_WIDTH).zip(&t.points) {
+                let origin = p.origin.map_or([f64::NAN; 3], |(o, _)| o);
+                chunk[..3].copy_from_slice(&p.traction);
+                chunk[3..6].copy_from_slice(&p.lambda);
+                chunk[6..9].copy_from_slice(&origin);
+                chunk[9] = p.state as i32 as f64;
+            }
+            t.halo.exchange(&owned)?;
         }
         Ok(())
     }
@@ -317,15 +311,14 @@ impl Multipliers {
     pub fn nodal_tangential_forces(&self) -> Result<Vec<[f64; 3]>> {
         let mut forces = vec![[0.0; 3]; self.owned_nodes.len()];
         if let Some(t) = &self.tangential {
-            t.halo.with_local(|all| {
-                for w in &self.nodal {
-                    let base = FRICTION_WIDTH * w.slot as usize;
-                    let f = &mut forces[w.owned_slot as usize];
-                    for (fi, ti) in f.iter_mut().zip(&all[base..base + 3]) {
-                        *fi += w.weight * ti;
-                    }
+            let all = t.halo.local();
+            for w in &self.nodal {
+                let base = FRICTION_WIDTH * w.slot as usize;
+                let f = &mut forces[w.owned_slot as usize];
+                for (fi, ti) in f.iter_mut().zip(&all[base..base + 3]) {
+                    *fi += w.weight * ti;
                 }
-            })?;
+            }
         }
         Ok(forces)
     }
@@ -336,11 +329,10 @@ impl Multipliers {
     /// a facet's points over-constrain the surface) do not move the solution.
     pub fn nodal_forces(&self) -> Result<Vec<f64>> {
         let mut forces = vec![0.0; self.owned_nodes.len()];
-        self.halo.with_local(|all| {
-            for w in &self.nodal {
-                forces[w.owned_slot as usize] += w.weight * all[w.slot as usize];
-            }
-        })?;
+        let all = self.halo.local();
+        for w in &self.nodal {
+            forces[w.owned_slot as usize] += w.weight * all[w.slot as usize];
+        }
         Ok(forces)
     }
 
@@ -370,19 +362,19 @@ impl Multipliers {
     /// multipliers of every slave point around the node, on any rank), added
     /// into `numerator` and `denominator` (indexed by owned local node).
     pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) -> Result<()> {
-        self.halo.with_local(|all| {
-            debug_assert_eq!(all.len(), self.n_owned + self.n_ghost);
-            for w in &self.nodal {
-                numerator[w.owned_node as usize] += w.weight * all[w.slot as usize];
-                denominator[w.owned_node as usize] += w.weight;
-            }
-        })?;
+        let all = self.halo.local();
+        debug_assert_eq!(all.len(), self.n_owned + self.n_ghost);
+        for w in &self.nodal {
+            numerator[w.owned_node as usize] += w.weight * all[w.slot as usize];
+            denominator[w.owned_node as usize] += w.weight;
+        }
         Ok(())
     }
 
-    /// PETSc number of a slave point of this rank, for redistribution to output order.
-    pub fn petsc_point(&self, set_index: usize, q: usize, nqp: usize) -> usize {
-        self.petsc_facet[set_index] * nqp + q
+    /// Global number of a slave point of this rank (contiguous per rank),
+    /// for redistribution to output order.
+    pub fn global_point(&self, set_index: usize, q: usize, nqp: usize) -> usize {
+        self.global_facet[set_index] * nqp + q
     }
 }
 

@@ -5,11 +5,10 @@
 //! their nodes are ghosted on every rank (the master halo), so each rank
 //! searches and evaluates its own slave points without further messages.
 use super::kernel::reference_weights;
-use crate::dofs::{DofMap, LocalNode, NaturalNode, DIM};
+use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule};
 use crate::mesh::{FacetRef, Mesh};
-use crate::petsc::PetscInt;
 
 /// A slave facet this rank evaluates.
 #[derive(Debug, Clone)]
@@ -18,7 +17,7 @@ pub struct SlaveFacet {
     pub set_index: usize,
     pub nodes: Vec<u32>,
     pub x_ref: Vec<[f64; 3]>,
-    pub dofs: Vec<PetscInt>,
+    pub dofs: Vec<GlobalDof>,
     /// Shortest edge: the local element size for the penalty and tolerance.
     pub h: f64,
 }
@@ -26,6 +25,8 @@ pub struct SlaveFacet {
 /// The slave side: this rank's facets and their quadrature points.
 #[derive(Debug, Clone)]
 pub struct SlaveSurface {
+    /// Name of the slave facet set.
+    pub set: String,
     pub facet_type: FacetType,
     pub facets: Vec<SlaveFacet>,
     /// Quadrature points per facet (same rule on every facet).
@@ -82,7 +83,7 @@ impl SlaveSurface {
             let facet_dofs = nodes
                 .iter()
                 .flat_map(|&l| (0..DIM).map(move |c| (l, c)))
-                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c).0)
+                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c))
                 .collect();
             facets.push(SlaveFacet {
                 set_index,
@@ -94,6 +95,7 @@ impl SlaveSurface {
         }
         let global_facets = facet_refs.len();
         Ok(SlaveSurface {
+            set: set.to_owned(),
             facet_type,
             facets,
             nqp: rule.len(),
@@ -132,10 +134,12 @@ impl SlaveSurface {
     }
 }
 
-/// The master side of a deformable pair: every facet of the set, with its
-/// nodes numbered compactly (0..n) for the search, and their local indices.
+/// A facet set every rank sees in full (its nodes are ghosted on every
+/// rank): the master of a deformable pair, and both sides of a mortar pair.
+/// Every facet of the set, with its nodes numbered compactly (0..n) for the
+/// search, and their local indices.
 #[derive(Debug, Clone)]
-pub struct MasterSurface {
+pub struct SharedSurface {
     pub facet_type: FacetType,
     /// Local node index (owned or ghost) of each master node.
     pub node_local: Vec<u32>,
@@ -144,7 +148,7 @@ pub struct MasterSurface {
     pub facets: Vec<[u32; 4]>,
 }
 
-impl MasterSurface {
+impl SharedSurface {
     /// The natural ids of the master nodes, which every rank must ghost.
     pub fn natural_nodes(mesh: &Mesh, set: &str) -> Result<Vec<usize>> {
         let mut nodes: Vec<usize> = Vec::new();
@@ -175,7 +179,7 @@ impl MasterSurface {
             }
             facets.push(ids);
         }
-        Ok(MasterSurface {
+        Ok(SharedSurface {
             facet_type: mesh.cell_type.facet_type(),
             node_local,
             x_ref,
@@ -194,11 +198,11 @@ impl MasterSurface {
         &self.facets[facet as usize][..self.facet_type.nodes()]
     }
 
-    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<PetscInt>) {
+    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<GlobalDof>) {
         for &m in self.facet_nodes(facet) {
             let l = LocalNode(self.node_local[m as usize] as usize);
             for c in 0..DIM {
-                out.push(dofs.dof(l, c).0);
+                out.push(dofs.dof(l, c));
             }
         }
     }

@@ -46,7 +46,7 @@ impl Hdf5Sink {
         for p in sim.contact() {
             let nqp = p.slave.nqp;
             let rows = p.slave.global_facets * nqp;
-            let petsc_row = |nat: usize| p.multipliers.petsc_point(nat / nqp, nat % nqp, nqp);
+            let petsc_row = |nat: usize| p.multipliers.global_point(nat / nqp, nat % nqp, nqp);
             let owned = p.slave.num_qps();
             pairs.push(PairOrder {
                 scalar: NaturalOrder::new(rows, 1, owned, petsc_row, dofs.rank, dofs.nranks)?,

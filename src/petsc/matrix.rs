@@ -1,13 +1,6 @@
 //! Distributed sparse matrices (MPIAIJ) with exact preallocation.
 use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result, Vector};
 
-/// Anything dense element blocks can be added to: a matrix, or a pattern
-/// builder that only records where the non-zeros are.
-pub trait BlockSink {
-    /// Adds a dense row-major block at global (rows, cols).
-    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()>;
-}
-
 /// Records the non-zero pattern of a matrix, including entries in rows other
 /// ranks own, and then creates the matrix exactly preallocated for it
 /// (PETSc's MATPREALLOCATOR: the off-rank bookkeeping is PETSc's).
@@ -100,8 +93,14 @@ impl PatternBuilder {
     }
 }
 
-impl BlockSink for PatternBuilder {
-    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
+impl PatternBuilder {
+    /// Records the entries of a dense block at global (rows, cols).
+    pub fn add_block(
+        &mut self,
+        rows: &[PetscInt],
+        cols: &[PetscInt],
+        values: &[f64],
+    ) -> Result<()> {
         set_values(self.raw, rows, cols, values, sys::InsertMode_INSERT_VALUES)
     }
 }
@@ -263,12 +262,6 @@ impl Matrix {
             ))?
         };
         Ok(info.nz_used)
-    }
-}
-
-impl BlockSink for Matrix {
-    fn add_block(&mut self, rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
-        Matrix::add_block(self, rows, cols, values)
     }
 }
 

@@ -11,7 +11,7 @@ pub mod sys;
 pub mod vector;
 
 pub use log::LogStage;
-pub use matrix::{BlockSink, Matrix, PatternBuilder};
+pub use matrix::{Matrix, PatternBuilder};
 pub use reason::{KspReason, SnesReason};
 pub use scatter::Scatter;
 pub use snes::{NonlinearProblem, Snes, SnesOutcome};

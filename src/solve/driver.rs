@@ -25,7 +25,7 @@ use super::setup::{
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
 use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
-use crate::contact::links::{PairSnapshot, PointValues};
+use crate::contact::pair_state::{PairSnapshot, PointValues};
 use crate::contact::{ContactPair, PairForce, UzawaStats};
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};

@@ -9,7 +9,7 @@
 //! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
 use super::newmark::Coefficients;
 use crate::assembly::BulkAssembler;
-use crate::contact::links::SlipRateMap;
+use crate::contact::pair_state::SlipRateMap;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;

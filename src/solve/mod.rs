@@ -12,6 +12,7 @@ pub mod boundary;
 mod driver;
 pub mod dynamics;
 mod failure;
+pub mod halo;
 pub mod lagging;
 pub mod mechanics;
 pub mod natural;

@@ -3,7 +3,7 @@
 //! the step line `-v` prints.
 use super::dynamics::DynamicsReport;
 use super::phases::PhaseTimes;
-use crate::contact::links::PairForce;
+use crate::contact::pair_state::PairForce;
 use crate::contact::{ContactPair, UzawaStats};
 use crate::dofs::DofMap;
 use crate::error::Result;
@@ -75,7 +75,7 @@ pub struct RunReport {
 /// This rank's contact values of one pair at a converged step, for output.
 pub struct PairFields<'a> {
     pub pair: &'a ContactPair,
-    pub values: crate::contact::links::PointValues,
+    pub values: crate::contact::pair_state::PointValues,
 }
 
 /// Receives every converged step (the output file, a progress printer, ...).

@@ -120,12 +120,12 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     let mut master_nodes = Vec::new();
     for pair in &model.contact {
         if let MasterSpec::Surface { set } = &pair.master {
-            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh, set,
             )?);
         }
         if pair.formulation == crate::model::Formulation::Mortar {
-            master_nodes.extend(crate::contact::surfaces::MasterSurface::natural_nodes(
+            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh,
                 &pair.slave,
             )?);
@@ -158,7 +158,16 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         model
             .contact
             .iter()
-            .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest))
+            .map(|p| {
+                ContactPair::new(
+                    mesh,
+                    &dofs,
+                    &partition,
+                    p,
+                    softest,
+                    &super::halo::PetscHalos,
+                )
+            })
             .collect::<Result<Vec<_>>>(),
     )?;
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;

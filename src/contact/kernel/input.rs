@@ -10,9 +10,11 @@ use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 use crate::model::RigidSurface;
 
-/// The master side of a link.
+/// The master as one link's kernel sees it: the current nodes of its master
+/// facet, or a rigid analytic surface (`pair::RigidSurface` placed for the
+/// load step).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Master<'a> {
+pub enum LinkMaster<'a> {
     /// Deformable master facet, CURRENT nodal positions (these are DOFs).
     Facet { facet: FacetType, x: &'a [[f64; 3]] },
     /// Rigid half-space, no DOFs; `normal` (any length) points out of the
@@ -29,18 +31,18 @@ pub enum Master<'a> {
 }
 
 // The scene's rigid surface is plain data in `model`; its view as a link
-// master belongs beside `Master`, which `model` must not know.
+// master belongs beside `LinkMaster`, which `model` must not know.
 impl RigidSurface {
     /// The link kernel's view of the surface.
-    pub fn as_master(&self) -> Master<'static> {
+    pub fn as_master(&self) -> LinkMaster<'static> {
         match *self {
-            RigidSurface::Plane { point, normal } => Master::Plane { point, normal },
-            RigidSurface::Sphere { centre, radius } => Master::Sphere { centre, radius },
+            RigidSurface::Plane { point, normal } => LinkMaster::Plane { point, normal },
+            RigidSurface::Sphere { centre, radius } => LinkMaster::Sphere { centre, radius },
             RigidSurface::Cylinder {
                 point,
                 axis,
                 radius,
-            } => Master::Cylinder {
+            } => LinkMaster::Cylinder {
                 point,
                 axis,
                 radius,
@@ -111,7 +113,7 @@ pub struct LinkInput<'a> {
     pub zeta: [f64; 2],
     /// Reference area weight of that point (see [`reference_weights`]).
     pub weight: f64,
-    pub master: Master<'a>,
+    pub master: LinkMaster<'a>,
     /// Start for the projection (the last ξ̄).
     pub xi_start: [f64; 2],
     /// Uzawa multiplier, fixed during Newton (≥ 0).
@@ -212,9 +214,9 @@ pub fn dof_count(input: &LinkInput) -> usize {
     3 * (input.slave_facet.nodes() + master_nodes(&input.master))
 }
 
-pub(super) fn master_nodes(master: &Master) -> usize {
+pub(super) fn master_nodes(master: &LinkMaster) -> usize {
     match master {
-        Master::Facet { facet, .. } => facet.nodes(),
+        LinkMaster::Facet { facet, .. } => facet.nodes(),
         _ => 0,
     }
 }
@@ -272,16 +274,16 @@ pub fn check_input(input: &LinkInput) -> Result<(), LinkError> {
         check_friction(input, f)?;
     }
     match input.master {
-        Master::Facet { facet, x } => facet_nodes("master x", facet, x),
-        Master::Plane { point, normal } => {
+        LinkMaster::Facet { facet, x } => facet_nodes("master x", facet, x),
+        LinkMaster::Plane { point, normal } => {
             finite("plane point", &point)?;
             nonzero("plane normal", normal)
         }
-        Master::Sphere { centre, radius } => {
+        LinkMaster::Sphere { centre, radius } => {
             finite("sphere centre", &centre)?;
             non_negative("sphere radius", radius, true)
         }
-        Master::Cylinder {
+        LinkMaster::Cylinder {
             point,
             axis,
             radius,
@@ -296,7 +298,7 @@ pub fn check_input(input: &LinkInput) -> Result<(), LinkError> {
 fn check_friction(input: &LinkInput, f: &Friction) -> Result<(), LinkError> {
     non_negative("friction coefficient", f.mu, false)?;
     non_negative("tangential penalty", f.penalty, true)?;
-    let rigid = !matches!(input.master, Master::Facet { .. });
+    let rigid = !matches!(input.master, LinkMaster::Facet { .. });
     match f.history {
         SlipHistory::Convected { xi_n, lambda } if !rigid => {
             finite("xi_n", &xi_n)?;
@@ -412,7 +414,7 @@ pub(super) fn seed<const N: usize>(
 
 pub(super) fn master_x<'a>(input: &LinkInput<'a>) -> &'a [[f64; 3]] {
     match input.master {
-        Master::Facet { x, .. } => x,
+        LinkMaster::Facet { x, .. } => x,
         _ => &[],
     }
 }

@@ -2,7 +2,7 @@
 //! the slave point, the closest master point, gap, normal and the frame in
 //! which the master point moves (convected on a facet, rigid otherwise).
 
-use super::input::{LinkInput, Master};
+use super::input::{LinkInput, LinkMaster};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::contact::projection::mixed_second_derivative;
 use crate::fem::shape::facet_shape;
@@ -136,24 +136,27 @@ fn unit_f64(v: [f64; 3]) -> [f64; 3] {
 
 /// Closest point on a rigid master, in `T`. `None` where the normal is
 /// undefined (slave point at the sphere centre / on the cylinder axis).
-pub(super) fn rigid_kinematics<T: Scalar>(x1: &Vec3<T>, master: &Master) -> Option<Kinematics<T>> {
+pub(super) fn rigid_kinematics<T: Scalar>(
+    x1: &Vec3<T>,
+    master: &LinkMaster,
+) -> Option<Kinematics<T>> {
     let no_nodes = [T::from_f64(0.0); MAX_FACET_NODES];
     let one = T::from_f64(1.0);
     let (normal, gap, master_point, scale, axis) = match *master {
-        Master::Plane { point, normal } => {
+        LinkMaster::Plane { point, normal } => {
             let n = dual::constant3::<T>(unit_f64(normal));
             let gap = dual::dot(&dual::sub(x1, &dual::constant3(point)), &n);
             let foot = dual::sub(x1, &dual::scale(&n, gap));
             (n, gap, foot, one, None)
         }
-        Master::Sphere { centre, radius } => {
+        LinkMaster::Sphere { centre, radius } => {
             let c = dual::constant3::<T>(centre);
             let n = unit(&dual::sub(x1, &c), radius)?;
             let dist = dual::dot(&dual::sub(x1, &c), &n);
             let foot = dual::add(&c, &dual::scale_f64(&n, radius));
             (n, dist - radius, foot, dist.recip() * radius, None)
         }
-        Master::Cylinder {
+        LinkMaster::Cylinder {
             point,
             axis,
             radius,
@@ -168,7 +171,7 @@ pub(super) fn rigid_kinematics<T: Scalar>(x1: &Vec3<T>, master: &Master) -> Opti
             let foot = dual::add(&base, &dual::scale_f64(&n, radius));
             (n, dist - radius, foot, dist.recip() * radius, Some(a_f))
         }
-        Master::Facet { .. } => return None,
+        LinkMaster::Facet { .. } => return None,
     };
     Some(Kinematics {
         separation: dual::sub(x1, &master_point),
@@ -195,7 +198,7 @@ pub(super) fn kinematics<T: Scalar>(
 ) -> Option<Kinematics<T>> {
     let x1 = slave_point(input.slave_facet, input.zeta, slave);
     match input.master {
-        Master::Facet { facet, .. } => facet_kinematics(&x1, facet, master, xi_bar),
+        LinkMaster::Facet { facet, .. } => facet_kinematics(&x1, facet, master, xi_bar),
         _ => rigid_kinematics(&x1, &input.master),
     }
 }

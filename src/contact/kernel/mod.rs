@@ -57,7 +57,7 @@ mod tests;
 
 pub use input::{
     check_buffers, check_input, dof_count, reference_weights, Friction, FrictionState, LinkError,
-    LinkInput, LinkState, Master, SlipHistory, SlipRate,
+    LinkInput, LinkMaster, LinkState, SlipHistory, SlipRate,
 };
 pub use normal::{contact_pressure, potential, trial_pressure};
 

@@ -3,7 +3,7 @@
 //! open/closed, and the frictionless state and potential of a link.
 
 use super::evaluate;
-use super::input::{check_input, nodes_as, LinkInput, LinkState, Master};
+use super::input::{check_input, nodes_as, LinkInput, LinkMaster, LinkState};
 use super::kinematics::{rigid_kinematics, slave_point};
 use crate::contact::dual::Scalar;
 use crate::contact::projection;
@@ -33,7 +33,7 @@ pub(super) fn evaluate_normal(input: &LinkInput) -> LinkState {
         &slave[..input.slave_facet.nodes()],
     );
     let mut state = match input.master {
-        Master::Facet { facet, x } => {
+        LinkMaster::Facet { facet, x } => {
             let p = projection::project(facet, x, x1, Some(input.xi_start));
             LinkState {
                 gap: p.gap,

@@ -12,15 +12,15 @@
 //! that counts it in the Uzawa statistics and writes it out.
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
-use crate::contact::surfaces::MasterSurface;
-use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::contact::surfaces::SharedSurface;
+use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
 use crate::mesh::Mesh;
 use crate::model::PairSpec;
-use crate::petsc::{BlockSink, PatternBuilder, PetscInt};
 
 /// The nodal fields the output writes, one entry per owned mesh node of
 /// this rank (zero at nodes off the slave surface).
@@ -85,8 +85,8 @@ impl MortarPair {
         search_distance: f64,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
-        let slave = MasterSurface::new(mesh, dofs, &spec.slave)?;
-        let master = MasterSurface::new(mesh, dofs, master_set)?;
+        let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
+        let master = SharedSurface::new(mesh, dofs, master_set)?;
         let n_slave = slave.x_ref.len();
         let offset = n_slave as u32;
         let nf = facet_type.nodes();
@@ -270,14 +270,13 @@ impl MortarPair {
         DIM * self.node_local[id as usize] as usize + c
     }
 
-    fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> PetscInt {
+    fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
         dofs.dof(LocalNode(self.node_local[id as usize] as usize), c)
-            .0
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
     /// (all nodes of its candidate segments), squared into the pattern.
-    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut PatternBuilder) -> Result<()> {
+    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
         let nf = self.facet_type.nodes();
         let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
         for &(s, m) in &self.candidates {
@@ -291,7 +290,7 @@ impl MortarPair {
                 }
             }
         }
-        let mut d: Vec<PetscInt> = Vec::new();
+        let mut d: Vec<GlobalDof> = Vec::new();
         for (j, mut nodes) in support.into_iter().enumerate() {
             if !self.complete[j] || nodes.is_empty() {
                 continue;
@@ -329,7 +328,12 @@ impl MortarPair {
         );
     }
 
-    pub fn add_tangent(&self, dofs: &DofMap, u_local: &[f64], k: &mut dyn BlockSink) -> Result<()> {
+    pub fn add_tangent(
+        &self,
+        dofs: &DofMap,
+        u_local: &[f64],
+        k: &mut dyn MatrixSink,
+    ) -> Result<()> {
         let x = self.positions(u_local);
         let (segments, states) = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x);
         let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
@@ -343,7 +347,7 @@ impl MortarPair {
             },
         );
         entries.sort_by_key(|e| (e.0, e.1));
-        let (mut cols, mut vals): (Vec<PetscInt>, Vec<f64>) = (Vec::new(), Vec::new());
+        let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut i = 0;
         while i < entries.len() {
             let row = entries[i].0;

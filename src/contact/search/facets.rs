@@ -2,7 +2,7 @@
 //! ones, their nodes and neighbours, and distances to their boundary.
 
 use super::grid::Rows;
-use super::{is_finite3, MasterSurface};
+use super::{is_finite3, SearchSurface};
 use crate::vec3::{distance, distance2, dot, sub};
 
 /// A facet whose node ids are in range and whose coordinates are finite.
@@ -13,7 +13,7 @@ pub(super) struct UsableFacet {
     pub(super) k: usize,
 }
 
-pub(super) fn facet_nodes(surface: &MasterSurface, f: u32) -> Option<UsableFacet> {
+pub(super) fn facet_nodes(surface: &SearchSurface, f: u32) -> Option<UsableFacet> {
     let k = surface.facet_type.nodes();
     let ids = *surface.facets.get(f as usize)?;
     let mut nodes = [[0.0; 3]; 4];
@@ -34,7 +34,7 @@ pub(super) fn facet_nodes(surface: &MasterSurface, f: u32) -> Option<UsableFacet
 
 /// The usable facets in id order (ids beyond `u32` cannot be named and are
 /// left out).
-pub(super) fn usable_facets(surface: &MasterSurface) -> Vec<UsableFacet> {
+pub(super) fn usable_facets(surface: &SearchSurface) -> Vec<UsableFacet> {
     let n = surface.facets.len().min(u32::MAX as usize);
     (0..n as u32)
         .filter_map(|f| facet_nodes(surface, f))
@@ -43,7 +43,7 @@ pub(super) fn usable_facets(surface: &MasterSurface) -> Vec<UsableFacet> {
 
 /// Nodes of usable facets, ascending. Only these are searched: a node on no
 /// facet has no facet to project onto.
-pub(super) fn used_nodes(surface: &MasterSurface, facets: &[UsableFacet]) -> Vec<u32> {
+pub(super) fn used_nodes(surface: &SearchSurface, facets: &[UsableFacet]) -> Vec<u32> {
     let mut used = vec![false; surface.positions.len()];
     for f in facets {
         for &n in &f.ids[..f.k] {
@@ -57,7 +57,7 @@ pub(super) fn used_nodes(surface: &MasterSurface, facets: &[UsableFacet]) -> Vec
 
 /// For every facet id, the facets sharing a node with it (itself
 /// included), merged from the node rows; empty for unusable facets.
-pub(super) fn facet_neighbours(surface: &MasterSurface, node_facets: &Rows) -> Rows {
+pub(super) fn facet_neighbours(surface: &SearchSurface, node_facets: &Rows) -> Rows {
     let k = surface.facet_type.nodes();
     let mut start = Vec::with_capacity(surface.facets.len() + 1);
     let mut items = Vec::new();

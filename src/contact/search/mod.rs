@@ -113,10 +113,10 @@ type Aabb = ([f64; 3], [f64; 3]);
 
 const EMPTY_BOX: Aabb = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
 
-/// A master surface in its current configuration: node positions and facets
-/// (indices into `positions`).
+/// The surface a search looks in: a master surface in its current
+/// configuration, node positions and facets (indices into `positions`).
 #[derive(Debug, Clone, Copy)]
-pub struct MasterSurface<'a> {
+pub struct SearchSurface<'a> {
     pub facet_type: FacetType,
     pub positions: &'a [[f64; 3]],
     /// Tri3 uses the first 3 entries.
@@ -189,7 +189,7 @@ impl SearchIndex {
     /// Buckets the master nodes that belong to a usable facet into a uniform
     /// grid (cells about the mean edge length), the facets by bounding box
     /// into the same cells, and records node → facets adjacency.
-    pub fn build(surface: &MasterSurface) -> Self {
+    pub fn build(surface: &SearchSurface) -> Self {
         let facets = usable_facets(surface);
         let used = used_nodes(surface, &facets);
         let bbox = points_bounding_box_of(used.iter().map(|&n| surface.positions[n as usize]))
@@ -263,7 +263,7 @@ impl SearchIndex {
     /// nearest; equal distances go to the smaller node id), searching grid
     /// shells outward until no closer node can exist. `None` if the surface
     /// is empty, does not match the index, or `x` is not finite.
-    pub fn closest_node(&self, surface: &MasterSurface, x: [f64; 3]) -> Option<(u32, f64)> {
+    pub fn closest_node(&self, surface: &SearchSurface, x: [f64; 3]) -> Option<(u32, f64)> {
         if !self.matches(surface) || !is_finite3(x) {
             return None;
         }
@@ -275,7 +275,7 @@ impl SearchIndex {
     /// module doc) under the selection rule of the module doc. `None` when
     /// the closest node is farther than `max_distance` (or as for
     /// [`closest_node`](Self::closest_node)).
-    pub fn find(&self, surface: &MasterSurface, x: [f64; 3], max_distance: f64) -> Option<Found> {
+    pub fn find(&self, surface: &SearchSurface, x: [f64; 3], max_distance: f64) -> Option<Found> {
         let (node, distance) = self.closest_node(surface, x)?;
         // A NaN `max_distance` (unordered) finds nothing.
         if distance
@@ -306,7 +306,7 @@ impl SearchIndex {
     /// order it costs one sort.
     pub fn find_many(
         &self,
-        surface: &MasterSurface,
+        surface: &SearchSurface,
         points: &[[f64; 3]],
         max_distance: f64,
     ) -> Vec<Option<Found>> {
@@ -341,7 +341,7 @@ impl SearchIndex {
         order
     }
 
-    fn matches(&self, surface: &MasterSurface) -> bool {
+    fn matches(&self, surface: &SearchSurface) -> bool {
         surface.facet_type == self.facet_type
             && surface.positions.len() == self.n_positions
             && surface.facets.len() == self.n_facets
@@ -419,7 +419,7 @@ impl SearchIndex {
     /// Projects onto the facets around the closest node, nearest bounding
     /// box first: on a smooth mesh the first one holds the point and its
     /// distance lets the others be skipped without projecting.
-    fn search_ring(&self, surface: &MasterSurface, node: u32, x: [f64; 3], sel: &mut Selection) {
+    fn search_ring(&self, surface: &SearchSurface, node: u32, x: [f64; 3], sel: &mut Selection) {
         let ring = self.node_facets.row(node as usize);
         let mut order = [(0.0, 0u32); RING_BUF];
         let n = ring.len().min(RING_BUF);
@@ -438,7 +438,7 @@ impl SearchIndex {
     /// Looks at every facet whose bounding box lies within the best distance
     /// so far (plus margin): those are the only ones that could still win or
     /// tie, and the ring around the closest node need not hold them all.
-    fn sweep_near_facets(&self, surface: &MasterSurface, x: [f64; 3], sel: &mut Selection) {
+    fn sweep_near_facets(&self, surface: &SearchSurface, x: [f64; 3], sel: &mut Selection) {
         let r = sel.best + self.max_margin;
         let lo = x.map(|v| v - r);
         let hi = x.map(|v| v + r);
@@ -459,7 +459,7 @@ impl SearchIndex {
     /// their nodes are even read.
     fn consider(
         &self,
-        surface: &MasterSurface,
+        surface: &SearchSurface,
         f: u32,
         lower_bound2: f64,
         x: [f64; 3],
@@ -513,7 +513,7 @@ impl SearchIndex {
 /// among the candidates. Unusable candidate ids are ignored; `None` when no
 /// candidate is usable or `x` is not finite.
 pub fn select_facet(
-    surface: &MasterSurface,
+    surface: &SearchSurface,
     candidates: &[u32],
     x: [f64; 3],
     previous: Option<(u32, [f64; 2])>,

@@ -2,7 +2,7 @@
 //! (nearest valid projection, ties by facet id).
 
 use super::facets::{boundary_distance, facet_nodes, facet_size};
-use super::{is_finite3, MasterSurface, INSIDE_TOL, PRUNE_REL, TIE_REL};
+use super::{is_finite3, SearchSurface, INSIDE_TOL, PRUNE_REL, TIE_REL};
 use crate::contact::projection::{project, Projection};
 use crate::vec3::distance;
 
@@ -85,7 +85,7 @@ impl Selection {
 /// bounding box (at squared distance `lower_bound2`) is too far to win or
 /// tie.
 pub(super) fn consider(
-    surface: &MasterSurface,
+    surface: &SearchSurface,
     f: u32,
     lower_bound2: f64,
     x: [f64; 3],

@@ -9,8 +9,8 @@ use crate::vec3::distance;
 
 type Mesh = (Vec<[f64; 3]>, Vec<[u32; 4]>);
 
-fn surface<'a>(facet_type: FacetType, mesh: &'a Mesh) -> MasterSurface<'a> {
-    MasterSurface {
+fn surface<'a>(facet_type: FacetType, mesh: &'a Mesh) -> SearchSurface<'a> {
+    SearchSurface {
         facet_type,
         positions: &mesh.0,
         facets: &mesh.1,
@@ -104,7 +104,7 @@ struct Brute {
 
 /// Reference inner search: every facet of the surface projected, then the
 /// selection rule of the module doc written out directly.
-fn brute_force(s: &MasterSurface, facets: &[u32], x: [f64; 3]) -> Option<Brute> {
+fn brute_force(s: &SearchSurface, facets: &[u32], x: [f64; 3]) -> Option<Brute> {
     let mut all = Vec::new();
     for &f in facets {
         let Some(conn) = s.facets.get(f as usize) else {
@@ -138,18 +138,18 @@ fn brute_force(s: &MasterSurface, facets: &[u32], x: [f64; 3]) -> Option<Brute> 
         })
 }
 
-fn all_facets(s: &MasterSurface) -> Vec<u32> {
+fn all_facets(s: &SearchSurface) -> Vec<u32> {
     (0..s.facets.len() as u32).collect()
 }
 
-fn ring_of(s: &MasterSurface, node: u32) -> Vec<u32> {
+fn ring_of(s: &SearchSurface, node: u32) -> Vec<u32> {
     let k = s.facet_type.nodes();
     (0..s.facets.len() as u32)
         .filter(|&f| s.facets[f as usize][..k].contains(&node))
         .collect()
 }
 
-fn closest_node_brute(s: &MasterSurface, x: [f64; 3]) -> Option<(u32, f64)> {
+fn closest_node_brute(s: &SearchSurface, x: [f64; 3]) -> Option<(u32, f64)> {
     let k = s.facet_type.nodes();
     let mut best: Option<(u32, f64)> = None;
     for (n, p) in s.positions.iter().enumerate() {
@@ -169,7 +169,7 @@ fn closest_node_brute(s: &MasterSurface, x: [f64; 3]) -> Option<(u32, f64)> {
 /// `sample`; returns how often the winner was not around the closest
 /// node (so a test can insist the exactness sweep was exercised).
 fn check_find_against_brute(
-    s: &MasterSurface,
+    s: &SearchSurface,
     n: usize,
     rng: &mut Lcg,
     mut sample: impl FnMut(&mut Lcg) -> [f64; 3],
@@ -199,7 +199,7 @@ fn check_find_against_brute(
 /// The patch is sorted, unique, holds the facet and every facet sharing
 /// a node with it, and is exactly the 2-ring of the closest node plus the
 /// chosen facet's neighbours.
-fn check_patch(s: &MasterSurface, found: &Found) {
+fn check_patch(s: &SearchSurface, found: &Found) {
     let k = s.facet_type.nodes();
     let p = &found.patch;
     assert!(p.windows(2).all(|w| w[0] < w[1]), "patch not sorted/unique");
@@ -565,7 +565,7 @@ fn bad_input_finds_nothing_and_never_panics() {
     }
     // A surface that is not the one indexed.
     let other = small_flat();
-    let short = MasterSurface {
+    let short = SearchSurface {
         facets: &other.1[..3],
         ..surface(FacetType::Quad4, &other)
     };

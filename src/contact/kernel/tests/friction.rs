@@ -230,7 +230,7 @@ fn sliding_block_transmits_mu_times_pressure() {
     ];
     let masters = [
         (
-            Master::Facet {
+            LinkMaster::Facet {
                 facet: FacetType::Quad4,
                 x: &master_x,
             },
@@ -241,7 +241,7 @@ fn sliding_block_transmits_mu_times_pressure() {
             },
         ),
         (
-            Master::Plane {
+            LinkMaster::Plane {
                 point: [0.0; 3],
                 normal: [0.0, 0.0, 1.0],
             },

@@ -11,11 +11,11 @@ use crate::contact::{dual, projection};
 use crate::fem::test_util::{rel_err, Lcg};
 use crate::fem::{FacetType, QuadRule};
 
-/// Owned counterpart of [`Master`], so test cases can be perturbed.
+/// Owned counterpart of [`LinkMaster`], so test cases can be perturbed.
 #[derive(Clone)]
 enum OwnedMaster {
     Facet(FacetType, Vec<[f64; 3]>),
-    Rigid(Master<'static>),
+    Rigid(LinkMaster<'static>),
 }
 
 #[derive(Clone)]
@@ -45,7 +45,7 @@ struct CaseFriction {
 impl Case {
     fn input(&self) -> LinkInput<'_> {
         let master = match &self.master {
-            OwnedMaster::Facet(facet, x) => Master::Facet { facet: *facet, x },
+            OwnedMaster::Facet(facet, x) => LinkMaster::Facet { facet: *facet, x },
             OwnedMaster::Rigid(m) => *m,
         };
         let xi_start = match &self.master {
@@ -213,17 +213,17 @@ fn master_nodes(facet: FacetType, rng: &mut Lcg) -> Vec<[f64; 3]> {
     x
 }
 
-fn rigid_masters() -> [Master<'static>; 3] {
+fn rigid_masters() -> [LinkMaster<'static>; 3] {
     [
-        Master::Plane {
+        LinkMaster::Plane {
             point: [0.05, -0.02, 0.01],
             normal: [0.1, -0.15, 2.0],
         },
-        Master::Sphere {
+        LinkMaster::Sphere {
             centre: [0.1, 0.05, -1.3],
             radius: 1.3,
         },
-        Master::Cylinder {
+        LinkMaster::Cylinder {
             point: [0.0, 0.0, -1.3],
             axis: [1.0, 0.2, 0.1],
             radius: 1.3,

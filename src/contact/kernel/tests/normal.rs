@@ -157,7 +157,7 @@ fn pressed_totals(
     slave: FacetType,
     x_ref: &[[f64; 3]],
     x: &[[f64; 3]],
-    master: Master,
+    master: LinkMaster,
 ) -> ([f64; 3], [f64; 3]) {
     let rule = QuadRule::default_for_facet(slave);
     let (mut fs, mut fm) = ([0.0; 3], [0.0; 3]);
@@ -197,11 +197,11 @@ fn flat_facet_pressed_uniformly() {
         [table[0], table[1], 0.0],
     ];
     let masters = [
-        Master::Facet {
+        LinkMaster::Facet {
             facet: FacetType::Quad4,
             x: &master_x,
         },
-        Master::Plane {
+        LinkMaster::Plane {
             point: [0.0; 3],
             normal: [0.0, 0.0, 3.0],
         },
@@ -230,7 +230,7 @@ fn flat_facet_pressed_uniformly() {
                 "{} {fs:?} vs {expect:?}",
                 facet.name()
             );
-            if matches!(master, Master::Facet { .. }) {
+            if matches!(master, LinkMaster::Facet { .. }) {
                 assert!(rel_err(&fm, &[0.0, 0.0, p_n * area]) < 1e-13);
             }
         }
@@ -332,24 +332,24 @@ fn bad_input_is_reported_not_panicked() {
         [-0.5, 0.5, 0.0],
     ];
     let rigid = [
-        Master::Plane {
+        LinkMaster::Plane {
             point: [0.0; 3],
             normal: [0.0; 3],
         },
-        Master::Sphere {
+        LinkMaster::Sphere {
             centre: [0.0; 3],
             radius: 0.0,
         },
-        Master::Sphere {
+        LinkMaster::Sphere {
             centre: [0.0; 3],
             radius: 1.0,
         },
-        Master::Cylinder {
+        LinkMaster::Cylinder {
             point: [0.0; 3],
             axis: [0.0, 1.0, 0.0],
             radius: 1.0,
         },
-        Master::Cylinder {
+        LinkMaster::Cylinder {
             point: [0.0; 3],
             axis: [0.0; 3],
             radius: 1.0,
@@ -380,7 +380,7 @@ fn rigid_sphere_values() {
         slave_x: &x,
         zeta: [0.0, 0.0],
         weight: 2.0,
-        master: Master::Sphere {
+        master: LinkMaster::Sphere {
             centre: [0.0; 3],
             radius: 1.0,
         },

@@ -1,0 +1,264 @@
+//! What the links add to the Jacobian pattern, the residual and the tangent.
+use super::links::Link;
+use super::{ContactPair, MasterSide};
+use crate::assembly::{MatrixSink, PatternSink};
+use crate::contact::kernel::{self, Friction, LinkInput, LinkMaster, LinkState, SlipRate};
+use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::error::Result;
+
+/// Scratch space for one link's input (no allocation per link).
+#[derive(Default)]
+pub(super) struct LinkBuffers {
+    xs: [[f64; 3]; 4],
+    xm: [[f64; 3]; 4],
+    vs: [[f64; 3]; 4],
+    vm: [[f64; 3]; 4],
+}
+
+const MAX_LINK_NODES: usize = 8;
+
+const MAX_LINK_DOFS: usize = DIM * MAX_LINK_NODES;
+
+impl ContactPair {
+    /// Records every entry the links of this step may couple: each slave
+    /// facet with itself and with every master node in its links' patches.
+    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
+        if let Some(m) = &self.mortar {
+            return m.add_pattern(dofs, pattern);
+        }
+        let mut by_facet: std::collections::BTreeMap<usize, Vec<u32>> =
+            std::collections::BTreeMap::new();
+        for l in &self.links {
+            let entry = by_facet.entry(l.qp as usize / self.slave.nqp).or_default();
+            if let MasterSide::Deformable(m) = &self.master {
+                for &f in &l.patch {
+                    entry.extend_from_slice(m.facet_nodes(f));
+                }
+            }
+        }
+        let mut d: Vec<GlobalDof> = Vec::new();
+        for (facet, mut master_nodes) in by_facet {
+            d.clear();
+            d.extend_from_slice(&self.slave.facets[facet].dofs);
+            if let MasterSide::Deformable(m) = &self.master {
+                master_nodes.sort_unstable();
+                master_nodes.dedup();
+                for &n in &master_nodes {
+                    let l = crate::dofs::LocalNode(m.node_local[n as usize] as usize);
+                    d.extend((0..DIM).map(|c| dofs.dof(l, c)));
+                }
+            }
+            pattern.add_square(&d)?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates every link at the current state, handing each one's DOFs,
+    /// residual block and (when `with_tangent`) tangent block to `sink`.
+    fn for_each_link(
+        &mut self,
+        u_local: &[f64],
+        factor: f64,
+        with_tangent: bool,
+        mut sink: impl FnMut(&[u32], &[GlobalDof], &[f64], Option<&[f64]>, &LinkState) -> Result<()>,
+        dofs: &DofMap,
+    ) -> Result<()> {
+        self.follow(u_local);
+        let mut buf = LinkBuffers::default();
+        let mut r = [0.0; MAX_LINK_DOFS];
+        let mut k = vec![0.0; MAX_LINK_DOFS * MAX_LINK_DOFS];
+        let mut nodes: Vec<u32> = Vec::with_capacity(MAX_LINK_NODES);
+        let mut link_dofs: Vec<GlobalDof> = Vec::with_capacity(MAX_LINK_DOFS);
+        for li in 0..self.links.len() {
+            let link = &self.links[li];
+            let sf = link.qp as usize / self.slave.nqp;
+            nodes.clear();
+            link_dofs.clear();
+            nodes.extend_from_slice(&self.slave.facets[sf].nodes);
+            link_dofs.extend_from_slice(&self.slave.facets[sf].dofs);
+            if let MasterSide::Deformable(m) = &self.master {
+                let fnodes = m.facet_nodes(link.facet);
+                nodes.extend(fnodes.iter().map(|&n| m.node_local[n as usize]));
+                m.facet_dofs(link.facet, dofs, &mut link_dofs);
+            }
+            let input = self.link_input(link, u_local, factor, &mut buf);
+            let n = link_dofs.len();
+            let state = if with_tangent {
+                kernel::residual_tangent(&input, &mut r[..n], Some(&mut k[..n * n]))
+            } else {
+                kernel::residual_tangent(&input, &mut r[..n], None)
+            };
+            self.links[li].xi = state.xi;
+            if state.closed {
+                sink(
+                    &nodes,
+                    &link_dofs,
+                    &r[..n],
+                    with_tangent.then_some(&k[..n * n]),
+                    &state,
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The kernel's input for one link at the current state: slave and master
+    /// positions, λN, and (with friction) the slip history and velocities.
+    pub(super) fn link_input<'b>(
+        &'b self,
+        link: &Link,
+        u_local: &[f64],
+        factor: f64,
+        buf: &'b mut LinkBuffers,
+    ) -> LinkInput<'b> {
+        let LinkBuffers { xs, xm, vs, vm } = buf;
+        let qp = link.qp as usize;
+        let sf = qp / self.slave.nqp;
+        let ns = self.slave.facet_type.nodes();
+        self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
+        let (master, master_nodes): (LinkMaster, &[u32]) = match &self.master {
+            MasterSide::Deformable(m) => {
+                let fnodes = m.facet_nodes(link.facet);
+                for (x, &n) in xm.iter_mut().zip(fnodes) {
+                    *x = self.positions[n as usize];
+                }
+                let x: &'b [[f64; 3]] = &xm[..fnodes.len()];
+                (
+                    LinkMaster::Facet {
+                        facet: m.facet_type,
+                        x,
+                    },
+                    fnodes,
+                )
+            }
+            MasterSide::Rigid(spec) => (
+                spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor))
+                    .as_master(),
+                &[],
+            ),
+        };
+        let friction = match (&self.friction, &self.multipliers.tangential) {
+            (Some(pf), Some(t)) => {
+                let rate = self.rate.as_ref().map(|rate| {
+                    let velocity = |local: u32| {
+                        let d = DIM * local as usize;
+                        [0, 1, 2].map(|c| rate.dv_du * u_local[d + c] + rate.offset[d + c])
+                    };
+                    for (v, &n) in vs.iter_mut().zip(&self.slave.facets[sf].nodes) {
+                        *v = velocity(n);
+                    }
+                    let nm = match &self.master {
+                        MasterSide::Deformable(m) => {
+                            for (v, &n) in vm.iter_mut().zip(master_nodes) {
+                                *v = velocity(m.node_local[n as usize]);
+                            }
+                            master_nodes.len()
+                        }
+                        MasterSide::Rigid(_) => {
+                            vm[0] = rate.rigid_velocity;
+                            1
+                        }
+                    };
+                    SlipRate {
+                        slave_v: &vs[..ns],
+                        master_v: &vm[..nm],
+                        dt: rate.dt,
+                        dv_dx: rate.dv_du,
+                    }
+                });
+                Some(Friction {
+                    mu: pf.mu,
+                    penalty: pf.penalty[sf],
+                    history: self.slip_history(&t.points[qp], link, factor, u_local),
+                    rate,
+                })
+            }
+            _ => None,
+        };
+        LinkInput {
+            slave_facet: self.slave.facet_type,
+            slave_x: &xs[..ns],
+            zeta: self.slave.qp_zeta[qp],
+            weight: self.slave.qp_weight[qp],
+            master,
+            xi_start: link.xi,
+            lambda_n: self.multipliers.lambda[qp],
+            penalty: self.facet_penalty[sf],
+            friction,
+        }
+    }
+
+    /// Adds the links' residual r_c = −∫ pN δgN into the local-form array.
+    pub fn add_residual(
+        &mut self,
+        dofs: &DofMap,
+        u_local: &[f64],
+        factor: f64,
+        r_local: &mut [f64],
+    ) -> Result<()> {
+        if let Some(m) = &self.mortar {
+            m.add_residual(u_local, r_local);
+            return Ok(());
+        }
+        self.for_each_link(
+            u_local,
+            factor,
+            false,
+            |nodes, _, r, _, _| {
+                for (a, &l) in nodes.iter().enumerate() {
+                    for c in 0..DIM {
+                        r_local[DIM * l as usize + c] += r[DIM * a + c];
+                    }
+                }
+                Ok(())
+            },
+            dofs,
+        )
+    }
+
+    /// Adds the links' consistent tangent into `k` (not assembled).
+    pub fn add_tangent(
+        &mut self,
+        dofs: &DofMap,
+        u_local: &[f64],
+        factor: f64,
+        k: &mut dyn MatrixSink,
+    ) -> Result<()> {
+        if self.mortar.is_some() {
+            // No active-set hash for mortar pairs yet: a new signature at
+            // every tangent makes the solver rebuild its preconditioner each
+            // time, as it did before the active-set lag existed.
+            self.tangent_signature = self.tangent_signature.wrapping_add(1);
+        }
+        if let Some(m) = &self.mortar {
+            return m.add_tangent(dofs, u_local, k);
+        }
+        // Which links are closed, on which master facets, sticking or
+        // sliding: what the tangent's structure depends on.
+        let mut signature = std::collections::hash_map::DefaultHasher::new();
+        self.for_each_link(
+            u_local,
+            factor,
+            true,
+            |_, d, _, ke, s| match ke {
+                Some(ke) => {
+                    use std::hash::Hash;
+                    d.hash(&mut signature);
+                    s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
+                    k.add_block(d, d, ke)
+                }
+                None => Ok(()),
+            },
+            dofs,
+        )?;
+        self.tangent_signature = std::hash::Hasher::finish(&signature);
+        Ok(())
+    }
+
+    /// A hash of the active set the last tangent was assembled with (this
+    /// rank's links): equal hashes mean the same closed links on the same
+    /// master facets in the same stick/slip states.
+    pub fn tangent_signature(&self) -> u64 {
+        self.tangent_signature
+    }
+}

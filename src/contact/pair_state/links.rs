@@ -1,0 +1,173 @@
+//! The links of a load step: the search that makes them at the start of the
+//! step, and the following of sliding during its Newton iterations.
+use super::assemble::LinkBuffers;
+use super::{ContactPair, MasterSide};
+use crate::contact::kernel::{self, LinkState};
+use crate::contact::projection::{self, Projection};
+use crate::contact::search::{self, SearchIndex};
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+
+/// One ContactLink3D: a slave quadrature point and its partner on the master.
+#[derive(Debug, Clone)]
+pub struct Link {
+    /// Local slave quadrature point.
+    pub qp: u32,
+    /// Master facet (deformable masters).
+    pub facet: u32,
+    pub xi: [f64; 2],
+    /// Master facets the link may move to during this step's Newton
+    /// iterations (large sliding); the sparsity pattern covers them all.
+    pub patch: Vec<u32>,
+}
+
+impl ContactPair {
+    /// The search that starts every load step: outer search (closest master
+    /// node through the spatial index) and inner search (projection onto the
+    /// facets around it) for every slave point. Returns true when the coupling
+    /// pattern differs from the previous step's.
+    pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
+        if let Some(m) = &mut self.mortar {
+            return m.search(u_local);
+        }
+        let nq = self.slave.num_qps();
+        let points: Vec<[f64; 3]> = (0..nq)
+            .map(|q| self.slave.qp_position(q, u_local))
+            .collect();
+        let previous: Vec<Option<(u32, [f64; 2])>> = {
+            let mut p = vec![None; nq];
+            for l in &self.links {
+                p[l.qp as usize] = Some((l.facet, l.xi));
+            }
+            p
+        };
+        self.links.clear();
+        match &self.master {
+            MasterSide::Deformable(m) => {
+                self.positions = m.positions(u_local);
+                let surface = search::SearchSurface {
+                    facet_type: m.facet_type,
+                    positions: &self.positions,
+                    facets: &m.facets,
+                };
+                let index = SearchIndex::build(&surface);
+                let far_apart = match search::points_bounding_box(&points) {
+                    Some(b) => {
+                        !search::boxes_overlap(b, index.bounding_box(), self.search_distance)
+                    }
+                    None => true,
+                };
+                if !far_apart {
+                    for (q, x) in points.iter().enumerate() {
+                        if let Some(found) = index.find(&surface, *x, self.search_distance) {
+                            // Keep last step's partner while the point still lies
+                            // over it (see `follow`), else take the search's.
+                            let (facet, xi) = match previous[q] {
+                                Some((f, xi)) if found.patch.contains(&f) => {
+                                    match still_inside(&surface, f, *x, xi) {
+                                        Some(p) => (f, p.xi),
+                                        None => (found.facet, found.projection.xi),
+                                    }
+                                }
+                                _ => (found.facet, found.projection.xi),
+                            };
+                            self.links.push(Link {
+                                qp: q as u32,
+                                facet,
+                                xi,
+                                patch: found.patch,
+                            });
+                        }
+                    }
+                }
+            }
+            MasterSide::Rigid(spec) => {
+                let geometry = spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor));
+                for (q, x) in points.iter().enumerate() {
+                    if geometry.distance(*x) <= self.search_distance {
+                        self.links.push(Link {
+                            qp: q as u32,
+                            facet: 0,
+                            xi: [0.0; 2],
+                            patch: Vec::new(),
+                        });
+                    }
+                }
+            }
+        }
+        self.start_slip(&points, factor);
+        let key = self.coupling_key();
+        let changed = key != self.pattern_key;
+        self.pattern_key = key;
+        changed
+    }
+
+    fn coupling_key(&self) -> u64 {
+        let mut h = DefaultHasher::new();
+        for l in &self.links {
+            (l.qp / self.slave.nqp as u32).hash(&mut h);
+            l.patch.hash(&mut h);
+        }
+        self.links.len().hash(&mut h);
+        h.finish()
+    }
+
+    /// Follows sliding: re-selects each link's master facet within its patch
+    /// for the current configuration, and caches the master positions.
+    pub(super) fn follow(&mut self, u_local: &[f64]) {
+        let MasterSide::Deformable(m) = &self.master else {
+            return;
+        };
+        self.positions = m.positions(u_local);
+        let surface = search::SearchSurface {
+            facet_type: m.facet_type,
+            positions: &self.positions,
+            facets: &m.facets,
+        };
+        for l in &mut self.links {
+            let x = self.slave.qp_position(l.qp as usize, u_local);
+            // A link stays on its facet while it still projects inside it:
+            // where a point lies over a master node or edge, two facets are
+            // equally near, and switching between them from one Newton
+            // iteration to the next would make the residual chatter.
+            if let Some(p) = still_inside(&surface, l.facet, x, l.xi) {
+                l.xi = p.xi;
+                continue;
+            }
+            if let Some((facet, p)) =
+                search::select_facet(&surface, &l.patch, x, Some((l.facet, l.xi)))
+            {
+                l.facet = facet;
+                l.xi = p.xi;
+            }
+        }
+    }
+
+    pub(super) fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
+        self.follow(u_local);
+        let mut buf = LinkBuffers::default();
+        self.links
+            .iter()
+            .map(|l| kernel::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
+            .collect()
+    }
+}
+
+/// The projection onto `facet` when it is valid and inside the facet (with a
+/// small hysteresis beyond the search's own tolerance).
+fn still_inside(
+    surface: &search::SearchSurface,
+    facet: u32,
+    x: [f64; 3],
+    xi: [f64; 2],
+) -> Option<Projection> {
+    const STICKY: f64 = 1e-3;
+    let ids = surface.facets.get(facet as usize)?;
+    let n = surface.facet_type.nodes();
+    let mut xm = [[0.0; 3]; 4];
+    for (slot, &id) in xm.iter_mut().zip(&ids[..n]) {
+        *slot = *surface.positions.get(id as usize)?;
+    }
+    let p = projection::project(surface.facet_type, &xm[..n], x, Some(xi));
+    (p.converged && p.outside <= STICKY).then_some(p)
+}

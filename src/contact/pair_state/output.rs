@@ -1,0 +1,175 @@
+//! A pair's values for the result file: per slave point, per owned slave
+//! node, and this rank's part of the contact force.
+use super::ContactPair;
+use crate::contact::dual::norm;
+use crate::contact::multipliers::{FrictionRecord, PointFriction};
+use crate::contact::outcome::PairForce;
+use crate::error::Result;
+
+/// Point values for output, for this rank's slave points.
+pub struct PointValues {
+    pub points: Vec<[f64; 3]>,
+    pub pressure: Vec<f64>,
+    pub gap: Vec<f64>,
+    pub lambda: Vec<f64>,
+    /// Each point's area weight (reference configuration, the same weight
+    /// the contact force Σ pN·w uses), so readers can integrate pressures
+    /// and measure the contact area Σ w over points with pN > 0.
+    pub weight: Vec<f64>,
+    /// Friction (empty for a frictionless pair): tangential traction on the
+    /// slave, slip increment of the step, state (0 open, 1 stick, 2 slip).
+    pub traction: Vec<[f64; 3]>,
+    pub slip: Vec<[f64; 3]>,
+    pub state: Vec<i8>,
+    /// Friction history a restart needs (empty for a frictionless pair).
+    pub records: Vec<FrictionRecord>,
+    /// Owned slave nodes: reference position and nodal contact pressure.
+    pub nodes: Vec<([f64; 3], f64)>,
+    /// Mortar pairs: the nodal fields, per owned mesh node.
+    pub mortar: Option<crate::contact::mortar::pair::NodeFields>,
+}
+
+impl PointValues {
+    fn empty() -> Self {
+        PointValues {
+            points: Vec::new(),
+            pressure: Vec::new(),
+            gap: Vec::new(),
+            lambda: Vec::new(),
+            weight: Vec::new(),
+            traction: Vec::new(),
+            slip: Vec::new(),
+            state: Vec::new(),
+            records: Vec::new(),
+            nodes: Vec::new(),
+            mortar: None,
+        }
+    }
+}
+
+impl ContactPair {
+    /// Reference position and nodal contact pressure of every slave node
+    /// this rank owns. Reference, because small-strain closed forms (Hertz)
+    /// describe the pressure over the undeformed surface: the surfaces also
+    /// slide inward under load (about 1 % of the Hertz width here).
+    pub fn node_values(&self) -> Result<Vec<([f64; 3], f64)>> {
+        if let Some(m) = &self.mortar {
+            return Ok(m.node_values());
+        }
+        let pressures = self.multipliers.nodal_pressures()?;
+        Ok(self
+            .multipliers
+            .owned_nodes()
+            .iter()
+            .zip(pressures)
+            .map(|((_, x), p)| (*x, p))
+            .collect())
+    }
+
+    /// Point values at the current state for output (pressure from the
+    /// current multipliers: after a converged Uzawa loop λN is the pressure),
+    /// and this rank's part of the total contact force on the slave surface.
+    pub fn point_values(
+        &mut self,
+        u_local: &[f64],
+        factor: f64,
+    ) -> Result<(PointValues, PairForce)> {
+        if self.mortar.is_some() {
+            return Ok(self.mortar_point_values(u_local));
+        }
+        let nq = self.slave.num_qps();
+        let states = self.evaluate_links(u_local, factor);
+        let mut values = PointValues {
+            points: (0..nq)
+                .map(|q| self.slave.qp_position(q, u_local))
+                .collect(),
+            pressure: vec![0.0; nq],
+            gap: vec![self.search_distance; nq],
+            lambda: self.multipliers.lambda.clone(),
+            weight: self.slave.qp_weight.clone(),
+            traction: Vec::new(),
+            slip: Vec::new(),
+            state: Vec::new(),
+            records: Vec::new(),
+            nodes: self.node_values()?,
+            mortar: None,
+        };
+        if let Some(t) = &self.multipliers.tangential {
+            values.traction = t.points.iter().map(|p| p.traction).collect();
+            values.slip = t.points.iter().map(|p| p.slip).collect();
+            values.state = t.points.iter().map(|p| p.state as i8).collect();
+            values.records = t.points.iter().map(PointFriction::record).collect();
+        }
+        let mut force = PairForce::default();
+        for (l, s) in self.links.iter().zip(&states) {
+            let q = l.qp as usize;
+            // The updated multiplier ⟨λN − εN gN⟩ is exactly the pressure the
+            // last Newton solve balanced, so forces computed from it are in
+            // equilibrium with the reactions to the Newton tolerance.
+            let p = self.multipliers.lambda[q];
+            values.pressure[q] = p;
+            values.gap[q] = s.gap;
+            let w = self.slave.qp_weight[q];
+            for (f, n) in force.force.iter_mut().zip(s.normal) {
+                *f += p * n * w;
+            }
+            force.normal += p * w;
+            if let Some(t) = &self.multipliers.tangential {
+                // The traction of the last Uzawa update, like λN above.
+                let traction = t.points[q].traction;
+                for (f, tc) in force.force.iter_mut().zip(traction) {
+                    *f += tc * w;
+                }
+                force.tangential += norm(&traction) * w;
+            }
+        }
+        Ok((values, force))
+    }
+
+    /// Mortar pair: the slave points carry λ interpolated from the nodes
+    /// with the standard shape functions (Σ N_a λ_a, the smooth nodal
+    /// traction; the mortar field Σ Φ_a λ_a itself oscillates inside a facet).
+    fn mortar_point_values(&self, u_local: &[f64]) -> (PointValues, PairForce) {
+        let Some(m) = &self.mortar else {
+            return (PointValues::empty(), PairForce::default());
+        };
+        let lambda = m.lambda_by_local_node();
+        let nq = self.slave.num_qps();
+        let mut pressure = vec![0.0; nq];
+        for (q, p) in pressure.iter_mut().enumerate() {
+            let facet = &self.slave.facets[q / self.slave.nqp];
+            let s = crate::fem::shape::facet_shape(self.slave.facet_type, self.slave.qp_zeta[q]);
+            *p = facet
+                .nodes
+                .iter()
+                .zip(s.n)
+                .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
+                .sum();
+        }
+        let (fields, force) = m.output(u_local);
+        let values = PointValues {
+            points: (0..nq)
+                .map(|q| self.slave.qp_position(q, u_local))
+                .collect(),
+            lambda: pressure.clone(),
+            pressure,
+            gap: vec![0.0; nq],
+            weight: self.slave.qp_weight.clone(),
+            nodes: m.node_values(),
+            mortar: Some(fields),
+            ..PointValues::empty()
+        };
+        (values, force)
+    }
+
+    /// Adds this pair's nodal contact pressure (owned nodes) into the field.
+    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) -> Result<()> {
+        match &self.mortar {
+            Some(m) => {
+                m.add_nodal_pressure(numerator, denominator);
+                Ok(())
+            }
+            None => self.multipliers.add_nodal_pressure(numerator, denominator),
+        }
+    }
+}

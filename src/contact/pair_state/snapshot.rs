@@ -1,0 +1,122 @@
+//! What a pair keeps across steps: the snapshot a cutback restores, the
+//! commit that ends a converged step, and the restart from a result file.
+use super::ContactPair;
+use crate::contact::mortar::pair::MortarPair;
+use crate::contact::multipliers::{FrictionRecord, PointFriction};
+use crate::error::{Error, Result};
+
+/// One pair's state as a result file stores it, whole-pair arrays in output
+/// row order: what [`ContactPair::restart_from`] takes over.
+#[derive(Debug, Clone, Default)]
+pub struct RestartRows {
+    /// The pair's penalty at that step (None in files that lack it).
+    pub penalty: Option<f64>,
+    pub lambda: Vec<f64>,
+    pub friction: Option<FrictionRows>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct FrictionRows {
+    pub records: Vec<FrictionRecord>,
+    pub state: Vec<f64>,
+    pub traction: Vec<[f64; 3]>,
+}
+
+/// What a cut-back step restores: the multipliers and friction state of the
+/// last converged step.
+pub struct PairSnapshot {
+    lambda: Vec<f64>,
+    friction: Option<Vec<PointFriction>>,
+    /// The nodal multipliers of a mortar pair.
+    mortar: Option<Vec<f64>>,
+}
+
+impl ContactPair {
+    /// A converged step is final: the next one measures slip from here.
+    pub fn commit(&mut self) -> Result<()> {
+        if let Some(t) = &mut self.multipliers.tangential {
+            t.commit();
+            self.multipliers.exchange()?;
+        }
+        Ok(())
+    }
+
+    /// Takes over a converged step's multipliers and friction history from a
+    /// result file, given as whole-pair arrays in output row order (set
+    /// facet × quadrature point), then commits them as the step end did.
+    pub fn restart_from(&mut self, rows: &RestartRows) -> Result<()> {
+        if self.mortar.is_some() {
+            return Err(Error::Restart(format!(
+                "contact pair '{}': restarting a mortar pair is not supported",
+                self.spec.name
+            )));
+        }
+        let nqp = self.slave.nqp;
+        let row_of = |i: usize| self.slave.facets[i / nqp].set_index * nqp + i % nqp;
+        let n = self.slave.num_qps();
+        let lambda = (0..n)
+            .map(|i| rows.lambda.get(row_of(i)).copied())
+            .collect::<Option<Vec<f64>>>()
+            .filter(|l| l.iter().all(|v| v.is_finite() && *v >= 0.0))
+            .ok_or_else(|| self.restart_error("lambda_n"))?;
+        let friction = match (&self.multipliers.tangential, &rows.friction) {
+            (None, _) => None,
+            (Some(_), None) => return Err(self.restart_error("friction history")),
+            (Some(_), Some(f)) => Some(
+                (0..n)
+                    .map(|i| {
+                        let r = row_of(i);
+                        PointFriction::from_record(
+                            f.records.get(r)?,
+                            *f.state.get(r)?,
+                            *f.traction.get(r)?,
+                        )
+                    })
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or_else(|| self.restart_error("friction history"))?,
+            ),
+        };
+        if let Some(p) = rows.penalty.filter(|p| p.is_finite() && *p > 0.0) {
+            // Raised during the first run: continue with the same penalty.
+            self.raise_penalty(p / self.penalty);
+        }
+        self.restore(PairSnapshot {
+            lambda,
+            friction,
+            mortar: None,
+        })?;
+        self.commit()
+    }
+
+    fn restart_error(&self, what: &str) -> Error {
+        Error::Restart(format!(
+            "contact pair '{}': the file's {what} does not fit this pair's {} slave points",
+            self.spec.name,
+            self.slave.global_facets * self.slave.nqp
+        ))
+    }
+
+    /// The multipliers and friction state, to restore on a cutback.
+    pub fn snapshot(&self) -> PairSnapshot {
+        PairSnapshot {
+            lambda: self.multipliers.lambda.clone(),
+            friction: self
+                .multipliers
+                .tangential
+                .as_ref()
+                .map(|t| t.points.clone()),
+            mortar: self.mortar.as_ref().map(MortarPair::snapshot),
+        }
+    }
+
+    pub fn restore(&mut self, snap: PairSnapshot) -> Result<()> {
+        if let (Some(m), Some(lambda)) = (&mut self.mortar, snap.mortar) {
+            m.restore(lambda);
+        }
+        self.multipliers.lambda = snap.lambda;
+        if let (Some(t), Some(points)) = (&mut self.multipliers.tangential, snap.friction) {
+            t.points = points;
+        }
+        self.multipliers.exchange()
+    }
+}

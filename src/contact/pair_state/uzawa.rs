@@ -1,0 +1,82 @@
+//! The Uzawa update of a pair's multipliers, and its penalty.
+use super::ContactPair;
+use crate::contact::dual::{norm, sub};
+use crate::contact::multipliers::{updated_multiplier, PointState};
+use crate::contact::outcome::UzawaStats;
+use crate::error::Result;
+
+impl ContactPair {
+    /// The Uzawa update λN ← ⟨λN − εN gN⟩ (and, with friction, λT ← tT) at
+    /// every slave point of this rank (points without a link get λ = 0),
+    /// then the halo exchange.
+    pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
+        if let Some(m) = &mut self.mortar {
+            return Ok(m.uzawa_update(u_local));
+        }
+        let before = self.multipliers.nodal_forces()?;
+        let before_t = self.multipliers.nodal_tangential_forces()?;
+        let states = self.evaluate_links(u_local, factor);
+        let mut new_lambda = vec![0.0; self.slave.num_qps()];
+        let mut stats = UzawaStats::default();
+        for (l, s) in self.links.iter().zip(&states) {
+            let q = l.qp as usize;
+            let facet = q / self.slave.nqp;
+            new_lambda[q] =
+                updated_multiplier(self.multipliers.lambda[q], self.facet_penalty[facet], s.gap);
+            stats.max_penetration = stats
+                .max_penetration
+                .max(-s.gap / self.slave.facets[facet].h);
+            if new_lambda[q] > 0.0 {
+                stats.active += 1;
+            }
+        }
+        stats.max_multiplier = new_lambda.iter().copied().fold(0.0, f64::max);
+        self.multipliers.lambda = new_lambda;
+        stats.sliding = self.update_friction(&states, factor);
+        self.multipliers.exchange()?;
+        let after = self.multipliers.nodal_forces()?;
+        for (b, a) in before.iter().zip(&after) {
+            stats.max_change = stats.max_change.max((a - b).abs());
+            stats.max_force = stats.max_force.max(a.abs());
+        }
+        let after_t = self.multipliers.nodal_tangential_forces()?;
+        for (b, a) in before_t.iter().zip(&after_t) {
+            stats.max_change = stats.max_change.max(norm(&sub(a, b)));
+        }
+        Ok(stats)
+    }
+
+    /// Multiplies the normal penalty by `factor`, and the tangential one
+    /// when it follows the normal one (no `tangential_penalty` given). The
+    /// multipliers are kept: the augmented Lagrangian converges to the same
+    /// solution for any penalty, only faster for a larger one.
+    pub fn raise_penalty(&mut self, factor: f64) {
+        self.penalty *= factor;
+        self.facet_penalty.iter_mut().for_each(|p| *p *= factor);
+        if let Some(m) = &mut self.mortar {
+            m.raise_penalty(factor);
+        }
+        let follows = self
+            .spec
+            .active_friction()
+            .is_some_and(|f| f.penalty.is_none());
+        if let (true, Some(f)) = (follows, &mut self.friction) {
+            f.penalty.iter_mut().for_each(|p| *p *= factor);
+        }
+    }
+
+    /// This rank's points in contact (λN > 0) and, of those, sliding.
+    pub fn multiplier_states(&self) -> (usize, usize) {
+        if let Some(m) = &self.mortar {
+            return (m.active_nodes(), 0);
+        }
+        let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();
+        let sliding = self.multipliers.tangential.as_ref().map_or(0, |t| {
+            t.points
+                .iter()
+                .filter(|p| p.state == PointState::Slip)
+                .count()
+        });
+        (active, sliding)
+    }
+}
