@@ -615,6 +615,7 @@ impl<'m> Simulation<'m> {
             if echo && rt.rank() == 0 {
                 print_step(&report);
             }
+            crate::footprint::checkpoint("load step (solver and preconditioner alive)");
             let pair_fields: Vec<PairFields> = mech
                 .contact
                 .iter()
@@ -1082,7 +1083,9 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
     let world = rt.world();
     let (rank, size) = (rt.rank(), rt.size());
     let mesh = &model.mesh;
+    crate::footprint::checkpoint("model build");
     let partition = broadcast_partition(&world, mesh, rank, size)?;
+    crate::footprint::checkpoint("partition");
     let mut master_nodes = Vec::new();
     for pair in &model.contact {
         if let MasterSpec::Surface { set } = &pair.master {
@@ -1098,6 +1101,7 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         }
     }
     let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
+    crate::footprint::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
@@ -1128,6 +1132,8 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
             .collect::<Result<Vec<_>>>(),
     )?;
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
+    crate::footprint::checkpoint("assembly set-up and matrix allocation");
+    crate::footprint::setup_finished();
     Ok(Simulation {
         model,
         partition,
