@@ -1106,6 +1106,7 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
     )?;
+    crate::footprint::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();
     for (set, load, amplitude) in &model.facet_loads {
         let facets = mesh.facet_sets.get(set).ok_or_else(|| {
@@ -1131,8 +1132,9 @@ fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
             .map(|p| ContactPair::new(mesh, &dofs, &partition, p, softest))
             .collect::<Result<Vec<_>>>(),
     )?;
+    crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
-    crate::footprint::checkpoint("assembly set-up and matrix allocation");
+    crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
     Ok(Simulation {
         model,
