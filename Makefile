@@ -5,18 +5,24 @@ MPIRUN ?= mpirun --allow-run-as-root --oversubscribe
 CARGO ?= cargo
 # Debian's Python (python3-matplotlib is installed for it), not a pyenv shim.
 PYTHON ?= /usr/bin/python3
-export OMPI_MCA_rmaps_base_oversubscribe := 1
-export OMPI_ALLOW_RUN_AS_ROOT := 1
-export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
-# Shared-memory transport only: the machines have no usable network between ranks.
-export OMPI_MCA_btl := self,vader
-export OMPI_MCA_btl_vader_single_copy_mechanism := none
+# Local defaults; each can be overridden from the environment or the command
+# line (e.g. on a cluster: make scaling OMPI_MCA_btl=self,vader,tcp;
+# see docs/cluster.md).
+OMPI_MCA_rmaps_base_oversubscribe ?= 1
+OMPI_ALLOW_RUN_AS_ROOT ?= 1
+OMPI_ALLOW_RUN_AS_ROOT_CONFIRM ?= 1
+# Shared-memory transport only: a single machine with no usable network
+# between ranks. Multi-node runs need a network transport here.
+OMPI_MCA_btl ?= self,vader
+OMPI_MCA_btl_vader_single_copy_mechanism ?= none
+export OMPI_MCA_rmaps_base_oversubscribe OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
+export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism
 
 # The executable cargo built for target KIND NAME, from cargo's JSON messages
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
 cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
 
-.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -30,7 +36,7 @@ demo: build
 	@echo "demo: results in out/demo.h5 (open out/demo.xmf in ParaView; h5ls -r out/demo.h5 lists it)"
 
 # Every test: unit, verification and end-to-end (serial and mpirun -n 1/2/3),
-# then the MPI harness under 2 and 3 ranks, then the examples.
+# then the MPI harness under 2, 3 and 4 ranks, then the examples.
 test: deps
 	$(CARGO) build --release --bins --examples
 	$(CARGO) test --release
@@ -39,7 +45,7 @@ test: deps
 
 test-mpi:
 	@set -e; bin=$(call cargo_exe,test,mpi,test --release --test mpi --no-run); \
-	for n in 2 3; do \
+	for n in 2 3 4; do \
 	  echo "mpi-tests on $$n ranks"; \
 	  $(MPIRUN) -n $$n $$bin; \
 	done
@@ -103,11 +109,21 @@ work-precision: build
 	$(PYTHON) scripts/work_precision.py --scene hertz-sphere --np $(NP) --repeats 3 \
 	  --sizes 0.7,0.5 --penalties 0.1,1,10 --tols 1e-2,1e-3
 
-# Strong (152k DOFs, 1/2 ranks, 4 oversubscribed for correctness) and weak
-# scaling of the Hertz line contact, with the halo volume (about 4 minutes).
+# Strong (152k DOFs on the iterative path, 1/2 ranks, 4 oversubscribed for
+# correctness) and weak scaling of the Hertz line contact, with the halo
+# volume and the peak memory per rank; ends with the 2-rank efficiency
+# T1/(2·T2) and memory lines (medians of 3 runs).
 scaling: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/scaling.py --repeats 3
+
+# Peak memory per rank (largest, smallest) against the ranks: set-up only of a
+# 1.28M-DOF mesh on 1, 2, 4, 8 ranks and a 167k-DOF plain elastic solve on
+# 1, 2, 4, with each phase's resident memory and the ratios to 1 rank against
+# the targets (about 5 minutes on 2 cores; the 8-rank set-up needs ~3 GB).
+memory: build
+	@mkdir -p bench-results
+	$(PYTHON) scripts/memory.py --mpirun "$(MPIRUN)"
 
 # Hertz verification under refinement (figures in the README).
 hertz-study: build

@@ -251,10 +251,10 @@ HERTZ = re.compile(r"p0 computed ([-+0-9.e]+), analytic ([-+0-9.e]+) \(([-+0-9.]
 
 
 def mpi_env():
-    return dict(os.environ, OMPI_MCA_btl="self,vader",
+    return dict(dict(OMPI_MCA_btl="self,vader",
                 OMPI_MCA_btl_vader_single_copy_mechanism="none",
                 OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-                OMP_NUM_THREADS="1")
+                OMP_NUM_THREADS="1"), **os.environ)
 
 
 def run_contactlink(binary, np_, scene, extra):

@@ -3,32 +3,37 @@
 
 usage: scaling.py [--repeats 3] [--out bench-results]
 
-Strong: hertz-cylinder at h = 0.05 (152,316 DOFs) on 1 and 2 ranks (median
-of --repeats runs of the solve time printed by contactlink), and on 4 ranks
-with --oversubscribe for correctness only (2 cores). Weak: about 16k DOFs
-per rank (h = 0.2 on 1 rank, h = 0.1414 on 2). Prints a table, the parallel
-efficiency, the halo volume, and that 2 and 4 ranks reproduce 1 rank's
-Hertz figures; writes <out>/scaling.csv.
+Strong: hertz-cylinder at mesh.level=1 (152,316 DOFs) on the iterative path
+(the default solver: GAMG-preconditioned Krylov above 20k DOFs) on 1 and 2
+ranks (median of --repeats runs of the solve time printed by contactlink),
+and on 4 ranks with --oversubscribe for correctness only (2 cores). Weak:
+about 16k DOFs per rank (h = 0.2 on 1 rank, h = 0.1414 on 2). Prints a
+table, the parallel efficiency, the halo volume, the peak memory per rank
+(largest and smallest), and that 2 and 4 ranks reproduce 1 rank's Hertz
+figures; ends with the two headline lines: the 2-rank strong-scaling
+efficiency T1/(2*T2) and the 2-rank peak memory of the largest rank against
+1 rank's. Writes <out>/scaling.csv. Set MPIRUN to change the launcher.
 """
 import argparse
 import csv
 import os
 import re
+import shlex
 import statistics
 import subprocess
 
 DONE = re.compile(r"done: \d+ steps, (\d+) Newton iterations, (\d+) DOFs on (\d+) rank\(s\), ([0-9.]+) s")
 HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
+MEMORY = re.compile(r"memory: peak resident ([0-9.]+) MiB on the largest rank, ([0-9.]+) MiB on the smallest")
 HALO = re.compile(r"halo \(all ranks\): (\d+) ghost displacement values per residual, (\d+) ghost multiplier")
 
 
 def run(np_, args):
-    env = dict(os.environ, OMPI_MCA_btl="self,vader",
+    env = dict(dict(OMPI_MCA_btl="self,vader",
                OMPI_MCA_btl_vader_single_copy_mechanism="none",
-               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           "target/release/contactlink", "run", "hertz-cylinder",
-           "--set", "solver.direct_max_dofs=200000"] + args
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"), **os.environ)
+    mpirun = shlex.split(os.environ.get("MPIRUN", "mpirun --allow-run-as-root --oversubscribe"))
+    cmd = mpirun + ["-n", str(np_), "target/release/contactlink", "run", "hertz-cylinder"] + args
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     out = p.stdout + p.stderr
     d = DONE.search(out)
@@ -36,9 +41,12 @@ def run(np_, args):
         raise SystemExit(f"{' '.join(cmd)} failed:\n{out[-600:]}")
     h = HERTZ.search(out.split("Hertz:")[-1])
     halo = HALO.search(out)
+    mem = MEMORY.search(out)
     return {
         "ranks": np_, "dofs": int(d[2]), "newton": int(d[1]), "seconds": float(d[4]),
         "e_p0": float(h[1]), "e_b": float(h[2]),
+        "peak_largest_mib": float(mem[1]) if mem else 0.0,
+        "peak_smallest_mib": float(mem[2]) if mem else 0.0,
         "halo_u": int(halo[1]) if halo else 0, "halo_lambda": int(halo[2]) if halo else 0,
     }
 
@@ -47,6 +55,8 @@ def median_run(np_, args, repeats):
     runs = [run(np_, args) for _ in range(repeats)]
     row = dict(runs[0])
     row["seconds"] = statistics.median(r["seconds"] for r in runs)
+    for k in ("peak_largest_mib", "peak_smallest_mib"):
+        row[k] = statistics.median(r[k] for r in runs)
     row["repeats"] = repeats
     return row
 
@@ -71,6 +81,7 @@ def main():
     w1 = rows[3]
     rows[4]["efficiency"] = w1["seconds"] / rows[4]["seconds"] * (rows[4]["dofs"] / rows[4]["ranks"]) / w1["dofs"]
     keys = ["kind", "ranks", "dofs", "repeats", "seconds", "efficiency", "newton",
+            "peak_largest_mib", "peak_smallest_mib",
             "e_p0", "e_b", "halo_u", "halo_lambda"]
     with open(f"{a.out}/scaling.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
@@ -80,10 +91,18 @@ def main():
         eff = f"{100 * r['efficiency']:.0f} %" if "efficiency" in r else "-"
         print(f"{r['kind']:<48} {r['ranks']} ranks {r['dofs']:>7} DOFs {r['seconds']:7.2f} s "
               f"eff {eff:>6}  Newton {r['newton']:3d}  p0 {r['e_p0']:+.3f} % b {r['e_b']:+.3f} %  "
-              f"halo {r['halo_u']} u / {r['halo_lambda']} λ")
+              f"halo {r['halo_u']} u / {r['halo_lambda']} λ  "
+              f"peak memory {r['peak_largest_mib']:.0f}/{r['peak_smallest_mib']:.0f} MiB (largest/smallest rank)")
     same = all(abs(r["e_p0"] - rows[0]["e_p0"]) < 1e-3 and abs(r["e_b"] - rows[0]["e_b"]) < 1e-3
                for r in rows[:3])
     print("strong-scaling runs agree on the Hertz figures:", same)
+    one, two = rows[0], rows[1]
+    print(f"2-rank parallel efficiency T1/(2*T2): {100 * two['efficiency']:.0f} % "
+          f"({one['dofs']} DOFs, iterative path, median of {a.repeats}: "
+          f"T1 {one['seconds']:.2f} s, T2 {two['seconds']:.2f} s)")
+    print(f"peak memory per rank: 1 rank {one['peak_largest_mib']:.0f} MiB; 2 ranks largest "
+          f"{two['peak_largest_mib']:.0f} MiB, smallest {two['peak_smallest_mib']:.0f} MiB "
+          f"({two['peak_largest_mib'] / one['peak_largest_mib']:.2f}x of 1 rank)")
     print(f"scaling: {a.out}/scaling.csv")
 
 

@@ -1,5 +1,6 @@
 //! The `contactlink` command line: run a scene, list the built-in scenes,
 //! check a scene without solving, summarise or plot a result file.
+use contactlink::footprint::Footprint;
 use contactlink::pipeline::{self, RunOptions};
 use contactlink::runtime::Runtime;
 use contactlink::scene::BUILTIN;
@@ -12,6 +13,7 @@ contactlink — parallel 3D contact mechanics on PETSc
 
 usage:
   contactlink run SCENE [-o OUT.h5] [--set key=value]... [--restart FROM.h5] [-v | -q] [PETSc options]
+  contactlink run SCENE --setup-only [--set key=value]... [PETSc options]
   contactlink check SCENE [--set key=value]...
   contactlink summary OUT.h5 [--csv]
   contactlink plot OUT.h5 [-o profile.png] [--step N]
@@ -29,8 +31,12 @@ PETSC_OPTIONS in the environment is read too. Options given here override the sc
 
 run prints one line per load step when its output goes to a terminal (under mpirun:
 when mpirun's does) or with -v (--verbose),
-then a summary (`done:`, time per phase, Hertz, `output:`); -q (--quiet) prints
-nothing on success.
+then a summary (`done:`, time per phase, peak memory per rank and set-up time,
+Hertz, `output:`); -q (--quiet) prints nothing on success.
+--setup-only stops before the first solve (scene, mesh, partition, DOFs and the
+matrix are built) and prints the peak memory per rank and the set-up time.
+CONTACTLINK_MEMORY=1 in the environment prints every rank's resident and peak
+memory after each set-up phase and each load step to stderr.
 summary prints one row per step of a result file: load, iterations, wall time and per
 contact pair the force, normal force, contact area, peak pressure and active points
 (--csv: the same as CSV).
@@ -50,6 +56,8 @@ struct Cli {
     csv: bool,
     /// plot --step N.
     step: Option<usize>,
+    /// run --setup-only: stop before the first solve.
+    setup_only: bool,
 }
 
 fn parse_args(args: &[String]) -> Result<Cli, String> {
@@ -63,6 +71,7 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
         verbose: false,
         csv: false,
         step: None,
+        setup_only: false,
     };
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -80,6 +89,7 @@ fn parse_args(args: &[String]) -> Result<Cli, String> {
             "-q" | "--quiet" => cli.run.quiet = true,
             "-v" | "--verbose" => cli.verbose = true,
             "--csv" => cli.csv = true,
+            "--setup-only" => cli.setup_only = true,
             "--step" => {
                 let n = it.next().ok_or("--step needs a step number")?;
                 let n = n
@@ -175,9 +185,16 @@ fn usage_error(msg: &str) -> ExitCode {
 }
 
 fn check(scene: &str, overrides: &[String]) -> ExitCode {
+    let started = std::time::Instant::now();
     match contactlink::check::load(scene, overrides) {
         Ok(checked) => {
+            let seconds = started.elapsed().as_secs_f64();
             print!("{}", contactlink::check::summary(&checked));
+            // One process, no partition or matrix: what the model alone costs.
+            println!(
+                "memory: peak resident {:.1} MiB (this process, model only); scene and mesh built in {seconds:.2} s",
+                contactlink::footprint::peak_mib().unwrap_or(0.0)
+            );
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -195,13 +212,22 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    if cli.setup_only {
+        return setup_only(rt, scene, cli);
+    }
     let rank = rt.rank();
     let result = pipeline::run_scene(&rt, scene, &cli.run);
+    // Collective, on every rank whatever the outcome (failures are agreed).
+    let footprint = Footprint::over_ranks(&rt.world());
+    contactlink::footprint::checkpoint("the run");
     // One error line under MPI: failures are agreed (every failing rank
     // holds the same text), so the lowest rank that has it prints it.
     let printer = contactlink::parallel::lowest_rank(&rt.world(), result.is_err());
     let code = match result {
         Ok(summary) => {
+            if let (0, Some(p)) = (rank, &summary.output) {
+                record_footprint(p, &footprint);
+            }
             // The summary prints unless -q (scripts parse its `done:` and
             // `Hertz:` lines); the per-step lines were decided in parse_args.
             if rank == 0 && !cli.run.quiet {
@@ -216,6 +242,7 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                     r.wall_seconds
                 );
                 println!("{}", phase_summary(&r.phases, r.wall_seconds));
+                println!("{}", footprint.summary_line());
                 if r.preconditioner_builds > 0 {
                     let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
                     println!(
@@ -275,6 +302,47 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     code
 }
 
+/// `/footprint` in the closed result file; a failure only warns (the
+/// results are written; the other ranks have moved on).
+fn record_footprint(path: &std::path::Path, footprint: &Footprint) {
+    if let Err(e) = contactlink::results::footprint::write(path, footprint) {
+        eprintln!("contactlink: warning: {e}");
+    }
+}
+
+/// `contactlink run SCENE --setup-only`.
+fn setup_only(rt: Runtime, scene: &str, cli: &Cli) -> ExitCode {
+    let rank = rt.rank();
+    let result = contactlink::setup_only::setup_only(&rt, scene, &cli.run.overrides);
+    let footprint = Footprint::over_ranks(&rt.world());
+    let printer = contactlink::parallel::lowest_rank(&rt.world(), result.is_err());
+    let code = match result {
+        Ok(s) => {
+            if rank == 0 && !cli.run.quiet {
+                println!(
+                    "set-up only: {}: {} cells, {} nodes, {} DOFs on {} rank(s), {:.2} s",
+                    s.model_name,
+                    s.cells,
+                    s.nodes,
+                    s.global_dofs,
+                    rt.size(),
+                    footprint.setup_seconds
+                );
+                println!("{}", footprint.summary_line());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            if printer == Some(rank) {
+                eprintln!("contactlink: {e}");
+            }
+            ExitCode::FAILURE
+        }
+    };
+    drop(rt);
+    code
+}
+
 /// "where the time went" line: each phase's seconds and share of the run.
 fn phase_summary(t: &contactlink::solve::phases::PhaseTimes, wall: f64) -> String {
     use contactlink::solve::phases::Phase;
@@ -302,6 +370,11 @@ fn summary(file: &str, csv: bool) -> ExitCode {
         }
         Ok(rows) => {
             print!("{}", summary::table(path, &rows));
+            match contactlink::results::footprint::read(path) {
+                Ok(Some(fp)) => println!("{}", fp.summary_line().trim_start()),
+                Ok(None) => {}
+                Err(e) => eprintln!("contactlink: warning: {e}"),
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

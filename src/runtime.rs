@@ -23,6 +23,10 @@ impl Runtime {
         let mut args = vec!["contactlink".to_owned()];
         args.extend(petsc_args.iter().cloned());
         let petsc = PetscGuard::initialize(&world, &args)?;
+        // Set-up time counts from here: the scene, the mesh, the partition
+        // and the matrix, not MPI's and PETSc's own start-up.
+        crate::footprint::setup_started();
+        crate::footprint::checkpoint("MPI and PETSc start-up");
         Ok(Runtime {
             _petsc: petsc,
             universe,

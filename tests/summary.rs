@@ -142,11 +142,20 @@ fn summary_and_plot_of_a_hertz_run() {
         2.0 * b_exact
     );
 
-    // The table: the file named once, one row per step.
+    // The table: the file named once, one row per step, then the run's
+    // peak memory per rank and set-up time (`/footprint`).
     let o = run_cmd(&["summary", file]);
     let table = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(o.status.success() && table.starts_with(file), "{table}");
-    assert_eq!(table.lines().count(), 2 + 2, "{table}");
+    assert_eq!(table.lines().count(), 2 + 2 + 1, "{table}");
+    assert!(
+        table
+            .lines()
+            .last()
+            .unwrap()
+            .starts_with("memory: peak resident"),
+        "{table}"
+    );
 
     // The plot: a PNG (its eight magic bytes) next to the file by default.
     let png = dir.join("profile.png");

@@ -2,6 +2,7 @@
 //! and each contact pair's force, area and peak pressure) and
 //! `contactlink plot` (the Hertz pressure profile against the closed form).
 //! Serial and read-only: any process can run them on a closed result file.
+pub mod footprint;
 pub mod plot;
 pub mod summary;
 

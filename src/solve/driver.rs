@@ -535,6 +535,7 @@ impl LoadSteps<'_> {
         if self.echo {
             print_step(&report);
         }
+        crate::footprint::checkpoint("load step (solver and preconditioner alive)");
         let pair_fields: Vec<PairFields> = self
             .mech
             .contact

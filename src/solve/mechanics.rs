@@ -336,6 +336,10 @@ impl NonlinearProblem for Mechanics<'_> {
 
     fn jacobian(&mut self, x: &Vector, j: &mut Matrix) -> std::result::Result<(), CallbackError> {
         let local = self.jacobian_impl(x, j);
+        if self.jacobian_evaluations == 1 {
+            // Before the first preconditioner set-up, which comes next.
+            crate::footprint::checkpoint("first Jacobian");
+        }
         self.agree(local)
     }
 

@@ -116,7 +116,9 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     let world = rt.world();
     let (rank, size) = (rt.rank(), rt.size());
     let mesh = &model.mesh;
+    crate::footprint::checkpoint("model build");
     let partition = broadcast_partition(&world, mesh, rank, size)?;
+    crate::footprint::checkpoint("partition");
     let mut master_nodes = Vec::new();
     for pair in &model.contact {
         if let MasterSpec::Surface { set } = &pair.master {
@@ -132,10 +134,12 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         }
     }
     let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
+    crate::footprint::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
         BulkAssembler::new(mesh, &dofs, model.materials.clone()),
     )?;
+    crate::footprint::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();
     for (set, load, amplitude) in &model.facet_loads {
         let facets = mesh.facet_sets.get(set).ok_or_else(|| {
@@ -170,7 +174,10 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
             })
             .collect::<Result<Vec<_>>>(),
     )?;
+    crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
+    crate::footprint::checkpoint("Jacobian allocation");
+    crate::footprint::setup_finished();
     Ok(Simulation {
         model,
         partition,

@@ -1,0 +1,118 @@
+#!/usr/bin/python3
+"""Peak memory per rank against the number of ranks (`make memory`).
+
+usage: memory.py [--out bench-results] [--setup-ranks 1,2,4,8] [--solve-ranks 1,2,4]
+                 [--setup-args ...] [--mpirun "mpirun ..."]
+
+Two cases, both of scripts/scenes/sphere-no-contact.toml (hertz-sphere's
+mesh, materials and boundary conditions without the contact pair: a plain
+elastic 3D run):
+  set-up: mesh.level=1 (1,277,628 DOFs), `contactlink run --setup-only`
+          (scene, mesh, partition, DOFs, matrix; no solve) on 1, 2, 4 and
+          8 ranks (8 oversubscribed on small machines; run once each);
+  solve:  the default mesh (167k DOFs), a full run on 1, 2 and 4 ranks.
+Every run has CONTACTLINK_MEMORY=1, so besides each rank's peak (the
+`memory:` summary line: largest and smallest rank) it prints the resident
+memory of the largest rank after each set-up phase. Prints the ratio of the
+largest rank's peak to the 1-rank peak against the targets (set-up on 8
+ranks <= 0.2x, solve on 4 ranks <= 0.36x) and writes <out>/memory.csv.
+Exits 0 whatever the ratios (a report, not a test); 1 when a run fails.
+"""
+import argparse
+import csv
+import os
+import re
+import shlex
+import subprocess
+import sys
+
+SCENE = "scripts/scenes/sphere-no-contact.toml"
+SUMMARY = re.compile(r"memory: peak resident ([0-9.]+) MiB on the largest rank, ([0-9.]+) MiB on the smallest "
+                     r"\((\d+) rank\(s\)\); set-up \([^)]*\) ([0-9.]+) s")
+DOFS = re.compile(r"(\d+) DOFs")
+CHECKPOINT = re.compile(r"memory: rank (\d+) of (\d+) after (.+?): resident ([0-9.]+) MiB, peak ([0-9.]+) MiB")
+TARGETS = {("set-up", 8): 0.2, ("solve", 4): 0.36}
+
+
+def mpi_env():
+    env = dict(os.environ, CONTACTLINK_MEMORY="1")
+    # Local defaults only where the caller set nothing (a cluster sets its own).
+    for k, v in (("OMPI_MCA_btl", "self,vader"),
+                 ("OMPI_MCA_btl_vader_single_copy_mechanism", "none"),
+                 ("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
+                 ("OMPI_MCA_rmaps_base_oversubscribe", "1")):
+        env.setdefault(k, v)
+    return env
+
+
+def run(mpirun, np_, args):
+    cmd = shlex.split(mpirun) + ["-n", str(np_), "target/release/contactlink", "run", SCENE] + args
+    p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
+    out = p.stdout + p.stderr
+    m = SUMMARY.search(out)
+    if p.returncode != 0 or not m:
+        sys.exit(f"{' '.join(cmd)} failed:\n{out[-800:]}")
+    # Phase -> resident memory of the largest rank after it (first occurrence
+    # of each phase; load steps keep their first).
+    phases = {}
+    for c in CHECKPOINT.finditer(out):
+        name, rss = c[3], float(c[4])
+        phases.setdefault(name, {})
+        rank = int(c[1])
+        phases[name].setdefault(rank, rss)
+    d = DOFS.search(out)
+    return {
+        "ranks": np_, "dofs": int(d[1]) if d else 0,
+        "peak_largest_mib": float(m[1]), "peak_smallest_mib": float(m[2]),
+        "setup_seconds": float(m[4]),
+        "phases": {k: max(v.values()) for k, v in phases.items()},
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", default="bench-results")
+    ap.add_argument("--setup-ranks", default="1,2,4,8")
+    ap.add_argument("--solve-ranks", default="1,2,4")
+    ap.add_argument("--setup-args", default="--set mesh.level=1")
+    ap.add_argument("--solve-args", default="")
+    ap.add_argument("--mpirun", default=os.environ.get("MPIRUN", "mpirun --allow-run-as-root --oversubscribe"))
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    cases = [("set-up", a.setup_ranks, ["--setup-only"] + shlex.split(a.setup_args)),
+             ("solve", a.solve_ranks, shlex.split(a.solve_args))]
+    rows = []
+    for kind, ranks, args in cases:
+        base = None
+        for np_ in [int(n) for n in ranks.split(",") if n]:
+            r = run(a.mpirun, np_, args)
+            r["kind"] = kind
+            base = base or r["peak_largest_mib"]
+            r["ratio"] = r["peak_largest_mib"] / base
+            target = TARGETS.get((kind, np_))
+            verdict = "" if target is None else (
+                f"  target <= {target:.2f}x: {'met' if r['ratio'] <= target else 'NOT met'}")
+            print(f"{kind:7} {np_} rank(s) {r['dofs']:>8} DOFs  peak largest {r['peak_largest_mib']:8.1f} MiB"
+                  f"  smallest {r['peak_smallest_mib']:8.1f} MiB  ratio to 1 rank {r['ratio']:.3f}x"
+                  f"  set-up {r['setup_seconds']:.2f} s{verdict}", flush=True)
+            rows.append(r)
+    print("\nresident memory of the largest rank after each phase (MiB):")
+    for kind in ("set-up", "solve"):
+        mine = [r for r in rows if r["kind"] == kind]
+        if not mine:
+            continue
+        names = list(dict.fromkeys(n for r in mine for n in r["phases"]))
+        print(f"  {kind}: " + " | ".join(f"{r['ranks']} rank(s)" for r in mine))
+        for n in names:
+            vals = " | ".join(f"{r['phases'].get(n, float('nan')):9.1f}" for r in mine)
+            print(f"    {n:52} {vals}")
+    keys = ["kind", "ranks", "dofs", "peak_largest_mib", "peak_smallest_mib", "ratio", "setup_seconds"]
+    with open(f"{a.out}/memory.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    print(f"memory: {a.out}/memory.csv (machine load inflates the set-up seconds, not the memory)")
+
+
+if __name__ == "__main__":
+    main()

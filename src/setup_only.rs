@@ -1,0 +1,29 @@
+//! `contactlink run SCENE --setup-only`: everything a run does before its
+//! first solve (scene and mesh, partition, DOF numbering, assembly set-up,
+//! the Jacobian allocated with its pattern filled in), then stop. What the
+//! set-up costs in memory and time, without the solve's share.
+use crate::error::Result;
+use crate::pipeline::load_model;
+use crate::runtime::Runtime;
+use crate::solve::Simulation;
+
+/// What was set up.
+pub struct SetupSummary {
+    pub model_name: String,
+    pub cells: usize,
+    pub nodes: usize,
+    pub global_dofs: usize,
+}
+
+/// Collective: builds the model and the set-up of a run on every rank.
+pub fn setup_only(rt: &Runtime, scene: &str, overrides: &[String]) -> Result<SetupSummary> {
+    crate::parallel::fault::arm(rt.rank())?;
+    let (model, _) = load_model(scene, overrides)?;
+    let sim = Simulation::setup(rt, &model)?;
+    Ok(SetupSummary {
+        model_name: model.name.clone(),
+        cells: model.mesh.num_cells(),
+        nodes: model.mesh.num_nodes(),
+        global_dofs: 3 * sim.dofs().num_global_nodes(),
+    })
+}
