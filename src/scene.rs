@@ -1360,7 +1360,7 @@ fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 }
 
 /// The pair's `formulation`, checked against what the mortar formulation
-/// supports (a master facet set of quad4 or tri3 facets, no friction yet).
+/// supports (a master facet set of quad4 or tri3 facets).
 fn formulation(
     mesh: &Mesh,
     c: &ContactSection,
@@ -1387,11 +1387,6 @@ fn formulation(
     if spec.master.is_rigid() {
         return Err(format!(
             "{at}: formulation \"mortar\" needs a master facet set, not a rigid surface"
-        ));
-    }
-    if c.friction.is_some_and(|mu| mu > 0.0) {
-        return Err(format!(
-            "{at}: formulation \"mortar\" is frictionless for now; remove friction or use \"links\""
         ));
     }
     if c.quadrature.is_some() {

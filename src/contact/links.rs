@@ -3,7 +3,7 @@
 //! residual and tangent, and the Uzawa update of their multipliers.
 use super::dual::{dot, norm, sub};
 use super::kernel::{self as link, Friction, LinkInput, LinkState, Master, SlipHistory, SlipRate};
-use super::mortar::pair::MortarPair;
+use super::mortar::pair::{MortarPair, MortarSnapshot};
 use super::multipliers::{
     updated_multiplier, FrictionRecord, Multipliers, PointFriction, PointState,
 };
@@ -117,7 +117,7 @@ pub struct PairSnapshot {
     lambda: Vec<f64>,
     friction: Option<Vec<PointFriction>>,
     /// The nodal multipliers of a mortar pair.
-    mortar: Option<Vec<f64>>,
+    mortar: Option<MortarSnapshot>,
 }
 
 /// Scratch space for one link's input (no allocation per link).
@@ -215,6 +215,7 @@ impl ContactPair {
                 // Jacobian pattern: one element size of margin, not the
                 // links' search distance.
                 search_distance.min(slave.h),
+                friction_spec,
             )?),
             (Formulation::Mortar, MasterSpec::Rigid(_)) => {
                 return Err(Error::scene(
@@ -630,7 +631,7 @@ impl ContactPair {
         r_local: &mut [f64],
     ) -> Result<()> {
         if let Some(m) = &self.mortar {
-            m.add_residual(u_local, r_local);
+            m.add_residual(u_local, self.mortar_rate().as_ref(), r_local);
             return Ok(());
         }
         self.for_each_link(
@@ -664,7 +665,7 @@ impl ContactPair {
             self.tangent_signature = self.tangent_signature.wrapping_add(1);
         }
         if let Some(m) = &self.mortar {
-            return m.add_tangent(dofs, u_local, k);
+            return m.add_tangent(dofs, u_local, self.mortar_rate().as_ref(), k);
         }
         // Which links are closed, on which master facets, sticking or
         // sliding: what the tangent's structure depends on.
@@ -700,7 +701,12 @@ impl ContactPair {
     /// then the halo exchange.
     pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
         if let Some(m) = &mut self.mortar {
-            return Ok(m.uzawa_update(u_local));
+            let rate = self.rate.as_ref().map(|r| super::mortar::friction::Rate {
+                dt: r.dt,
+                dv_du: r.dv_du,
+                offset: &r.offset,
+            });
+            return Ok(m.uzawa_update(u_local, rate.as_ref()));
         }
         let before = self.multipliers.nodal_forces()?;
         let before_t = self.multipliers.nodal_tangential_forces()?;
@@ -787,6 +793,10 @@ impl ContactPair {
 
     /// A converged step is final: the next one measures slip from here.
     pub fn commit(&mut self) -> Result<()> {
+        if let Some(m) = &mut self.mortar {
+            m.commit();
+            return Ok(());
+        }
         if let Some(t) = &mut self.multipliers.tangential {
             t.commit();
             self.multipliers.exchange()?;
@@ -911,7 +921,7 @@ impl ContactPair {
     /// This rank's points in contact (λN > 0) and, of those, sliding.
     pub fn multiplier_states(&self) -> (usize, usize) {
         if let Some(m) = &self.mortar {
-            return (m.active_nodes(), 0);
+            return (m.active_nodes(), m.sliding_nodes());
         }
         let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();
         let sliding = self.multipliers.tangential.as_ref().map_or(0, |t| {
@@ -1042,8 +1052,8 @@ impl ContactPair {
                 .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
                 .sum();
         }
-        let (fields, force) = m.output(u_local);
-        let values = PointValues {
+        let (fields, force) = m.output(u_local, self.mortar_rate().as_ref());
+        let mut values = PointValues {
             points: (0..nq)
                 .map(|q| self.slave.qp_position(q, u_local))
                 .collect(),
@@ -1055,7 +1065,50 @@ impl ContactPair {
             mortar: Some(fields),
             ..PointValues::empty()
         };
+        if self.has_friction() {
+            self.mortar_point_friction(m, &mut values);
+        }
         (values, force)
+    }
+
+    /// Mortar pair with friction: the points carry the nodal traction and
+    /// slip interpolated like the pressure, and the state of their facet's
+    /// nodes (slip if one slides); no restart history.
+    fn mortar_point_friction(&self, m: &MortarPair, values: &mut PointValues) {
+        let nodes = m.friction_by_local_node();
+        let nq = self.slave.num_qps();
+        values.records = vec![FrictionRecord::default(); nq];
+        for q in 0..nq {
+            let facet = &self.slave.facets[q / self.slave.nqp];
+            let s = crate::fem::shape::facet_shape(self.slave.facet_type, self.slave.qp_zeta[q]);
+            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
+            for (n, na) in facet.nodes.iter().zip(s.n) {
+                if let Some((tn, sn, slides)) = nodes.get(n) {
+                    for c in 0..3 {
+                        t[c] += na * tn[c];
+                        slip[c] += na * sn[c];
+                    }
+                    sliding |= *slides;
+                }
+            }
+            let state = match (values.pressure[q] > 0.0, sliding) {
+                (false, _) => PointState::Open,
+                (true, false) => PointState::Stick,
+                (true, true) => PointState::Slip,
+            };
+            values.traction.push(t);
+            values.slip.push(slip);
+            values.state.push(state as i8);
+        }
+    }
+
+    /// The dynamic slip rate in the mortar pair's terms (None quasi-static).
+    fn mortar_rate(&self) -> Option<super::mortar::friction::Rate<'_>> {
+        self.rate.as_ref().map(|r| super::mortar::friction::Rate {
+            dt: r.dt,
+            dv_du: r.dv_du,
+            offset: &r.offset,
+        })
     }
 
     /// Adds this pair's nodal contact pressure (owned nodes) into the field.

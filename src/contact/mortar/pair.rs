@@ -10,11 +10,12 @@
 //! positions, so every rank that sees node `j` computes the same `g̃_j` and
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
+use super::friction::{self, Increment, NodalFriction, NodeFriction, Rate, SegmentSlip};
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
-use crate::contact::pair::PairSpec;
+use crate::contact::pair::{FrictionSpec, PairSpec};
 use crate::contact::surfaces::MasterSurface;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
@@ -30,9 +31,42 @@ pub struct NodeFields {
     pub lambda: Vec<f64>,
     /// Weighted gaps g̃_j = ∫ Φ_j g dA.
     pub weighted_gap: Vec<f64>,
-    /// Contact traction on the slave at the node: −λ_j ν_j, ν_j the
-    /// D-weighted mean of its segments' normals.
+    /// Contact traction on the slave at the node: −λ_j ν_j − λT_j, ν_j the
+    /// D-weighted mean of its segments' normals (λT_j = 0 frictionless).
     pub traction: Vec<[f64; 3]>,
+}
+
+/// What a cut-back step restores: λ_j and λT_j of the last converged step.
+#[derive(Debug, Clone)]
+pub struct MortarSnapshot {
+    lambda: Vec<f64>,
+    lambda_t: Option<Vec<[f64; 3]>>,
+}
+
+/// Friction of a mortar pair at run time.
+struct PairFriction {
+    nodal: NodalFriction,
+    /// εT follows εN (no `tangential_penalty`): raised with it.
+    follows: bool,
+    /// Every pair node's position at the end of the last converged step:
+    /// the quasi-static slip increment is measured from there.
+    start: Vec<[f64; 3]>,
+    /// The positions of the last Uzawa update (the next `start` once the
+    /// step has converged).
+    last: Vec<[f64; 3]>,
+    /// Per slot: sliding, and the tangential mean slip of the step, at the
+    /// last Uzawa update.
+    sliding: Vec<bool>,
+    slip: Vec<[f64; 3]>,
+}
+
+/// One evaluation of the pair: segments, node states and (with friction)
+/// the segments' slip terms and the nodes' friction.
+struct Evaluation<T> {
+    segments: Vec<Segment<T>>,
+    states: Vec<NodeState>,
+    slips: Vec<SegmentSlip<T>>,
+    frictions: Vec<NodeFriction>,
 }
 
 pub struct MortarPair {
@@ -57,6 +91,7 @@ pub struct MortarPair {
     rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
     owned_mesh_nodes: usize,
+    friction: Option<PairFriction>,
 }
 
 fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
@@ -75,7 +110,8 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
 }
 
 impl MortarPair {
-    /// `penalty(h)`: the pair's εN for a node of element size `h`.
+    /// `penalty(h)`: the pair's εN for a node of element size `h`;
+    /// `friction`: the pair's Coulomb friction, if it computes any (μ > 0).
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
@@ -83,6 +119,7 @@ impl MortarPair {
         master_set: &str,
         penalty: impl Fn(f64) -> f64,
         search_distance: f64,
+        friction: Option<FrictionSpec>,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let slave = MasterSurface::new(mesh, dofs, &spec.slave)?;
@@ -177,6 +214,21 @@ impl MortarPair {
         node_local.extend(&master.node_local);
         let mut x_ref = slave.x_ref;
         x_ref.extend(&master.x_ref);
+        let friction = friction.map(|f| PairFriction {
+            nodal: NodalFriction {
+                mu: f.mu,
+                penalty: match f.penalty {
+                    Some(p) => vec![p; slots.len()],
+                    None => nodal.penalty.clone(),
+                },
+                lambda: vec![[0.0; 3]; slots.len()],
+            },
+            follows: f.penalty.is_none(),
+            start: x_ref.clone(),
+            last: x_ref.clone(),
+            sliding: vec![false; slots.len()],
+            slip: vec![[0.0; 3]; slots.len()],
+        });
         Ok(MortarPair {
             facet_type,
             node_local,
@@ -193,6 +245,7 @@ impl MortarPair {
             search_distance,
             rules: MortarRules::default(),
             owned_mesh_nodes: dofs.num_owned_nodes(),
+            friction,
         })
     }
 
@@ -307,41 +360,110 @@ impl MortarPair {
         Ok(())
     }
 
-    fn evaluate<T: system::Seed>(&self, x: &[[f64; 3]]) -> (Vec<Segment<T>>, Vec<NodeState>) {
+    /// The step's increment of every pair node (see [`Increment`]):
+    /// `x − xₙ` quasi-static, `Δt v(u)` in dynamics.
+    fn increments(
+        &self,
+        f: &PairFriction,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> (Vec<[f64; 3]>, f64) {
+        match rate {
+            None => (
+                x.iter()
+                    .zip(&f.start)
+                    .map(|(x, s)| [0, 1, 2].map(|i| x[i] - s[i]))
+                    .collect(),
+                1.0,
+            ),
+            Some(r) => (
+                self.node_local
+                    .iter()
+                    .map(|&l| {
+                        let b = DIM * l as usize;
+                        [0, 1, 2].map(|i| r.dt * (r.dv_du * u_local[b + i] + r.offset[b + i]))
+                    })
+                    .collect(),
+                r.dt * r.dv_du,
+            ),
+        }
+    }
+
+    fn evaluate<T: system::Seed>(
+        &self,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<T> {
         let interface = self.interface(x);
         let segments = system::segments::<T>(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
-        (segments, states)
+        let (slips, frictions) = match &self.friction {
+            Some(f) => {
+                let (value, slope) = self.increments(f, x, u_local, rate);
+                let inc = Increment {
+                    value: &value,
+                    slope,
+                };
+                let slips = friction::segment_slips(&interface, &segments, &inc);
+                let frictions = friction::node_frictions(
+                    &interface,
+                    &self.nodal,
+                    &f.nodal,
+                    &states,
+                    &segments,
+                    &slips,
+                );
+                (slips, frictions)
+            }
+            None => (Vec::new(), Vec::new()),
+        };
+        Evaluation {
+            segments,
+            states,
+            slips,
+            frictions,
+        }
     }
 
-    pub fn add_residual(&self, u_local: &[f64], r_local: &mut [f64]) {
+    pub fn add_residual(&self, u_local: &[f64], rate: Option<&Rate>, r_local: &mut [f64]) {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<f64>(&x);
-        system::residual(
-            &self.interface(&x),
-            &self.nodal,
-            &segments,
-            &states,
-            |n, c, v| {
-                r_local[self.local_dof(n, c)] += v;
-            },
-        );
+        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let interface = self.interface(&x);
+        let mut add = |n: u32, c: usize, v: f64| {
+            r_local[self.local_dof(n, c)] += v;
+        };
+        system::residual(&interface, &self.nodal, &e.segments, &e.states, &mut add);
+        if self.friction.is_some() {
+            friction::residual(&interface, &self.nodal, &e.segments, &e.frictions, &mut add);
+        }
     }
 
-    pub fn add_tangent(&self, dofs: &DofMap, u_local: &[f64], k: &mut dyn BlockSink) -> Result<()> {
+    pub fn add_tangent(
+        &self,
+        dofs: &DofMap,
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        k: &mut dyn BlockSink,
+    ) -> Result<()> {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x);
+        let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
+        let interface = self.interface(&x);
         let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
-        system::tangent(
-            &self.interface(&x),
-            &self.nodal,
-            &segments,
-            &states,
-            |r, c, v| {
-                entries.push((r, c, v));
-            },
-        );
+        let mut add = |r, c, v| entries.push((r, c, v));
+        system::tangent(&interface, &self.nodal, &e.segments, &e.states, &mut add);
+        if self.friction.is_some() {
+            friction::tangent(
+                &interface,
+                &self.nodal,
+                &e.segments,
+                &e.slips,
+                &e.frictions,
+                &mut add,
+            );
+        }
         entries.sort_by_key(|e| (e.0, e.1));
         let (mut cols, mut vals): (Vec<PetscInt>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut i = 0;
@@ -365,11 +487,13 @@ impl MortarPair {
         Ok(())
     }
 
-    /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ at every node whose weighted gap is complete on
-    /// this rank; statistics over the nodes this rank owns.
-    pub fn uzawa_update(&mut self, u_local: &[f64]) -> UzawaStats {
+    /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
+    /// weighted gap is complete on this rank; statistics over the nodes this
+    /// rank owns.
+    pub fn uzawa_update(&mut self, u_local: &[f64], rate: Option<&Rate>) -> UzawaStats {
         let x = self.positions(u_local);
-        let (_, states) = self.evaluate::<f64>(&x);
+        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let states = e.states;
         let mut stats = UzawaStats::default();
         for (j, s) in states.iter().enumerate() {
             if !self.complete[j] {
@@ -377,10 +501,24 @@ impl MortarPair {
             }
             let old = self.nodal.lambda[j];
             self.nodal.lambda[j] = s.pressure;
+            let area = self.nodal.area[j];
+            if let Some(f) = &mut self.friction {
+                let n = &e.frictions[j];
+                let change = crate::contact::dual::norm(&crate::contact::dual::sub(
+                    &n.traction,
+                    &f.nodal.lambda[j],
+                ));
+                f.nodal.lambda[j] = n.traction;
+                f.sliding[j] = n.sliding;
+                f.slip[j] = n.slip;
+                if self.owned[j] {
+                    stats.max_change = stats.max_change.max(change * area);
+                    stats.sliding += usize::from(n.sliding);
+                }
+            }
             if !self.owned[j] {
                 continue;
             }
-            let area = self.nodal.area[j];
             if s.pressure > 0.0 || s.closed {
                 stats.max_penetration = stats
                     .max_penetration
@@ -393,21 +531,50 @@ impl MortarPair {
             stats.max_change = stats.max_change.max((s.pressure - old).abs() * area);
             stats.max_force = stats.max_force.max(s.pressure * area);
         }
+        if let Some(f) = &mut self.friction {
+            f.last = x;
+        }
         stats
     }
 
-    pub fn snapshot(&self) -> Vec<f64> {
-        self.nodal.lambda.clone()
-    }
-
-    pub fn restore(&mut self, lambda: Vec<f64>) {
-        if lambda.len() == self.nodal.lambda.len() {
-            self.nodal.lambda = lambda;
+    /// A converged step is final: the next one measures slip from here.
+    pub fn commit(&mut self) {
+        if let Some(f) = &mut self.friction {
+            f.start.clone_from(&f.last);
         }
     }
 
+    pub fn snapshot(&self) -> MortarSnapshot {
+        MortarSnapshot {
+            lambda: self.nodal.lambda.clone(),
+            lambda_t: self.friction.as_ref().map(|f| f.nodal.lambda.clone()),
+        }
+    }
+
+    pub fn restore(&mut self, snap: MortarSnapshot) {
+        if snap.lambda.len() == self.nodal.lambda.len() {
+            self.nodal.lambda = snap.lambda;
+        }
+        if let (Some(f), Some(l)) = (&mut self.friction, snap.lambda_t) {
+            f.nodal.lambda = l;
+        }
+    }
+
+    /// Multiplies εN by `factor`, and εT when it follows εN.
     pub fn raise_penalty(&mut self, factor: f64) {
         self.nodal.penalty.iter_mut().for_each(|p| *p *= factor);
+        if let Some(f) = self.friction.as_mut().filter(|f| f.follows) {
+            f.nodal.penalty.iter_mut().for_each(|p| *p *= factor);
+        }
+    }
+
+    /// Owned nodes sliding at the last Uzawa update.
+    pub fn sliding_nodes(&self) -> usize {
+        self.friction.as_ref().map_or(0, |f| {
+            (0..self.owned.len())
+                .filter(|&j| self.owned[j] && f.sliding[j])
+                .count()
+        })
     }
 
     /// Owned nodes in contact.
@@ -433,9 +600,13 @@ impl MortarPair {
     /// Nodal output of the owned nodes and this rank's part of the pair's
     /// force on the slave, `Σ_j λ_j D_jk ν` summed over `k` (`D` of the
     /// current segments, so the force is the one the residual applied).
-    pub fn output(&self, u_local: &[f64]) -> (NodeFields, PairForce) {
+    pub fn output(&self, u_local: &[f64], rate: Option<&Rate>) -> (NodeFields, PairForce) {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<f64>(&x);
+        let Evaluation {
+            segments, states, ..
+        } = self.evaluate::<f64>(&x, u_local, rate);
+        let zero = [0.0; 3];
+        let lambda_t = |j: usize| self.friction.as_ref().map_or(&zero, |f| &f.nodal.lambda[j]);
         let nf = self.facet_type.nodes();
         let mut normal_sum = vec![[0.0; 3]; self.nodal.nodes.len()];
         let mut force = PairForce::default();
@@ -458,6 +629,11 @@ impl MortarPair {
                     *f -= lambda * d * nc;
                 }
                 force.normal += lambda * d;
+                let t = lambda_t(j);
+                for (f, tc) in force.force.iter_mut().zip(t) {
+                    *f -= tc * d;
+                }
+                force.tangential += crate::contact::dual::norm(t) * d;
             }
         }
         let n = self.owned_mesh_nodes;
@@ -475,7 +651,9 @@ impl MortarPair {
             out.weighted_gap[l] = states[j].weighted_gap;
             let len = crate::contact::dual::norm(&normal_sum[j]);
             if len > 0.0 {
-                out.traction[l] = normal_sum[j].map(|c| -self.nodal.lambda[j] * c / len);
+                let t = lambda_t(j);
+                out.traction[l] =
+                    [0, 1, 2].map(|i| -self.nodal.lambda[j] * normal_sum[j][i] / len - t[i]);
             }
         }
         (out, force)
@@ -491,6 +669,24 @@ impl MortarPair {
                 *d += 1.0;
             }
         }
+    }
+
+    /// Friction at the nodes this rank holds, by the slave node's local
+    /// index: traction on the slave (−λT_j), mean slip of the step, sliding.
+    /// Empty for a frictionless pair.
+    pub fn friction_by_local_node(
+        &self,
+    ) -> std::collections::HashMap<u32, ([f64; 3], [f64; 3], bool)> {
+        let Some(f) = &self.friction else {
+            return std::collections::HashMap::new();
+        };
+        (0..self.nodal.nodes.len())
+            .map(|j| {
+                let t = f.nodal.lambda[j].map(|c| -c);
+                let id = self.nodal.nodes[j] as usize;
+                (self.node_local[id], (t, f.slip[j], f.sliding[j]))
+            })
+            .collect()
     }
 
     /// λ_j by the slave node's local index, for the nodes this rank holds
