@@ -109,6 +109,22 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// See [`MortarPair::add_tangent`].
+fn signature<T>(e: &Evaluation<T>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for s in &e.segments {
+        (s.slave, s.master).hash(&mut h);
+    }
+    for s in &e.states {
+        s.closed.hash(&mut h);
+    }
+    for f in &e.frictions {
+        f.sliding.hash(&mut h);
+    }
+    h.finish()
+}
+
 impl MortarPair {
     /// `penalty(h)`: the pair's εN for a node of element size `h`;
     /// `friction`: the pair's Coulomb friction, if it computes any (μ > 0).
@@ -441,13 +457,17 @@ impl MortarPair {
         }
     }
 
+    /// Adds the tangent; returns its active-set signature: equal values mean
+    /// the same segments, the same closed nodes and the same sliding nodes
+    /// on this rank (what the tangent's structure depends on, so the
+    /// solver may keep the preconditioner of an earlier one).
     pub fn add_tangent(
         &self,
         dofs: &DofMap,
         u_local: &[f64],
         rate: Option<&Rate>,
         k: &mut dyn BlockSink,
-    ) -> Result<()> {
+    ) -> Result<u64> {
         let x = self.positions(u_local);
         let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
         let interface = self.interface(&x);
@@ -484,7 +504,7 @@ impl MortarPair {
             }
             k.add_block(&[self.global_dof(dofs, row.0, row.1)], &cols, &vals)?;
         }
-        Ok(())
+        Ok(signature(&e))
     }
 
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
