@@ -9,6 +9,8 @@
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
+//!   state at run time;
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
 //!   tangent of a set of segments.
 pub mod friction;
@@ -16,6 +18,7 @@ pub mod geometry;
 pub mod pair;
 pub mod segment;
 pub mod system;
+mod tangential;
 
 #[cfg(test)]
 mod friction_tests;

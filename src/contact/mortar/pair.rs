@@ -10,9 +10,10 @@
 //! positions, so every rank that sees node `j` computes the same `g̃_j` and
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
-use super::friction::{self, Increment, NodalFriction, NodeFriction, Rate, SegmentSlip};
+use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use super::tangential::PairFriction;
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
 use crate::contact::pair::{FrictionSpec, PairSpec};
@@ -41,23 +42,6 @@ pub struct NodeFields {
 pub struct MortarSnapshot {
     lambda: Vec<f64>,
     lambda_t: Option<Vec<[f64; 3]>>,
-}
-
-/// Friction of a mortar pair at run time.
-struct PairFriction {
-    nodal: NodalFriction,
-    /// εT follows εN (no `tangential_penalty`): raised with it.
-    follows: bool,
-    /// Every pair node's position at the end of the last converged step:
-    /// the quasi-static slip increment is measured from there.
-    start: Vec<[f64; 3]>,
-    /// The positions of the last Uzawa update (the next `start` once the
-    /// step has converged).
-    last: Vec<[f64; 3]>,
-    /// Per slot: sliding, and the tangential mean slip of the step, at the
-    /// last Uzawa update.
-    sliding: Vec<bool>,
-    slip: Vec<[f64; 3]>,
 }
 
 /// One evaluation of the pair: segments, node states and (with friction)
@@ -230,21 +214,7 @@ impl MortarPair {
         node_local.extend(&master.node_local);
         let mut x_ref = slave.x_ref;
         x_ref.extend(&master.x_ref);
-        let friction = friction.map(|f| PairFriction {
-            nodal: NodalFriction {
-                mu: f.mu,
-                penalty: match f.penalty {
-                    Some(p) => vec![p; slots.len()],
-                    None => nodal.penalty.clone(),
-                },
-                lambda: vec![[0.0; 3]; slots.len()],
-            },
-            follows: f.penalty.is_none(),
-            start: x_ref.clone(),
-            last: x_ref.clone(),
-            sliding: vec![false; slots.len()],
-            slip: vec![[0.0; 3]; slots.len()],
-        });
+        let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
             facet_type,
             node_local,
@@ -376,36 +346,6 @@ impl MortarPair {
         Ok(())
     }
 
-    /// The step's increment of every pair node (see [`Increment`]):
-    /// `x − xₙ` quasi-static, `Δt v(u)` in dynamics.
-    fn increments(
-        &self,
-        f: &PairFriction,
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        rate: Option<&Rate>,
-    ) -> (Vec<[f64; 3]>, f64) {
-        match rate {
-            None => (
-                x.iter()
-                    .zip(&f.start)
-                    .map(|(x, s)| [0, 1, 2].map(|i| x[i] - s[i]))
-                    .collect(),
-                1.0,
-            ),
-            Some(r) => (
-                self.node_local
-                    .iter()
-                    .map(|&l| {
-                        let b = DIM * l as usize;
-                        [0, 1, 2].map(|i| r.dt * (r.dv_du * u_local[b + i] + r.offset[b + i]))
-                    })
-                    .collect(),
-                r.dt * r.dv_du,
-            ),
-        }
-    }
-
     fn evaluate<T: system::Seed>(
         &self,
         x: &[[f64; 3]],
@@ -418,7 +358,7 @@ impl MortarPair {
         let states = system::node_states(&self.nodal, &gap, &covered);
         let (slips, frictions) = match &self.friction {
             Some(f) => {
-                let (value, slope) = self.increments(f, x, u_local, rate);
+                let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
                 let inc = Increment {
                     value: &value,
                     slope,
