@@ -1,7 +1,7 @@
 //! Mortar contact with Coulomb friction end to end: a block pressed onto a
 //! fixed flat block and pulled (stick below μN, exactly μN while every node
-//! slides), a pull that stays below μN (stick throughout), and the same
-//! answers on 1, 2 and 3 ranks.
+//! slides), a pull that stays below μN (stick throughout), the same
+//! answers on 1, 2 and 3 ranks, and a frictional impact in dynamics.
 mod common;
 use common::*;
 use contactlink::output::{list_steps, read_dataset, read_nodal};
@@ -212,4 +212,51 @@ fn frictional_mortar_answers_agree_on_one_two_and_three_ranks() {
         println!("{ranks} ranks vs 1: displacement {du:.1e}, force history {df:.1e}");
         assert!(du < 1e-10 && df < 1e-10, "{ranks} ranks differ");
     }
+}
+
+#[test]
+fn frictional_mortar_impact_conserves_momentum_and_never_creates_energy() {
+    // The `impact` scene (Newmark, friction damping in the tangent) with a
+    // mortar pair: the upper block (mass 0.5) flies at (0.5, 0, −1) onto
+    // the lower one at rest.
+    let dir = scratch("mortar-friction-impact");
+    let out = dir.join("impact.h5");
+    let o = mpirun(
+        1,
+        &[
+            "run",
+            "impact",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            "contact.formulation=mortar",
+            "--set",
+            "contact.friction=0.3",
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let rows = history(&out);
+    let p0 = [0.25, 0.0, -0.5];
+    let e0 = 0.5 * 0.5 * (0.25 + 1.0);
+    let slid = rows.iter().filter(|r| r["impact.sliding"] > 0.0).count();
+    assert!(slid >= 3, "only {slid} steps with sliding nodes");
+    let energy: Vec<f64> = rows.iter().map(|r| r["kinetic"] + r["strain"]).collect();
+    for r in &rows {
+        let drift = [r["px"], r["py"], r["pz"]]
+            .iter()
+            .zip(p0)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(drift < 1e-10, "momentum drift {drift:e}");
+    }
+    for w in energy.windows(2) {
+        assert!(w[1] <= w[0] * (1.0 + 1e-9), "energy grew {w:?}");
+    }
+    let last = *energy.last().unwrap();
+    println!(
+        "mortar impact μ = 0.3: E_end/E0 = {:.4} ({:.1} % dissipated), {slid} steps with sliding nodes",
+        last / e0,
+        100.0 * (1.0 - last / e0)
+    );
+    assert!(last < 0.75 * e0, "friction dissipates ({last} of {e0})");
 }
