@@ -1062,40 +1062,11 @@ impl ContactPair {
             ..PointValues::empty()
         };
         if self.has_friction() {
-            self.mortar_point_friction(m, &mut values);
+            (values.traction, values.slip, values.state) =
+                m.point_friction(&self.slave, &values.pressure);
+            values.records = vec![FrictionRecord::default(); nq];
         }
         (values, force)
-    }
-
-    /// Mortar pair with friction: the points carry the nodal traction and
-    /// slip interpolated like the pressure, and the state of their facet's
-    /// nodes (slip if one slides); no restart history.
-    fn mortar_point_friction(&self, m: &MortarPair, values: &mut PointValues) {
-        let nodes = m.friction_by_local_node();
-        let nq = self.slave.num_qps();
-        values.records = vec![FrictionRecord::default(); nq];
-        for q in 0..nq {
-            let facet = &self.slave.facets[q / self.slave.nqp];
-            let s = crate::fem::shape::facet_shape(self.slave.facet_type, self.slave.qp_zeta[q]);
-            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
-            for (n, na) in facet.nodes.iter().zip(s.n) {
-                if let Some((tn, sn, slides)) = nodes.get(n) {
-                    for c in 0..3 {
-                        t[c] += na * tn[c];
-                        slip[c] += na * sn[c];
-                    }
-                    sliding |= *slides;
-                }
-            }
-            let state = match (values.pressure[q] > 0.0, sliding) {
-                (false, _) => PointState::Open,
-                (true, false) => PointState::Stick,
-                (true, true) => PointState::Slip,
-            };
-            values.traction.push(t);
-            values.slip.push(slip);
-            values.state.push(state as i8);
-        }
     }
 
     /// The dynamic slip rate in the mortar pair's terms (None quasi-static).

@@ -631,22 +631,45 @@ impl MortarPair {
         }
     }
 
-    /// Friction at the nodes this rank holds, by the slave node's local
-    /// index: traction on the slave (−λT_j), mean slip of the step, sliding.
-    /// Empty for a frictionless pair.
-    pub fn friction_by_local_node(
+    /// Friction at the slave points of `slave` (output): the nodal traction
+    /// on the slave (−λT_j) and slip interpolated like the pressure, and the
+    /// state (0 open where `pressure` is 0, else 2 if a node of the facet
+    /// slides, else 1). Empty for a frictionless pair.
+    pub fn point_friction(
         &self,
-    ) -> std::collections::HashMap<u32, ([f64; 3], [f64; 3], bool)> {
+        slave: &crate::contact::surfaces::SlaveSurface,
+        pressure: &[f64],
+    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) {
+        use crate::contact::multipliers::PointState;
         let Some(f) = &self.friction else {
-            return std::collections::HashMap::new();
+            return Default::default();
         };
-        (0..self.nodal.nodes.len())
-            .map(|j| {
-                let t = f.nodal.lambda[j].map(|c| -c);
-                let id = self.nodal.nodes[j] as usize;
-                (self.node_local[id], (t, f.slip[j], f.sliding[j]))
-            })
-            .collect()
+        let by_node: std::collections::HashMap<u32, usize> = (0..self.nodal.nodes.len())
+            .map(|j| (self.node_local[self.nodal.nodes[j] as usize], j))
+            .collect();
+        let mut out: (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) = Default::default();
+        for (q, p) in pressure.iter().enumerate() {
+            let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
+            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
+            for (n, na) in slave.facets[q / slave.nqp].nodes.iter().zip(s.n) {
+                if let Some(&j) = by_node.get(n) {
+                    for c in 0..3 {
+                        t[c] -= na * f.nodal.lambda[j][c];
+                        slip[c] += na * f.slip[j][c];
+                    }
+                    sliding |= f.sliding[j];
+                }
+            }
+            let state = match (*p > 0.0, sliding) {
+                (false, _) => PointState::Open,
+                (true, false) => PointState::Stick,
+                (true, true) => PointState::Slip,
+            };
+            out.0.push(t);
+            out.1.push(slip);
+            out.2.push(state as i8);
+        }
+        out
     }
 
     /// λ_j by the slave node's local index, for the nodes this rank holds
