@@ -177,15 +177,19 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
     out
 }
 
-/// Nodal weighted gaps `g̃_j` (by slot) and whether any segment covers the
-/// node.
+/// Nodal weighted gaps `g̃_j` (by slot) and whether the segments cover the
+/// node: `∫ Φ_j dA` over them (the row sum of `D`, `A_j` when the node's
+/// facets are covered) at least half of `A_j`. Φ_j changes sign inside a
+/// facet, so over a small part of its support `∫ Φ_j g` may be negative
+/// with `g > 0` everywhere: such a node would be pulled into a contact it
+/// does not have.
 pub fn weighted_gaps<T: Scalar>(
     interface: &Interface,
     nodal: &NodalData,
     segments: &[Segment<T>],
 ) -> (Vec<f64>, Vec<bool>) {
     let mut gap = vec![0.0; nodal.nodes.len()];
-    let mut covered = vec![false; nodal.nodes.len()];
+    let mut weight = vec![0.0; nodal.nodes.len()];
     let ns = interface.slave_type.nodes();
     for seg in segments {
         for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
@@ -194,10 +198,15 @@ pub fn weighted_gaps<T: Scalar>(
         {
             if let Some(j) = nodal.slot_of(node) {
                 gap[j] += seg.terms.weighted_gap[a].re();
-                covered[j] = true;
+                weight[j] += seg.terms.d[a][..ns].iter().map(Scalar::re).sum::<f64>();
             }
         }
     }
+    let covered = weight
+        .iter()
+        .zip(&nodal.area)
+        .map(|(w, a)| *w >= 0.5 * a)
+        .collect();
     (gap, covered)
 }
 
