@@ -22,7 +22,7 @@ export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
 cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
 
-.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing ironing-compare friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -141,6 +141,14 @@ ironing: build
 	@mkdir -p out
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5
 	$(PYTHON) scripts/plot_history.py out/ironing.csv out/ironing.png --pair ironing --mu 0.3 --title "ironing: die dragged over a soft slab (μ = 0.3)"
+
+# Ironing with the links and with the mortar formulation: the die's force
+# ratio |Fx|/|Fz| over the drag (mean, max - min, std) side by side.
+ironing-compare: build
+	@mkdir -p out
+	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5
+	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing-mortar.h5 --set contact.formulation=mortar
+	$(PYTHON) scripts/ironing_ratio.py out/ironing.csv out/ironing-mortar.csv
 
 # The friction and dynamics figures of the README (block-slide, ironing, impact).
 friction-figures: ironing

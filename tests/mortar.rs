@@ -371,7 +371,10 @@ fn bad_formulation_is_a_scene_error_naming_the_line() {
             "penalty",
             "formulation 'penalty' is not \"links\" or \"mortar\"",
         ),
-        ("mortar\"\nfriction = 0.3\n#\"", "frictionless for now"),
+        (
+            "mortar\"\nquadrature = \"nodal\"\n#\"",
+            "quadrature places the links' points",
+        ),
     ] {
         let scene = write(dir.as_path(), "bad.toml", &case.scene(formulation));
         let o = run(&["run", scene.to_str().unwrap(), "-q", "-o", "/dev/null"]);

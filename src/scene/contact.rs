@@ -169,7 +169,7 @@ pub(super) fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 }
 
 /// The pair's `formulation`, checked against what the mortar formulation
-/// supports (a master facet set of quad4 or tri3 facets, no friction yet).
+/// supports (a master facet set of quad4 or tri3 facets).
 pub(super) fn formulation(
     mesh: &Mesh,
     c: &ContactSection,
@@ -195,11 +195,6 @@ pub(super) fn formulation(
     if spec.master.is_rigid() {
         return Err(format!(
             "{at}: formulation \"mortar\" needs a master facet set, not a rigid surface"
-        ));
-    }
-    if c.friction.is_some_and(|mu| mu > 0.0) {
-        return Err(format!(
-            "{at}: formulation \"mortar\" is frictionless for now; remove friction or use \"links\""
         ));
     }
     if c.quadrature.is_some() {

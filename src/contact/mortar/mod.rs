@@ -6,13 +6,21 @@
 //!   triangulation, quadrature points mapped back to both facets;
 //! - `segment`: dual basis of a slave facet and the integrals of one segment
 //!   (weighted gap, mortar matrices `D` and `M`);
+//! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
+//!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
+//!   state at run time;
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
 //!   tangent of a set of segments.
+pub mod friction;
 pub mod geometry;
 pub mod pair;
 pub mod segment;
 pub mod system;
+mod tangential;
 
+#[cfg(test)]
+mod friction_tests;
 #[cfg(test)]
 mod tests;

@@ -10,8 +10,10 @@
 //! positions, so every rank that sees node `j` computes the same `g̃_j` and
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
+use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::{PairForce, UzawaStats};
@@ -20,7 +22,7 @@ use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
 use crate::mesh::Mesh;
-use crate::model::PairSpec;
+use crate::model::{FrictionSpec, PairSpec};
 
 /// The nodal fields the output writes, one entry per owned mesh node of
 /// this rank (zero at nodes off the slave surface).
@@ -30,9 +32,25 @@ pub struct NodeFields {
     pub lambda: Vec<f64>,
     /// Weighted gaps g̃_j = ∫ Φ_j g dA.
     pub weighted_gap: Vec<f64>,
-    /// Contact traction on the slave at the node: −λ_j ν_j, ν_j the
-    /// D-weighted mean of its segments' normals.
+    /// Contact traction on the slave at the node: −λ_j ν_j − λT_j, ν_j the
+    /// D-weighted mean of its segments' normals (λT_j = 0 frictionless).
     pub traction: Vec<[f64; 3]>,
+}
+
+/// What a cut-back step restores: λ_j and λT_j of the last converged step.
+#[derive(Debug, Clone)]
+pub struct MortarSnapshot {
+    lambda: Vec<f64>,
+    lambda_t: Option<Vec<[f64; 3]>>,
+}
+
+/// One evaluation of the pair: segments, node states and (with friction)
+/// the segments' slip terms and the nodes' friction.
+struct Evaluation<T> {
+    segments: Vec<Segment<T>>,
+    states: Vec<NodeState>,
+    slips: Vec<SegmentSlip<T>>,
+    frictions: Vec<NodeFriction>,
 }
 
 pub struct MortarPair {
@@ -57,6 +75,7 @@ pub struct MortarPair {
     rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
     owned_mesh_nodes: usize,
+    friction: Option<PairFriction>,
 }
 
 fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
@@ -74,8 +93,25 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// See [`MortarPair::add_tangent`].
+fn signature<T>(e: &Evaluation<T>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for s in &e.segments {
+        (s.slave, s.master).hash(&mut h);
+    }
+    for s in &e.states {
+        s.closed.hash(&mut h);
+    }
+    for f in &e.frictions {
+        f.sliding.hash(&mut h);
+    }
+    h.finish()
+}
+
 impl MortarPair {
-    /// `penalty(h)`: the pair's εN for a node of element size `h`.
+    /// `penalty(h)`: the pair's εN for a node of element size `h`;
+    /// `friction`: the pair's Coulomb friction, if it computes any (μ > 0).
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
@@ -83,6 +119,7 @@ impl MortarPair {
         master_set: &str,
         penalty: impl Fn(f64) -> f64,
         search_distance: f64,
+        friction: Option<FrictionSpec>,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
@@ -177,6 +214,7 @@ impl MortarPair {
         node_local.extend(&master.node_local);
         let mut x_ref = slave.x_ref;
         x_ref.extend(&master.x_ref);
+        let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
             facet_type,
             node_local,
@@ -193,6 +231,7 @@ impl MortarPair {
             search_distance,
             rules: MortarRules::default(),
             owned_mesh_nodes: dofs.num_owned_nodes(),
+            friction,
         })
     }
 
@@ -306,46 +345,84 @@ impl MortarPair {
         Ok(())
     }
 
-    fn evaluate<T: system::Seed>(&self, x: &[[f64; 3]]) -> (Vec<Segment<T>>, Vec<NodeState>) {
+    fn evaluate<T: system::Seed>(
+        &self,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<T> {
         let interface = self.interface(x);
         let segments = system::segments::<T>(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
-        (segments, states)
+        let (slips, frictions) = match &self.friction {
+            Some(f) => {
+                let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
+                let inc = Increment {
+                    value: &value,
+                    slope,
+                };
+                let slips = friction::segment_slips(&interface, &segments, &inc);
+                let frictions = friction::node_frictions(
+                    &interface,
+                    &self.nodal,
+                    &f.nodal,
+                    &states,
+                    &segments,
+                    &slips,
+                );
+                (slips, frictions)
+            }
+            None => (Vec::new(), Vec::new()),
+        };
+        Evaluation {
+            segments,
+            states,
+            slips,
+            frictions,
+        }
     }
 
-    pub fn add_residual(&self, u_local: &[f64], r_local: &mut [f64]) {
+    pub fn add_residual(&self, u_local: &[f64], rate: Option<&Rate>, r_local: &mut [f64]) {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<f64>(&x);
-        system::residual(
-            &self.interface(&x),
-            &self.nodal,
-            &segments,
-            &states,
-            |n, c, v| {
-                r_local[self.local_dof(n, c)] += v;
-            },
-        );
+        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let interface = self.interface(&x);
+        let mut add = |n: u32, c: usize, v: f64| {
+            r_local[self.local_dof(n, c)] += v;
+        };
+        system::residual(&interface, &self.nodal, &e.segments, &e.states, &mut add);
+        if self.friction.is_some() {
+            friction::residual(&interface, &self.nodal, &e.segments, &e.frictions, &mut add);
+        }
     }
 
+    /// Adds the tangent; returns its active-set signature: equal values mean
+    /// the same segments, the same closed nodes and the same sliding nodes
+    /// on this rank (what the tangent's structure depends on, so the
+    /// solver may keep the preconditioner of an earlier one).
     pub fn add_tangent(
         &self,
         dofs: &DofMap,
         u_local: &[f64],
+        rate: Option<&Rate>,
         k: &mut dyn MatrixSink,
-    ) -> Result<()> {
+    ) -> Result<u64> {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x);
+        let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
+        let interface = self.interface(&x);
         let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
-        system::tangent(
-            &self.interface(&x),
-            &self.nodal,
-            &segments,
-            &states,
-            |r, c, v| {
-                entries.push((r, c, v));
-            },
-        );
+        let mut add = |r, c, v| entries.push((r, c, v));
+        system::tangent(&interface, &self.nodal, &e.segments, &e.states, &mut add);
+        if self.friction.is_some() {
+            friction::tangent(
+                &interface,
+                &self.nodal,
+                &e.segments,
+                &e.slips,
+                &e.frictions,
+                &mut add,
+            );
+        }
         entries.sort_by_key(|e| (e.0, e.1));
         let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut i = 0;
@@ -366,14 +443,16 @@ impl MortarPair {
             }
             k.add_block(&[self.global_dof(dofs, row.0, row.1)], &cols, &vals)?;
         }
-        Ok(())
+        Ok(signature(&e))
     }
 
-    /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ at every node whose weighted gap is complete on
-    /// this rank; statistics over the nodes this rank owns.
-    pub fn uzawa_update(&mut self, u_local: &[f64]) -> UzawaStats {
+    /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
+    /// weighted gap is complete on this rank; statistics over the nodes this
+    /// rank owns.
+    pub fn uzawa_update(&mut self, u_local: &[f64], rate: Option<&Rate>) -> UzawaStats {
         let x = self.positions(u_local);
-        let (_, states) = self.evaluate::<f64>(&x);
+        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let states = e.states;
         let mut stats = UzawaStats::default();
         for (j, s) in states.iter().enumerate() {
             if !self.complete[j] {
@@ -381,10 +460,24 @@ impl MortarPair {
             }
             let old = self.nodal.lambda[j];
             self.nodal.lambda[j] = s.pressure;
+            let area = self.nodal.area[j];
+            if let Some(f) = &mut self.friction {
+                let n = &e.frictions[j];
+                let change = crate::contact::dual::norm(&crate::contact::dual::sub(
+                    &n.traction,
+                    &f.nodal.lambda[j],
+                ));
+                f.nodal.lambda[j] = n.traction;
+                f.sliding[j] = n.sliding;
+                f.slip[j] = n.slip;
+                if self.owned[j] {
+                    stats.max_change = stats.max_change.max(change * area);
+                    stats.sliding += usize::from(n.sliding);
+                }
+            }
             if !self.owned[j] {
                 continue;
             }
-            let area = self.nodal.area[j];
             if s.pressure > 0.0 || s.closed {
                 stats.max_penetration = stats
                     .max_penetration
@@ -397,21 +490,50 @@ impl MortarPair {
             stats.max_change = stats.max_change.max((s.pressure - old).abs() * area);
             stats.max_force = stats.max_force.max(s.pressure * area);
         }
+        if let Some(f) = &mut self.friction {
+            f.last = x;
+        }
         stats
     }
 
-    pub fn snapshot(&self) -> Vec<f64> {
-        self.nodal.lambda.clone()
-    }
-
-    pub fn restore(&mut self, lambda: Vec<f64>) {
-        if lambda.len() == self.nodal.lambda.len() {
-            self.nodal.lambda = lambda;
+    /// A converged step is final: the next one measures slip from here.
+    pub fn commit(&mut self) {
+        if let Some(f) = &mut self.friction {
+            f.start.clone_from(&f.last);
         }
     }
 
+    pub fn snapshot(&self) -> MortarSnapshot {
+        MortarSnapshot {
+            lambda: self.nodal.lambda.clone(),
+            lambda_t: self.friction.as_ref().map(|f| f.nodal.lambda.clone()),
+        }
+    }
+
+    pub fn restore(&mut self, snap: MortarSnapshot) {
+        if snap.lambda.len() == self.nodal.lambda.len() {
+            self.nodal.lambda = snap.lambda;
+        }
+        if let (Some(f), Some(l)) = (&mut self.friction, snap.lambda_t) {
+            f.nodal.lambda = l;
+        }
+    }
+
+    /// Multiplies εN by `factor`, and εT when it follows εN.
     pub fn raise_penalty(&mut self, factor: f64) {
         self.nodal.penalty.iter_mut().for_each(|p| *p *= factor);
+        if let Some(f) = self.friction.as_mut().filter(|f| f.follows) {
+            f.nodal.penalty.iter_mut().for_each(|p| *p *= factor);
+        }
+    }
+
+    /// Owned nodes sliding at the last Uzawa update.
+    pub fn sliding_nodes(&self) -> usize {
+        self.friction.as_ref().map_or(0, |f| {
+            (0..self.owned.len())
+                .filter(|&j| self.owned[j] && f.sliding[j])
+                .count()
+        })
     }
 
     /// Owned nodes in contact.
@@ -437,9 +559,13 @@ impl MortarPair {
     /// Nodal output of the owned nodes and this rank's part of the pair's
     /// force on the slave, `Σ_j λ_j D_jk ν` summed over `k` (`D` of the
     /// current segments, so the force is the one the residual applied).
-    pub fn output(&self, u_local: &[f64]) -> (NodeFields, PairForce) {
+    pub fn output(&self, u_local: &[f64], rate: Option<&Rate>) -> (NodeFields, PairForce) {
         let x = self.positions(u_local);
-        let (segments, states) = self.evaluate::<f64>(&x);
+        let Evaluation {
+            segments, states, ..
+        } = self.evaluate::<f64>(&x, u_local, rate);
+        let zero = [0.0; 3];
+        let lambda_t = |j: usize| self.friction.as_ref().map_or(&zero, |f| &f.nodal.lambda[j]);
         let nf = self.facet_type.nodes();
         let mut normal_sum = vec![[0.0; 3]; self.nodal.nodes.len()];
         let mut force = PairForce::default();
@@ -462,6 +588,11 @@ impl MortarPair {
                     *f -= lambda * d * nc;
                 }
                 force.normal += lambda * d;
+                let t = lambda_t(j);
+                for (f, tc) in force.force.iter_mut().zip(t) {
+                    *f -= tc * d;
+                }
+                force.tangential += crate::contact::dual::norm(t) * d;
             }
         }
         let n = self.owned_mesh_nodes;
@@ -479,7 +610,9 @@ impl MortarPair {
             out.weighted_gap[l] = states[j].weighted_gap;
             let len = crate::contact::dual::norm(&normal_sum[j]);
             if len > 0.0 {
-                out.traction[l] = normal_sum[j].map(|c| -self.nodal.lambda[j] * c / len);
+                let t = lambda_t(j);
+                out.traction[l] =
+                    [0, 1, 2].map(|i| -self.nodal.lambda[j] * normal_sum[j][i] / len - t[i]);
             }
         }
         (out, force)
@@ -495,6 +628,47 @@ impl MortarPair {
                 *d += 1.0;
             }
         }
+    }
+
+    /// Friction at the slave points of `slave` (output): the nodal traction
+    /// on the slave (−λT_j) and slip interpolated like the pressure, and the
+    /// state (0 open where `pressure` is 0, else 2 if a node of the facet
+    /// slides, else 1). Empty for a frictionless pair.
+    pub fn point_friction(
+        &self,
+        slave: &crate::contact::surfaces::SlaveSurface,
+        pressure: &[f64],
+    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) {
+        use crate::contact::multipliers::PointState;
+        let Some(f) = &self.friction else {
+            return Default::default();
+        };
+        let by_node: std::collections::HashMap<u32, usize> = (0..self.nodal.nodes.len())
+            .map(|j| (self.node_local[self.nodal.nodes[j] as usize], j))
+            .collect();
+        let mut out: (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) = Default::default();
+        for (q, p) in pressure.iter().enumerate() {
+            let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
+            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
+            for (n, na) in slave.facets[q / slave.nqp].nodes.iter().zip(s.n) {
+                if let Some(&j) = by_node.get(n) {
+                    for c in 0..3 {
+                        t[c] -= na * f.nodal.lambda[j][c];
+                        slip[c] += na * f.slip[j][c];
+                    }
+                    sliding |= f.sliding[j];
+                }
+            }
+            let state = match (*p > 0.0, sliding) {
+                (false, _) => PointState::Open,
+                (true, false) => PointState::Stick,
+                (true, true) => PointState::Slip,
+            };
+            out.0.push(t);
+            out.1.push(slip);
+            out.2.push(state as i8);
+        }
+        out
     }
 
     /// λ_j by the slave node's local index, for the nodes this rank holds

@@ -23,7 +23,7 @@ use crate::fem::{FacetType, MAX_FACET_NODES};
 /// Variables of one segment: slave nodes at `3a + i`, master nodes at
 /// `12 + 3b + i` (fixed slots, whatever the facet types).
 pub const SEGMENT_DOFS: usize = 6 * MAX_FACET_NODES;
-const MASTER_OFFSET: usize = 3 * MAX_FACET_NODES;
+pub(super) const MASTER_OFFSET: usize = 3 * MAX_FACET_NODES;
 type D = Dual<SEGMENT_DOFS>;
 
 /// A node DOF: (node id, component).
@@ -80,10 +80,17 @@ impl NodalData {
 /// the index: residual only).
 pub trait Seed: Scalar {
     fn seed(v: f64, i: usize) -> Self;
+    /// Value `v` with derivative `slope` along variable `i` (an affine
+    /// function of that variable, such as a slip increment).
+    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
 }
 
 impl Seed for f64 {
     fn seed(v: f64, _: usize) -> Self {
+        v
+    }
+
+    fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
         v
     }
 }
@@ -91,6 +98,14 @@ impl Seed for f64 {
 impl Seed for D {
     fn seed(v: f64, i: usize) -> Self {
         Dual::variable(v, i)
+    }
+
+    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self {
+        let mut d = Dual::constant(v);
+        if let Some(e) = d.eps.get_mut(i) {
+            *e = slope;
+        }
+        d
     }
 }
 
@@ -162,15 +177,19 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
     out
 }
 
-/// Nodal weighted gaps `g̃_j` (by slot) and whether any segment covers the
-/// node.
+/// Nodal weighted gaps `g̃_j` (by slot) and whether the segments cover the
+/// node: `∫ Φ_j dA` over them (the row sum of `D`, `A_j` when the node's
+/// facets are covered) at least half of `A_j`. Φ_j changes sign inside a
+/// facet, so over a small part of its support `∫ Φ_j g` may be negative
+/// with `g > 0` everywhere: such a node would be pulled into a contact it
+/// does not have.
 pub fn weighted_gaps<T: Scalar>(
     interface: &Interface,
     nodal: &NodalData,
     segments: &[Segment<T>],
 ) -> (Vec<f64>, Vec<bool>) {
     let mut gap = vec![0.0; nodal.nodes.len()];
-    let mut covered = vec![false; nodal.nodes.len()];
+    let mut weight = vec![0.0; nodal.nodes.len()];
     let ns = interface.slave_type.nodes();
     for seg in segments {
         for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
@@ -179,10 +198,15 @@ pub fn weighted_gaps<T: Scalar>(
         {
             if let Some(j) = nodal.slot_of(node) {
                 gap[j] += seg.terms.weighted_gap[a].re();
-                covered[j] = true;
+                weight[j] += seg.terms.d[a][..ns].iter().map(Scalar::re).sum::<f64>();
             }
         }
     }
+    let covered = weight
+        .iter()
+        .zip(&nodal.area)
+        .map(|(w, a)| *w >= 0.5 * a)
+        .collect();
     (gap, covered)
 }
 
@@ -216,7 +240,7 @@ pub fn node_states(nodal: &NodalData, gap: &[f64], covered: &[bool]) -> Vec<Node
 }
 
 /// Node ids of a segment's variables in slot order (`u32::MAX`: unused).
-fn segment_nodes(
+pub(super) fn segment_nodes(
     interface: &Interface,
     seg_slave: u32,
     seg_master: u32,
@@ -279,7 +303,7 @@ pub fn residual<T: Scalar>(
 }
 
 /// A sparse vector over node DOFs, merged (sorted, duplicates summed).
-fn merged(mut v: Vec<(NodeDof, f64)>) -> Vec<(NodeDof, f64)> {
+pub(super) fn merged(mut v: Vec<(NodeDof, f64)>) -> Vec<(NodeDof, f64)> {
     v.sort_by_key(|e| e.0);
     let mut out: Vec<(NodeDof, f64)> = Vec::with_capacity(v.len());
     for (k, x) in v {

@@ -257,15 +257,15 @@ fn parallel_facets_give_gap_times_nodal_area_and_consistent_forces() {
 
 /// A random interface: a 2×2 slave patch (quads or triangles) under a
 /// perturbed, rotated, slightly penetrating master patch.
-struct Case {
-    slave_type: FacetType,
-    master_type: FacetType,
-    positions: Vec<[f64; 3]>,
-    slave_facets: Vec<[u32; 4]>,
-    master_facets: Vec<[u32; 4]>,
-    candidates: Vec<(u32, u32)>,
-    assembled: Vec<bool>,
-    nodal: NodalData,
+pub(super) struct Case {
+    pub(super) slave_type: FacetType,
+    pub(super) master_type: FacetType,
+    pub(super) positions: Vec<[f64; 3]>,
+    pub(super) slave_facets: Vec<[u32; 4]>,
+    pub(super) master_facets: Vec<[u32; 4]>,
+    pub(super) candidates: Vec<(u32, u32)>,
+    pub(super) assembled: Vec<bool>,
+    pub(super) nodal: NodalData,
 }
 
 /// Where a test patch sits: facets per side, side length, height, rotation
@@ -321,7 +321,7 @@ fn patch(
     facets
 }
 
-fn random_case(seed: u64, slave_type: FacetType, master_type: FacetType) -> Case {
+pub(super) fn random_case(seed: u64, slave_type: FacetType, master_type: FacetType) -> Case {
     let mut rng = Lcg::new(seed);
     let mut positions = Vec::new();
     let slave = PatchSpec {
@@ -365,7 +365,7 @@ fn random_case(seed: u64, slave_type: FacetType, master_type: FacetType) -> Case
 }
 
 impl Case {
-    fn interface<'a>(&'a self, positions: &'a [[f64; 3]]) -> Interface<'a> {
+    pub(super) fn interface<'a>(&'a self, positions: &'a [[f64; 3]]) -> Interface<'a> {
         Interface {
             slave_type: self.slave_type,
             master_type: self.master_type,

@@ -197,7 +197,7 @@ impl ContactPair {
         r_local: &mut [f64],
     ) -> Result<()> {
         if let Some(m) = &self.mortar {
-            m.add_residual(u_local, r_local);
+            m.add_residual(u_local, self.mortar_rate().as_ref(), r_local);
             return Ok(());
         }
         self.for_each_link(
@@ -224,14 +224,10 @@ impl ContactPair {
         factor: f64,
         k: &mut dyn MatrixSink,
     ) -> Result<()> {
-        if self.mortar.is_some() {
-            // No active-set hash for mortar pairs yet: a new signature at
-            // every tangent makes the solver rebuild its preconditioner each
-            // time, as it did before the active-set lag existed.
-            self.tangent_signature = self.tangent_signature.wrapping_add(1);
-        }
         if let Some(m) = &self.mortar {
-            return m.add_tangent(dofs, u_local, k);
+            let rate = self.mortar_rate();
+            self.tangent_signature = m.add_tangent(dofs, u_local, rate.as_ref(), k)?;
+            return Ok(());
         }
         // Which links are closed, on which master facets, sticking or
         // sliding: what the tangent's structure depends on.

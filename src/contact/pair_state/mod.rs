@@ -140,6 +140,7 @@ impl ContactPair {
                 // Jacobian pattern: one element size of margin, not the
                 // links' search distance.
                 search_distance.min(slave.h),
+                friction_spec,
             )?),
             (Formulation::Mortar, MasterSpec::Rigid(_)) => {
                 return Err(Error::scene(

@@ -146,8 +146,8 @@ impl ContactPair {
                 .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
                 .sum();
         }
-        let (fields, force) = m.output(u_local);
-        let values = PointValues {
+        let (fields, force) = m.output(u_local, self.mortar_rate().as_ref());
+        let mut values = PointValues {
             points: (0..nq)
                 .map(|q| self.slave.qp_position(q, u_local))
                 .collect(),
@@ -159,7 +159,23 @@ impl ContactPair {
             mortar: Some(fields),
             ..PointValues::empty()
         };
+        if self.has_friction() {
+            (values.traction, values.slip, values.state) =
+                m.point_friction(&self.slave, &values.pressure);
+            values.records = vec![FrictionRecord::default(); nq];
+        }
         (values, force)
+    }
+
+    /// The dynamic slip rate in the mortar pair's terms (None quasi-static).
+    pub(super) fn mortar_rate(&self) -> Option<crate::contact::mortar::friction::Rate<'_>> {
+        self.rate
+            .as_ref()
+            .map(|r| crate::contact::mortar::friction::Rate {
+                dt: r.dt,
+                dv_du: r.dv_du,
+                offset: &r.offset,
+            })
     }
 
     /// Adds this pair's nodal contact pressure (owned nodes) into the field.

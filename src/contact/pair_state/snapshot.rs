@@ -1,7 +1,7 @@
 //! What a pair keeps across steps: the snapshot a cutback restores, the
 //! commit that ends a converged step, and the restart from a result file.
 use super::ContactPair;
-use crate::contact::mortar::pair::MortarPair;
+use crate::contact::mortar::pair::{MortarPair, MortarSnapshot};
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::error::{Error, Result};
 
@@ -28,12 +28,16 @@ pub struct PairSnapshot {
     lambda: Vec<f64>,
     friction: Option<Vec<PointFriction>>,
     /// The nodal multipliers of a mortar pair.
-    mortar: Option<Vec<f64>>,
+    mortar: Option<MortarSnapshot>,
 }
 
 impl ContactPair {
     /// A converged step is final: the next one measures slip from here.
     pub fn commit(&mut self) -> Result<()> {
+        if let Some(m) = &mut self.mortar {
+            m.commit();
+            return Ok(());
+        }
         if let Some(t) = &mut self.multipliers.tangential {
             t.commit();
             self.multipliers.exchange()?;

@@ -11,7 +11,15 @@ impl ContactPair {
     /// then the halo exchange.
     pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
         if let Some(m) = &mut self.mortar {
-            return Ok(m.uzawa_update(u_local));
+            let rate = self
+                .rate
+                .as_ref()
+                .map(|r| crate::contact::mortar::friction::Rate {
+                    dt: r.dt,
+                    dv_du: r.dv_du,
+                    offset: &r.offset,
+                });
+            return Ok(m.uzawa_update(u_local, rate.as_ref()));
         }
         let before = self.multipliers.nodal_forces()?;
         let before_t = self.multipliers.nodal_tangential_forces()?;
@@ -68,7 +76,7 @@ impl ContactPair {
     /// This rank's points in contact (λN > 0) and, of those, sliding.
     pub fn multiplier_states(&self) -> (usize, usize) {
         if let Some(m) = &self.mortar {
-            return (m.active_nodes(), 0);
+            return (m.active_nodes(), m.sliding_nodes());
         }
         let active = self.multipliers.lambda.iter().filter(|l| **l > 0.0).count();
         let sliding = self.multipliers.tangential.as_ref().map_or(0, |t| {

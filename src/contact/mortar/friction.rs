@@ -1,0 +1,355 @@
+//! Coulomb friction on the nodal mortar multipliers (docs/formulation.md
+//! §13.3): the weighted tangential slip of a slave node, the links' return
+//! map on its tangential multiplier, and the residual and exact tangent of
+//! the tangential forces.
+//!
+//! Per slave node `j`, over the segments of its facets:
+//! - weighted slip `ũ_j = Σ_k D_jk Δ¹_k − Σ_l M_jl Δ²_l`, with `Δ` the nodes'
+//!   increment of the step (`x − xₙ` quasi-static, `Δt v(x)` in dynamics,
+//!   both affine in `x`: [`Increment`]), i.e. the relative motion of the
+//!   material points in contact now, weighted with `Φ_j`;
+//! - node normal `n_j = a_j / |a_j|`, `a_j = Σ_s A_s ν_s` (segment areas and
+//!   auxiliary-plane normals);
+//! - trial `t*_j = P_j λT_j + εT P_j ũ_j / A_j` (`P_j = I − n_j ⊗ n_j`,
+//!   `A_j` the reference nodal area, so `ũ_j / A_j` is the mean slip), then
+//!   stick `tT_j = t*_j` if `|t*_j| ≤ μ p_j`, else `tT_j = μ p_j t*_j/|t*_j|`
+//!   with `p_j = λ_j − ε_j g̃_j / A_j` of the closed node;
+//! - residual `+D_jk tT_j` on slave node `k`, `−M_jl tT_j` on master node
+//!   `l` (the variation of `ũ_j` at fixed `D`, `M`, as the normal part).
+//!
+//! `tT_j` is a function of seven node aggregates (`g̃_j`, `a_j`, `ũ_j`),
+//! each a sum of segment terms. The law is evaluated once per node in
+//! `Dual<7>` over those aggregates, and the chain rule through the
+//! segments' `Dual<24>` gives `∂tT_j/∂x`: the slip branch, the coupling to
+//! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
+use super::system::{
+    merged, segment_nodes, Interface, NodalData, NodeDof, NodeState, Seed, Segment,
+};
+use crate::contact::dual::{self, Dual, Scalar, Vec3};
+use crate::fem::MAX_FACET_NODES;
+
+type D = Dual<{ super::system::SEGMENT_DOFS }>;
+/// The node aggregates the law depends on: `g̃`, `a` (3), `ũ` (3).
+const AGGREGATES: usize = 7;
+
+/// The friction data of the slave nodes (by slot, as [`NodalData`]).
+#[derive(Debug, Clone, Default)]
+pub struct NodalFriction {
+    pub mu: f64,
+    /// εT per slot.
+    pub penalty: Vec<f64>,
+    /// λT per slot (a vector, the sense of `tT`: along the slave's slip).
+    pub lambda: Vec<[f64; 3]>,
+}
+
+/// The step's increment of every node id as an affine function of its
+/// current position: `Δ(x) = value + slope (x − x_current)`.
+#[derive(Debug, Clone, Copy)]
+pub struct Increment<'a> {
+    pub value: &'a [[f64; 3]],
+    pub slope: f64,
+}
+
+/// Dynamics: the integrator's velocity `v = dv_du · u + offset` per local
+/// DOF; the increment is then `Δt v`.
+#[derive(Debug, Clone, Copy)]
+pub struct Rate<'a> {
+    pub dt: f64,
+    pub dv_du: f64,
+    pub offset: &'a [f64],
+}
+
+/// One segment's contributions to the node aggregates.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentSlip<T> {
+    /// `A_s ν_s` (the same for every row).
+    pub normal: Vec3<T>,
+    /// Per slave row `a`: `Σ_k D_ak Δ¹_k − Σ_l M_al Δ²_l`.
+    pub slip: [Vec3<T>; MAX_FACET_NODES],
+}
+
+/// The increments of a facet's nodes in `T`, seeded at the segment's
+/// variable slots `offset + 3a + i` with derivative `slope`.
+fn increments<T: Seed>(
+    nodes: &[u32],
+    offset: usize,
+    inc: &Increment,
+) -> [Vec3<T>; MAX_FACET_NODES] {
+    let mut out = [[T::from_f64(0.0); 3]; MAX_FACET_NODES];
+    for (a, (o, &n)) in out.iter_mut().zip(nodes).enumerate() {
+        let v = inc.value[n as usize];
+        *o = [0, 1, 2].map(|i| T::seed_scaled(v[i], offset + 3 * a + i, inc.slope));
+    }
+    out
+}
+
+/// Every segment's slip terms (same order as `segments`).
+pub fn segment_slips<T: Seed>(
+    interface: &Interface,
+    segments: &[Segment<T>],
+    inc: &Increment,
+) -> Vec<SegmentSlip<T>> {
+    let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
+    segments
+        .iter()
+        .map(|seg| {
+            let s_nodes = &interface.slave_facets[seg.slave as usize][..ns];
+            let m_nodes = &interface.master_facets[seg.master as usize][..nm];
+            let d1 = increments::<T>(s_nodes, 0, inc);
+            let d2 = increments::<T>(m_nodes, super::system::MASTER_OFFSET, inc);
+            let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+            for (a, s) in slip.iter_mut().enumerate().take(ns) {
+                for (dak, x) in seg.terms.d[a].iter().zip(&d1).take(ns) {
+                    *s = dual::add(s, &dual::scale(x, *dak));
+                }
+                for (mal, x) in seg.terms.m[a].iter().zip(&d2).take(nm) {
+                    *s = dual::sub(s, &dual::scale(x, *mal));
+                }
+            }
+            SegmentSlip {
+                normal: dual::scale(&seg.terms.normal, seg.terms.area),
+                slip,
+            }
+        })
+        .collect()
+}
+
+/// What the friction law needs of one node besides its aggregates.
+#[derive(Debug, Clone, Copy)]
+pub struct Law {
+    pub lambda_n: f64,
+    pub penalty_n: f64,
+    pub area: f64,
+    pub lambda_t: [f64; 3],
+    pub penalty_t: f64,
+    pub mu: f64,
+}
+
+/// The return map of a closed node: `(tT, tangential mean slip, sliding)`.
+pub fn traction<T: Scalar>(
+    gap: T,
+    normal_sum: &Vec3<T>,
+    slip: &Vec3<T>,
+    law: &Law,
+) -> (Vec3<T>, Vec3<T>, bool) {
+    let pressure = T::from_f64(law.lambda_n) - gap * (law.penalty_n / law.area);
+    let n = dual::scale(normal_sum, dual::norm(normal_sum).recip());
+    let tangential = |v: &Vec3<T>| dual::sub(v, &dual::scale(&n, dual::dot(v, &n)));
+    let lambda = tangential(&dual::constant3(law.lambda_t));
+    let mean_slip = dual::scale_f64(&tangential(slip), 1.0 / law.area);
+    let trial = dual::add(&lambda, &dual::scale_f64(&mean_slip, law.penalty_t));
+    let size = dual::norm(&trial);
+    let limit = pressure * law.mu;
+    if size.re() > limit.re() && size.re() > 0.0 {
+        (dual::scale(&trial, limit / size), mean_slip, true)
+    } else {
+        (trial, mean_slip, false)
+    }
+}
+
+/// The friction outcome of one node.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NodeFriction {
+    /// Closed: the node carries friction.
+    pub active: bool,
+    pub sliding: bool,
+    /// `tT_j` (residual sense; the traction on the slave is `−tT_j`).
+    pub traction: [f64; 3],
+    /// Tangential mean slip `P_j ũ_j / A_j` of the step.
+    pub slip: [f64; 3],
+    /// `∂tT_i/∂(g̃, a, ũ)`.
+    pub derivative: [[f64; AGGREGATES]; 3],
+}
+
+/// The law at every closed node, from the segments' terms.
+pub fn node_frictions<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    friction: &NodalFriction,
+    states: &[NodeState],
+    segments: &[Segment<T>],
+    slips: &[SegmentSlip<T>],
+) -> Vec<NodeFriction> {
+    let ns = interface.slave_type.nodes();
+    let nn = nodal.nodes.len();
+    let (mut normal, mut slip) = (vec![[0.0; 3]; nn], vec![[0.0; 3]; nn]);
+    for (seg, s) in segments.iter().zip(slips) {
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            if let Some(j) = nodal.slot_of(node) {
+                for i in 0..3 {
+                    normal[j][i] += s.normal[i].re();
+                    slip[j][i] += s.slip[a][i].re();
+                }
+            }
+        }
+    }
+    (0..nn)
+        .map(|j| {
+            if !states[j].closed {
+                return NodeFriction::default();
+            }
+            let law = Law {
+                lambda_n: nodal.lambda[j],
+                penalty_n: nodal.penalty[j],
+                area: nodal.area[j],
+                lambda_t: friction.lambda[j],
+                penalty_t: friction.penalty[j],
+                mu: friction.mu,
+            };
+            let var = |v: f64, i: usize| Dual::<AGGREGATES>::variable(v, i);
+            let (t, s, sliding) = traction(
+                var(states[j].weighted_gap, 0),
+                &[0, 1, 2].map(|i| var(normal[j][i], 1 + i)),
+                &[0, 1, 2].map(|i| var(slip[j][i], 4 + i)),
+                &law,
+            );
+            NodeFriction {
+                active: true,
+                sliding,
+                traction: dual::re3(&t),
+                slip: dual::re3(&s),
+                derivative: t.map(|c| c.eps),
+            }
+        })
+        .collect()
+}
+
+/// The tangential force coefficient of slave row `a` on segment node slot
+/// `b` (`< 4` slave, else master `b − 4`): `D_ab` or `−M_a(b−4)`.
+fn coefficient<T: Scalar>(seg: &Segment<T>, a: usize, b: usize) -> T {
+    if b < MAX_FACET_NODES {
+        seg.terms.d[a][b]
+    } else {
+        -seg.terms.m[a][b - MAX_FACET_NODES]
+    }
+}
+
+/// Adds the tangential residual of the assembled segments.
+pub fn residual<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<T>],
+    frictions: &[NodeFriction],
+    mut emit: impl FnMut(u32, usize, f64),
+) {
+    let ns = interface.slave_type.nodes();
+    for seg in segments
+        .iter()
+        .filter(|s| interface.assembled[s.slave as usize])
+    {
+        let ids = segment_nodes(interface, seg.slave, seg.master);
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            let Some(f) = nodal.slot_of(node).map(|j| &frictions[j]) else {
+                continue;
+            };
+            if !f.active || f.traction == [0.0; 3] {
+                continue;
+            }
+            for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
+                let c = coefficient(seg, a, b).re();
+                for (i, t) in f.traction.iter().enumerate() {
+                    emit(id, i, c * t);
+                }
+            }
+        }
+    }
+}
+
+/// Adds the exact tangent of the tangential residual. `segments` and
+/// `slips` must hold every segment of every node of an assembled facet.
+pub fn tangent(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<D>],
+    slips: &[SegmentSlip<D>],
+    frictions: &[NodeFriction],
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    let ns = interface.slave_type.nodes();
+    let nn = nodal.nodes.len();
+    // Per active node: ∂tT_i/∂x over all its segments, and the assembled
+    // coefficients D_jk / −M_jl by node id.
+    let mut grad: Vec<[Vec<(NodeDof, f64)>; 3]> = vec![Default::default(); nn];
+    let mut coef: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    for (seg, s) in segments.iter().zip(slips) {
+        let ids = segment_nodes(interface, seg.slave, seg.master);
+        let assembled = interface.assembled[seg.slave as usize];
+        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
+            .iter()
+            .enumerate()
+        {
+            let Some(j) = nodal.slot_of(node) else {
+                continue;
+            };
+            let f = &frictions[j];
+            if !f.active {
+                continue;
+            }
+            let aggregates: [&D; AGGREGATES] = [
+                &seg.terms.weighted_gap[a],
+                &s.normal[0],
+                &s.normal[1],
+                &s.normal[2],
+                &s.slip[a][0],
+                &s.slip[a][1],
+                &s.slip[a][2],
+            ];
+            for (v, &id) in ids
+                .iter()
+                .flat_map(|id| [id; 3])
+                .enumerate()
+                .filter(|e| *e.1 != u32::MAX)
+            {
+                for (g, row) in grad[j].iter_mut().zip(&f.derivative) {
+                    let d: f64 = row.iter().zip(&aggregates).map(|(r, x)| r * x.eps[v]).sum();
+                    if d != 0.0 {
+                        g.push(((id, v % 3), d));
+                    }
+                }
+            }
+            if !assembled {
+                continue;
+            }
+            for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
+                let c = coefficient(seg, a, b);
+                coef[j].push(((id, 0), c.re));
+                // tT_j ∂c/∂x: local to the segment.
+                for (w, d) in c.eps.iter().enumerate() {
+                    let col = ids[w / 3];
+                    if col == u32::MAX || *d == 0.0 {
+                        continue;
+                    }
+                    for (i, t) in f.traction.iter().enumerate() {
+                        if *t != 0.0 {
+                            emit((id, i), (col, w % 3), t * d);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // c ⊗ ∂tT_j/∂x.
+    for j in 0..nn {
+        if coef[j].is_empty() {
+            continue;
+        }
+        let rows = merged(std::mem::take(&mut coef[j]));
+        for (i, g) in std::mem::take(&mut grad[j]).into_iter().enumerate() {
+            let g = merged(g);
+            for ((id, _), c) in &rows {
+                for (col, dt) in &g {
+                    let v = c * dt;
+                    if v != 0.0 {
+                        emit((*id, i), *col, v);
+                    }
+                }
+            }
+        }
+    }
+}
