@@ -77,12 +77,12 @@ pub fn read_hertz_setup(path: &Path) -> Result<HertzCheck, ResultsError> {
     };
     let text = |k: &str| read_string_attr(path, layout::HERTZ, k);
     let number = |k: &str| read_f64_attr(path, layout::HERTZ, k);
-    let kind = text("kind")?.ok_or_else(missing)?;
+    let kind = text(layout::HERTZ_KIND_ATTR)?.ok_or_else(missing)?;
     let kind = match kind.as_str() {
-        "line" => HertzKind::Line {
-            thickness: number("thickness")?.ok_or_else(missing)?,
+        layout::HERTZ_KIND_LINE => HertzKind::Line {
+            thickness: number(layout::HERTZ_THICKNESS_ATTR)?.ok_or_else(missing)?,
         },
-        "point" => HertzKind::Point,
+        layout::HERTZ_KIND_POINT => HertzKind::Point,
         other => {
             return Err(ResultsError::file(
                 path,
@@ -92,9 +92,9 @@ pub fn read_hertz_setup(path: &Path) -> Result<HertzCheck, ResultsError> {
     };
     Ok(HertzCheck {
         kind,
-        pair: text("pair")?.ok_or_else(missing)?,
-        radius: number("radius")?.ok_or_else(missing)?,
-        effective_modulus: number("effective_modulus")?.ok_or_else(missing)?,
+        pair: text(layout::HERTZ_PAIR_ATTR)?.ok_or_else(missing)?,
+        radius: number(layout::HERTZ_RADIUS_ATTR)?.ok_or_else(missing)?,
+        effective_modulus: number(layout::HERTZ_EFFECTIVE_MODULUS_ATTR)?.ok_or_else(missing)?,
     })
 }
 
