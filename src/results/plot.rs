@@ -3,6 +3,7 @@
 //! from the file's `/hertz` group (written by `run` when the scene has a
 //! [hertz] check), the load from the step's total contact force.
 use super::{open_steps, slave_nodes, PairPoints, ResultsError};
+use crate::dofs::NaturalNode;
 use crate::output::{layout, read_dataset, read_f64_attr, read_nodal, read_string_attr};
 use crate::verify::{self, HertzCheck, HertzKind};
 use plotters::prelude::*;
@@ -120,13 +121,13 @@ impl NodalPressure {
         }
         // Without the pair → slave set map (older files) every loaded node
         // counts; a Hertz scene has one pair.
-        let ids: Vec<usize> = match slave_nodes(path, pair)? {
+        let ids: Vec<NaturalNode> = match slave_nodes(path, pair)? {
             Some(ids) => ids,
-            None => (0..rows).collect(),
+            None => (0..rows).map(NaturalNode).collect(),
         };
         let (points, pressure) = ids
             .into_iter()
-            .filter_map(|n| Some((nodes.get(3 * n..3 * n + 3)?, *pressure.get(n)?)))
+            .filter_map(|NaturalNode(n)| Some((nodes.get(3 * n..3 * n + 3)?, *pressure.get(n)?)))
             .filter(|(_, p)| *p > 0.0)
             .map(|(x, p)| ([x[0], x[1], x[2]], p))
             .unzip();
