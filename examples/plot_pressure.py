@@ -30,17 +30,47 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# The names of the result file, as src/output/layout.rs spells them.
+MESH = "mesh"
+STEPS = "steps"
+CONTACT_PAIRS = "contact_pairs"
+HERTZ = "hertz"
+NODES = "nodes"
+FACET_SETS = "facet_sets"
+FACET_NODES = "nodes"
+DISPLACEMENT = "displacement"
+CONTACT_PRESSURE = "contact_pressure"
+CONTACT = "contact"
+PAIR_POINTS = "points"
+PAIR_PRESSURE = "pressure"
+PAIR_FORCE = "force"
+HERTZ_KIND_ATTR = "kind"
+HERTZ_RADIUS_ATTR = "radius"
+HERTZ_EFFECTIVE_MODULUS_ATTR = "effective_modulus"
+HERTZ_THICKNESS_ATTR = "thickness"
+HERTZ_KIND_LINE = "line"
+
+
+def pair_dataset(pair, name):
+    """contact/<pair>/<name>, relative to a step group."""
+    return f"{CONTACT}/{pair}/{name}"
+
+
+def step_group_name(index):
+    """The step group's name: six digits, zero-padded."""
+    return f"{index:06d}"
+
 
 def hertz_profile(h5, force):
     """(half-width, p0, is_line) of the Hertz solution for the step's force."""
-    attrs = h5["hertz"].attrs
-    kind = attrs["kind"]
+    attrs = h5[HERTZ].attrs
+    kind = attrs[HERTZ_KIND_ATTR]
     kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-    radius = float(attrs["radius"])
-    e_star = float(attrs["effective_modulus"])
+    radius = float(attrs[HERTZ_RADIUS_ATTR])
+    e_star = float(attrs[HERTZ_EFFECTIVE_MODULUS_ATTR])
     total = float(np.linalg.norm(force))
-    if kind == "line":
-        load = total / float(attrs["thickness"])
+    if kind == HERTZ_KIND_LINE:
+        load = total / float(attrs[HERTZ_THICKNESS_ATTR])
         b = math.sqrt(4.0 * load * radius / (math.pi * e_star))
         return b, 2.0 * load / (math.pi * b), True
     a = (3.0 * total * radius / (4.0 * e_star)) ** (1.0 / 3.0)
@@ -62,28 +92,28 @@ def main():
     if not path.is_file():
         sys.exit(f"plot_pressure: {path}: no such file")
     with h5py.File(path, "r") as h5:
-        if "steps" not in h5 or "contact_pairs" not in h5:
+        if STEPS not in h5 or CONTACT_PAIRS not in h5:
             sys.exit(f"plot_pressure: {path}: not a contactlink result file with contact pairs")
-        steps = sorted(h5["steps"].keys())
+        steps = sorted(h5[STEPS].keys())
         if not steps:
             sys.exit(f"plot_pressure: {path}: holds no steps")
-        step = steps[-1] if a.step is None else f"{a.step:06d}"
-        if step not in h5["steps"]:
+        step = steps[-1] if a.step is None else step_group_name(a.step)
+        if step not in h5[STEPS]:
             sys.exit(f"plot_pressure: {path}: no step {a.step} (steps {int(steps[0])}..{int(steps[-1])})")
-        pairs = sorted(h5["contact_pairs"].attrs.keys())
+        pairs = sorted(h5[CONTACT_PAIRS].attrs.keys())
         pair = a.pair or pairs[0]
         if pair not in pairs:
             sys.exit(f"plot_pressure: {path}: no pair '{pair}' (pairs: {', '.join(pairs)})")
-        slave = h5["contact_pairs"].attrs[pair]
+        slave = h5[CONTACT_PAIRS].attrs[pair]
         slave = slave.decode() if isinstance(slave, bytes) else str(slave)
-        g = h5["steps"][step]
-        points = g[f"contact/{pair}/points"][()]
-        pressure = g[f"contact/{pair}/pressure"][()].ravel()
-        force = g[f"contact/{pair}/force"][()].ravel()
-        nodes = np.unique(h5[f"mesh/facet_sets/{slave}/nodes"][()].ravel())
-        xyz = h5["mesh/nodes"][()][nodes] + g["displacement"][()][nodes]
-        nodal = g["contact_pressure"][()].ravel()[nodes]
-        hertz = hertz_profile(h5, force) if "hertz" in h5 else None
+        g = h5[STEPS][step]
+        points = g[pair_dataset(pair, PAIR_POINTS)][()]
+        pressure = g[pair_dataset(pair, PAIR_PRESSURE)][()].ravel()
+        force = g[pair_dataset(pair, PAIR_FORCE)][()].ravel()
+        nodes = np.unique(h5[f"{MESH}/{FACET_SETS}/{slave}/{FACET_NODES}"][()].ravel())
+        xyz = h5[f"{MESH}/{NODES}"][()][nodes] + g[DISPLACEMENT][()][nodes]
+        nodal = g[CONTACT_PRESSURE][()].ravel()[nodes]
+        hertz = hertz_profile(h5, force) if HERTZ in h5 else None
 
     line = hertz[2] if hertz else bool(np.ptp(points[:, 1]) > 10 * np.ptp(points[:, 0]))
     s_points, s_nodes = distance(points, line), distance(xyz, line)

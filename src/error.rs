@@ -2,7 +2,6 @@
 //! where (file, set, cell, step), so a user can act on it.
 use crate::fem::FemError;
 use crate::mesh::MeshError;
-use crate::output::OutputError;
 use crate::petsc::PetscError;
 
 #[derive(Debug, thiserror::Error)]
@@ -17,8 +16,11 @@ pub enum Error {
         "cell {cell} is inverted in the reference configuration (det J = {det_j:.3e} at quadrature point {qp}); check the mesh and its node order"
     )]
     InvertedCell { cell: usize, qp: usize, det_j: f64 },
+    /// A result file could not be written or read. The cause is the output
+    /// module's own error (it converts itself into this variant, so this
+    /// module need not know its type).
     #[error("output: {0}")]
-    Output(#[from] OutputError),
+    Output(#[source] Box<dyn std::error::Error + Send + Sync + 'static>),
     #[error("scene {origin}: {message}")]
     Scene { origin: String, message: String },
     #[error("partition: {0}")]

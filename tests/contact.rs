@@ -3,7 +3,7 @@
 //! it says so) and reads the HDF5 file it wrote.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_dataset, read_nodal};
+use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
 use contactlink::verify::{self, HertzCheck, HertzKind};
 use std::path::Path;
 
@@ -15,7 +15,7 @@ fn last_step(path: &Path) -> usize {
 }
 
 fn dataset(path: &Path, step: usize, rel: &str) -> Vec<f64> {
-    read_dataset::<f64>(path, &format!("/steps/{step:06}/{rel}"))
+    read_dataset::<f64>(path, &layout::step_dataset(step, rel))
         .expect(rel)
         .0
 }
@@ -35,10 +35,13 @@ fn norm(v: [f64; 3]) -> f64 {
 
 /// Total reaction on every node of the body that carries facet set `set`.
 fn reaction_on_body_of(path: &Path, step: usize, set: &str) -> [f64; 3] {
-    let (cell, _) =
-        read_dataset::<i64>(path, &format!("/mesh/facet_sets/{set}/cell")).expect("facet set");
-    let (cell_body, _) = read_dataset::<i32>(path, "/mesh/cell_body").expect("cell_body");
-    let (cells, shape) = read_dataset::<i64>(path, "/mesh/cells").expect("cells");
+    let (cell, _) = read_dataset::<i64>(
+        path,
+        &format!("{}/{}", layout::facet_set(set), layout::FACET_CELL),
+    )
+    .expect("facet set");
+    let (cell_body, _) = read_dataset::<i32>(path, layout::MESH_CELL_BODY).expect("cell_body");
+    let (cells, shape) = read_dataset::<i64>(path, layout::MESH_CELLS).expect("cells");
     let body = cell_body[cell[0] as usize];
     let mut nodes: Vec<usize> = cells
         .chunks_exact(shape[1])
@@ -48,7 +51,7 @@ fn reaction_on_body_of(path: &Path, step: usize, set: &str) -> [f64; 3] {
         .collect();
     nodes.sort_unstable();
     nodes.dedup();
-    let (r, _, _) = read_nodal(path, step, "reaction").expect("reaction");
+    let (r, _, _) = read_nodal(path, step, layout::REACTION).expect("reaction");
     let mut f = [0.0; 3];
     for n in nodes {
         for c in 0..3 {
@@ -62,7 +65,7 @@ fn reaction_on_body_of(path: &Path, step: usize, set: &str) -> [f64; 3] {
 /// body's supports: |F_c + R| ≤ 1e-8 |R|.
 fn assert_balance(path: &Path, pair: &str, slave_set: &str) {
     let step = last_step(path);
-    let fc = dataset(path, step, &format!("contact/{pair}/force"));
+    let fc = dataset(path, step, &layout::pair_dataset(pair, layout::PAIR_FORCE));
     let r = reaction_on_body_of(path, step, slave_set);
     let support = format!("the body of {slave_set}");
     let residual = norm([fc[0] + r[0], fc[1] + r[1], fc[2] + r[2]]);
@@ -85,22 +88,25 @@ fn block_on_rigid_plane_balances_and_does_not_penetrate() {
     run_scene(2, "block-on-plane", &out, &[]);
     assert_balance(&out, "floor", "block.bottom");
     let step = last_step(&out);
-    let gap = dataset(&out, step, "contact/floor/gap");
+    let gap = dataset(&out, step, &layout::pair_dataset("floor", layout::PAIR_GAP));
     let worst = gap.iter().fold(0.0f64, |m, g| m.max(-g));
     // Uzawa tolerance: 1e-4 of the slave facet size (0.25).
     assert!(worst <= 1e-4 * 0.25 + 1e-15, "penetration {worst:.3e}");
     // Uniform compression: all slave points carry pressure.
-    let p = dataset(&out, step, "contact/floor/pressure");
+    let p = dataset(
+        &out,
+        step,
+        &layout::pair_dataset("floor", layout::PAIR_PRESSURE),
+    );
     assert!(p.iter().all(|&v| v > 0.0));
 }
 
 /// Nodal contact pressure at the nodes of a node set, with their reference
 /// positions (small-strain closed forms are stated over the undeformed surface).
 fn nodal_pressure_on(path: &Path, step: usize, set: &str) -> Vec<([f64; 3], f64)> {
-    let (nodes, _) =
-        read_dataset::<i64>(path, &format!("/mesh/node_sets/{set}")).expect("node set");
-    let (x, _) = read_dataset::<f64>(path, "/mesh/nodes").expect("nodes");
-    let (p, _, _) = read_nodal(path, step, "contact_pressure").expect("contact_pressure");
+    let (nodes, _) = read_dataset::<i64>(path, &layout::node_set(set)).expect("node set");
+    let (x, _) = read_dataset::<f64>(path, layout::MESH_NODES).expect("nodes");
+    let (p, _, _) = read_nodal(path, step, layout::CONTACT_PRESSURE).expect("contact_pressure");
     nodes
         .iter()
         .map(|&n| {
@@ -117,14 +123,22 @@ fn patch_test_pressure_is_uniform_up_to_the_measured_deviation() {
     run_scene(2, "patch-test", &out, &[]);
     assert_balance(&out, "interface", "upper.bottom");
     let step = last_step(&out);
-    let force = dataset(&out, step, "contact/interface/force");
+    let force = dataset(
+        &out,
+        step,
+        &layout::pair_dataset("interface", layout::PAIR_FORCE),
+    );
     let mean = force[2].abs(); // interface area 1 × 1
     let nodal = nodal_pressure_on(&out, step, "upper.bottom");
     let nodal_dev = nodal
         .iter()
         .fold(0.0f64, |m, (_, p)| m.max((p - mean).abs()))
         / mean;
-    let points = dataset(&out, step, "contact/interface/pressure");
+    let points = dataset(
+        &out,
+        step,
+        &layout::pair_dataset("interface", layout::PAIR_PRESSURE),
+    );
     let point_dev = points.iter().fold(0.0f64, |m, v| m.max((v - mean).abs())) / mean;
     println!(
         "patch test: mean pressure {mean:.6e} (E·strain = 10), max deviation: nodal pressure {:.2} %, point multipliers {:.2} %",
@@ -157,7 +171,11 @@ fn hertz_line(out: &Path) -> verify::HertzComparison {
         .collect();
     let pts: Vec<[f64; 3]> = nodal.iter().map(|(x, _)| *x).collect();
     let p: Vec<f64> = nodal.iter().map(|(_, p)| *p).collect();
-    let f = dataset(out, step, "contact/hertz/force");
+    let f = dataset(
+        out,
+        step,
+        &layout::pair_dataset("hertz", layout::PAIR_FORCE),
+    );
     let check = HertzCheck {
         kind: HertzKind::Line { thickness: 1.0 },
         pair: "hertz".into(),
@@ -228,11 +246,15 @@ fn contact_scenes_same_on_1_2_3_ranks() {
             run_scene(*n, scene, f, &args);
         }
         let step = last_step(&files[0]);
-        let (u1, _, _) = read_nodal(&files[0], step, "displacement").unwrap();
-        let p1 = dataset(&files[0], step, &format!("contact/{pair}/pressure"));
+        let (u1, _, _) = read_nodal(&files[0], step, layout::DISPLACEMENT).unwrap();
+        let p1 = dataset(
+            &files[0],
+            step,
+            &layout::pair_dataset(pair, layout::PAIR_PRESSURE),
+        );
         for (n, f) in [2, 3].iter().zip(&files[1..]) {
-            let (u, _, _) = read_nodal(f, step, "displacement").unwrap();
-            let p = dataset(f, step, &format!("contact/{pair}/pressure"));
+            let (u, _, _) = read_nodal(f, step, layout::DISPLACEMENT).unwrap();
+            let p = dataset(f, step, &layout::pair_dataset(pair, layout::PAIR_PRESSURE));
             let (du, dp) = (relative_difference(&u1, &u), relative_difference(&p1, &p));
             println!("{scene}: {n} ranks vs 1: displacement {du:.3e}, pressure {dp:.3e}");
             assert!(
@@ -264,7 +286,11 @@ fn hertz_sphere_on_a_coarse_mesh_is_close_to_closed_form() {
         .collect();
     let pts: Vec<[f64; 3]> = nodal.iter().map(|(x, _)| *x).collect();
     let p: Vec<f64> = nodal.iter().map(|(_, p)| *p).collect();
-    let f = dataset(&out, step, "contact/hertz/force");
+    let f = dataset(
+        &out,
+        step,
+        &layout::pair_dataset("hertz", layout::PAIR_FORCE),
+    );
     let check = HertzCheck {
         kind: HertzKind::Point,
         pair: "hertz".into(),

@@ -4,6 +4,7 @@
 //! a run killed (SIGKILL of one rank, SIGTERM to mpirun) in the middle.
 mod common;
 use common::*;
+use contactlink::output::layout;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -139,7 +140,7 @@ fn assert_file_holds(h5: &Path, csv_listed: &[usize]) {
             steps.contains(s),
             "step {s} in the CSV but not in the file ({steps:?})"
         );
-        let (u, rows, cols) = contactlink::output::read_nodal(h5, *s, "displacement")
+        let (u, rows, cols) = contactlink::output::read_nodal(h5, *s, layout::DISPLACEMENT)
             .unwrap_or_else(|e| panic!("step {s} unreadable: {e}"));
         assert_eq!((u.len(), cols), (rows * 3, 3));
         assert!(

@@ -9,6 +9,7 @@
 //! whose follower-pressure facets all sit on one rank.
 mod common;
 use common::*;
+use contactlink::output::layout;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::sync::mpsc;
@@ -175,7 +176,7 @@ fn assert_file_holds_completed_steps(h5: &Path, what: &str) -> Vec<usize> {
         "{what}: steps in the file vs the history CSV"
     );
     for s in &steps {
-        let (u, rows, cols) = contactlink::output::read_nodal(h5, *s, "displacement")
+        let (u, rows, cols) = contactlink::output::read_nodal(h5, *s, layout::DISPLACEMENT)
             .unwrap_or_else(|e| panic!("{what}: step {s} unreadable: {e}"));
         assert_eq!((u.len(), cols), (rows * 3, 3));
         assert!(
@@ -687,14 +688,14 @@ fn follower_patch_test_with_its_loaded_facets_on_one_rank_matches_one_rank() {
             // The case this test is about: every upper cell (and so every
             // loaded facet) on one rank, none on the other.
             let (part, _) =
-                contactlink::output::read_dataset::<i32>(&out, "/mesh/partition").unwrap();
+                contactlink::output::read_dataset::<i32>(&out, layout::MESH_PARTITION).unwrap();
             let upper = &part[25..];
             assert!(
                 upper.iter().all(|r| *r == upper[0]),
                 "upper block split: {part:?}"
             );
         }
-        let (u, _, _) = contactlink::output::read_nodal(&out, last, "displacement").unwrap();
+        let (u, _, _) = contactlink::output::read_nodal(&out, last, layout::DISPLACEMENT).unwrap();
         fields.push(u);
     }
     let d = relative_difference(&fields[0], &fields[1]);

@@ -4,7 +4,7 @@
 //! and the frictional scenes on 1 and 2 ranks.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_dataset, read_nodal};
+use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -34,7 +34,7 @@ fn history(h5: &Path) -> Vec<HashMap<String, f64>> {
 }
 
 fn dataset(path: &Path, step: usize, rel: &str) -> Vec<f64> {
-    read_dataset::<f64>(path, &format!("/steps/{step:06}/{rel}"))
+    read_dataset::<f64>(path, &layout::step_dataset(step, rel))
         .expect(rel)
         .0
 }
@@ -61,7 +61,11 @@ fn block_slide_sticks_below_mu_n_and_transmits_mu_n_while_sliding() {
             // Well below μN nothing slips: every point sticks and its slip
             // in the step is below the Uzawa tolerance (1e-3 h).
             assert_eq!(row["floor.sliding"], 0.0, "step {step} slides at T = {t}");
-            let slip = dataset(&out, step, "contact/floor/slip");
+            let slip = dataset(
+                &out,
+                step,
+                &layout::pair_dataset("floor", layout::PAIR_SLIP),
+            );
             let worst = slip
                 .chunks_exact(3)
                 .map(|s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt())
@@ -91,8 +95,16 @@ fn block_slide_sticks_below_mu_n_and_transmits_mu_n_while_sliding() {
     assert!(sliding >= 5, "too few fully sliding steps ({sliding})");
     // The state array says the same: 1 (stick) or 2 (slip) on every contact point.
     let last = *steps.last().unwrap();
-    let state = dataset(&out, last, "contact/floor/state");
-    let pressure = dataset(&out, last, "contact/floor/pressure");
+    let state = dataset(
+        &out,
+        last,
+        &layout::pair_dataset("floor", layout::PAIR_STATE),
+    );
+    let pressure = dataset(
+        &out,
+        last,
+        &layout::pair_dataset("floor", layout::PAIR_PRESSURE),
+    );
     for (s, p) in state.iter().zip(&pressure) {
         assert_eq!(*s, if *p > 0.0 { 2.0 } else { 0.0 });
     }
@@ -189,8 +201,8 @@ fn same_on_1_and_2_ranks(scene: &str, extra: &[&str], pair: &str) {
     let steps = list_steps(&files[0]).unwrap();
     assert_eq!(list_steps(&files[1]).unwrap(), steps);
     let last = *steps.last().unwrap();
-    let (u1, _, _) = read_nodal(&files[0], last, "displacement").unwrap();
-    let (u2, _, _) = read_nodal(&files[1], last, "displacement").unwrap();
+    let (u1, _, _) = read_nodal(&files[0], last, layout::DISPLACEMENT).unwrap();
+    let (u2, _, _) = read_nodal(&files[1], last, layout::DISPLACEMENT).unwrap();
     let d = relative_difference(&u1, &u2);
     let (h1, h2) = (history(&files[0]), history(&files[1]));
     let forces = |h: &[HashMap<String, f64>]| -> Vec<f64> {
@@ -199,8 +211,16 @@ fn same_on_1_and_2_ranks(scene: &str, extra: &[&str], pair: &str) {
             .collect()
     };
     let df = relative_difference(&forces(&h1), &forces(&h2));
-    let state1 = dataset(&files[0], last, &format!("contact/{pair}/state"));
-    let state2 = dataset(&files[1], last, &format!("contact/{pair}/state"));
+    let state1 = dataset(
+        &files[0],
+        last,
+        &layout::pair_dataset(pair, layout::PAIR_STATE),
+    );
+    let state2 = dataset(
+        &files[1],
+        last,
+        &layout::pair_dataset(pair, layout::PAIR_STATE),
+    );
     println!("{scene}: 2 ranks vs 1: displacement {d:.2e}, contact forces {df:.2e}");
     assert!(d < 1e-8 && df < 1e-8, "{scene}: {d:e} {df:e}");
     assert_eq!(state1, state2, "{scene}: stick/slip states differ");
@@ -267,19 +287,22 @@ fn a_frictionless_static_scene_carries_no_friction_or_dynamics_data() {
     run_scene(1, "patch-test", &rough, &["--set", "contact.friction=0.3"]);
     let last = *list_steps(&plain).unwrap().last().unwrap();
     let has =
-        |f: &Path, rel: &str| read_dataset::<f64>(f, &format!("/steps/{last:06}/{rel}")).is_ok();
+        |f: &Path, rel: &str| read_dataset::<f64>(f, &layout::step_dataset(last, rel)).is_ok();
     // μ absent: no friction state, hence no tangential arrays; static: no
     // mass matrix, hence no velocity, energy or momentum.
     for rel in [
-        "contact/interface/traction_t",
-        "contact/interface/state",
-        "velocity",
-        "energy",
+        layout::pair_dataset("interface", layout::PAIR_TRACTION_T),
+        layout::pair_dataset("interface", layout::PAIR_STATE),
+        layout::VELOCITY.to_string(),
+        layout::ENERGY.to_string(),
     ] {
-        assert!(!has(&plain, rel), "frictionless static run wrote {rel}");
+        assert!(!has(&plain, &rel), "frictionless static run wrote {rel}");
     }
-    assert!(has(&rough, "contact/interface/traction_t"));
-    assert!(!has(&rough, "velocity"));
+    assert!(has(
+        &rough,
+        &layout::pair_dataset("interface", layout::PAIR_TRACTION_T)
+    ));
+    assert!(!has(&rough, layout::VELOCITY));
     // Uniform compression: friction changes nothing here but must not break
     // the patch test (normal force identical to 1e-8).
     let (h0, h1) = (history(&plain), history(&rough));

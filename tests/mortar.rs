@@ -5,7 +5,7 @@
 //! `formulation` input is one scene error naming the line.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_dataset, read_nodal};
+use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
 use std::path::Path;
 
 /// One patch-test case: the stacked blocks with `upper` over `lower`
@@ -215,9 +215,8 @@ fn last_step(path: &Path) -> usize {
 
 /// Nodal contact pressure at the slave surface's nodes.
 fn slave_pressures(path: &Path, node_set: &str) -> Vec<f64> {
-    let (nodes, _) =
-        read_dataset::<i64>(path, &format!("/mesh/node_sets/{node_set}")).expect("node set");
-    let (p, _, _) = read_nodal(path, last_step(path), "contact_pressure").expect("pressure");
+    let (nodes, _) = read_dataset::<i64>(path, &layout::node_set(node_set)).expect("node set");
+    let (p, _, _) = read_nodal(path, last_step(path), layout::CONTACT_PRESSURE).expect("pressure");
     nodes.iter().map(|&n| p[n as usize]).collect()
 }
 
@@ -255,26 +254,31 @@ fn try_case(
         return Err(text(&o));
     }
     let step = last_step(&out);
-    let force = read_dataset::<f64>(&out, &format!("/steps/{step:06}/contact/interface/force"))
-        .expect("force")
-        .0;
+    let force = read_dataset::<f64>(
+        &out,
+        &layout::step_dataset(step, &layout::pair_dataset("interface", layout::PAIR_FORCE)),
+    )
+    .expect("force")
+    .0;
     Ok((slave_pressures(&out, case.slave().0), force))
 }
 
 /// The mortar pair's nodal datasets at the slave nodes: λ, g̃ and the traction.
 fn mortar_fields(path: &Path, node_set: &str) -> Vec<(f64, f64, [f64; 3])> {
     let step = last_step(path);
-    let (nodes, _) =
-        read_dataset::<i64>(path, &format!("/mesh/node_sets/{node_set}")).expect("node set");
+    let (nodes, _) = read_dataset::<i64>(path, &layout::node_set(node_set)).expect("node set");
     let read = |name: &str| {
-        read_dataset::<f64>(path, &format!("/steps/{step:06}/contact/interface/{name}"))
-            .expect(name)
-            .0
+        read_dataset::<f64>(
+            path,
+            &layout::step_dataset(step, &layout::pair_dataset("interface", name)),
+        )
+        .expect(name)
+        .0
     };
     let (lambda, gap, traction) = (
-        read("node_lambda"),
-        read("node_weighted_gap"),
-        read("node_traction"),
+        read(layout::PAIR_NODE_LAMBDA),
+        read(layout::PAIR_NODE_WEIGHTED_GAP),
+        read(layout::PAIR_NODE_TRACTION),
     );
     nodes
         .iter()

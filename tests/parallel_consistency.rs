@@ -2,7 +2,7 @@
 //! (input) order, with the documented file layout.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_dataset, read_nodal, read_step_attrs};
+use contactlink::output::{layout, list_steps, read_dataset, read_nodal, read_step_attrs};
 
 fn run_on(ranks: usize, scene: &str, out: &std::path::Path) {
     let o = mpirun(ranks, &["run", scene, "-q", "-o", out.to_str().unwrap()]);
@@ -33,34 +33,37 @@ fn compare_ranks(scene: &str) {
         );
     }
     let last = *steps.last().unwrap();
-    let (u1, rows, cols) = read_nodal(&files[0], last, "displacement").unwrap();
+    let (u1, rows, cols) = read_nodal(&files[0], last, layout::DISPLACEMENT).unwrap();
     assert_eq!(cols, 3);
     assert!(
         u1.iter().any(|v| v.abs() > 0.0),
         "the 1-rank displacement is zero"
     );
     for (n, f) in [2, 3].iter().zip(&files[1..]) {
-        let (u, r, _) = read_nodal(f, last, "displacement").unwrap();
+        let (u, r, _) = read_nodal(f, last, layout::DISPLACEMENT).unwrap();
         assert_eq!(r, rows);
         let d = relative_difference(&u1, &u);
         println!("{scene}: {n} ranks vs 1: max relative displacement difference {d:.3e}");
         assert!(d < 1e-8, "{scene}: {n} ranks differ from 1 rank by {d:.3e}");
-        let (reaction1, _, _) = read_nodal(&files[0], last, "reaction").unwrap();
-        let (reaction, _, _) = read_nodal(f, last, "reaction").unwrap();
+        let (reaction1, _, _) = read_nodal(&files[0], last, layout::REACTION).unwrap();
+        let (reaction, _, _) = read_nodal(f, last, layout::REACTION).unwrap();
         let dr = relative_difference(&reaction1, &reaction);
         assert!(dr < 1e-6, "{scene}: {n}-rank reactions differ by {dr:.3e}");
     }
     // Mesh arrays are in input order whatever the rank count: identical.
-    let (nodes1, shape) = read_dataset::<f64>(&files[0], "/mesh/nodes").unwrap();
-    let (cells1, cshape) = read_dataset::<i64>(&files[0], "/mesh/cells").unwrap();
+    let (nodes1, shape) = read_dataset::<f64>(&files[0], layout::MESH_NODES).unwrap();
+    let (cells1, cshape) = read_dataset::<i64>(&files[0], layout::MESH_CELLS).unwrap();
     assert_eq!(shape[1], 3);
     for f in &files[1..] {
-        assert_eq!(read_dataset::<f64>(f, "/mesh/nodes").unwrap().0, nodes1);
-        let (cells, s) = read_dataset::<i64>(f, "/mesh/cells").unwrap();
+        assert_eq!(
+            read_dataset::<f64>(f, layout::MESH_NODES).unwrap().0,
+            nodes1
+        );
+        let (cells, s) = read_dataset::<i64>(f, layout::MESH_CELLS).unwrap();
         assert_eq!((cells, s), (cells1.clone(), cshape.clone()));
     }
     // The partition column says which rank owned each cell.
-    let (part3, _) = read_dataset::<i32>(&files[2], "/mesh/partition").unwrap();
+    let (part3, _) = read_dataset::<i32>(&files[2], layout::MESH_PARTITION).unwrap();
     for r in 0..3 {
         assert!(
             part3.contains(&r),
@@ -71,7 +74,7 @@ fn compare_ranks(scene: &str) {
     assert!(info.converged && info.newton_iterations > 0);
     assert!((info.load_factor - 1.0).abs() < 1e-12);
     let xmf = std::fs::read_to_string(files[1].with_extension("xmf")).unwrap();
-    assert!(xmf.contains("displacement") && xmf.contains(&format!("{scene}-2.h5")));
+    assert!(xmf.contains(layout::DISPLACEMENT) && xmf.contains(&format!("{scene}-2.h5")));
 }
 
 #[test]

@@ -4,7 +4,7 @@
 //! with the reason.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_nodal};
+use contactlink::output::{layout, list_steps, read_nodal};
 use std::path::{Path, PathBuf};
 
 fn run_ok(ranks: usize, args: &[&str]) -> String {
@@ -20,13 +20,15 @@ fn cut_after(full: &Path, keep: usize, name: &str) -> PathBuf {
     let cut = full.with_file_name(name);
     std::fs::copy(full, &cut).expect("copy result file");
     let file = hdf5::File::open_rw(&cut).expect("open copy");
-    let steps = file.group("steps").expect("/steps");
+    let steps = file.group(layout::STEPS_NAME).expect("/steps");
     for step in list_steps(full)
         .expect("steps")
         .into_iter()
         .filter(|&s| s > keep)
     {
-        steps.unlink(&format!("{step:06}")).expect("unlink step");
+        steps
+            .unlink(&layout::step_group_name(step))
+            .expect("unlink step");
     }
     cut
 }
@@ -61,11 +63,11 @@ fn continued_run_matches(scene: &str, extra: &[&str], keep: usize, ranks: usize,
     let cont_steps = list_steps(&cont).unwrap();
     assert_eq!(cont_steps.first(), Some(&(keep + 1)), "{scene}");
     assert_eq!(cont_steps.last(), Some(&last), "{scene}");
-    for name in ["displacement", "reaction"] {
+    for name in [layout::DISPLACEMENT, layout::REACTION] {
         let d = relative_difference(&field(&full, last, name), &field(&cont, last, name));
         assert!(d < 1e-9, "{scene}: final {name} differs by {d:e}");
     }
-    let force = |p: &Path| field(p, last, &format!("contact/{pair}/force"));
+    let force = |p: &Path| field(p, last, &layout::pair_dataset(pair, layout::PAIR_FORCE));
     let d = relative_difference(&force(&full), &force(&cont));
     assert!(d < 1e-9, "{scene}: final contact force differs by {d:e}");
     eprintln!(

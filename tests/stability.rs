@@ -5,7 +5,7 @@
 //! within the Uzawa tolerance, with finite output.
 mod common;
 use common::*;
-use contactlink::output::{list_steps, read_nodal};
+use contactlink::output::{layout, list_steps, read_nodal};
 use std::path::Path;
 
 /// The patch test: E = 1000, a stack of height 1, the top pushed 0.01: the
@@ -45,7 +45,11 @@ fn patch(name: &str, extra: &[&str]) -> (f64, usize, usize) {
 /// Every nodal field of the last step is finite.
 fn assert_finite(out: &Path) {
     let last = *list_steps(out).unwrap().last().unwrap();
-    for field in ["displacement", "reaction", "contact_pressure"] {
+    for field in [
+        layout::DISPLACEMENT,
+        layout::REACTION,
+        layout::CONTACT_PRESSURE,
+    ] {
         let (v, _, _) = read_nodal(out, last, field).unwrap();
         assert!(
             v.iter().all(|x| x.is_finite()),

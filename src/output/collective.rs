@@ -31,7 +31,7 @@ use hdf5::dataset::FillTime;
 use hdf5::types::VarLenUnicode;
 use hdf5::{File, Group, H5Type, Location};
 use mpi::topology::SimpleCommunicator;
-use mpi::traits::{Communicator, CommunicatorCollectives};
+use mpi::traits::Communicator;
 use ndarray::{ArrayView1, ArrayView2};
 
 use super::{BlockRows, OutputError};
@@ -96,8 +96,7 @@ impl Coll<'_> {
         object: &str,
         fingerprint: u64,
     ) -> Result<(), OutputError> {
-        let mut all = vec![0_u64; self.size()];
-        self.comm.all_gather_into(&fingerprint, &mut all[..]);
+        let all = crate::parallel::gather_equal(self.comm, &[fingerprint]);
         let first = all.first().copied().unwrap_or(fingerprint);
         match all.iter().position(|&f| f != first) {
             None => Ok(()),
@@ -131,8 +130,7 @@ impl Coll<'_> {
             rows.cols as u64,
             u64::from(local.is_ok()),
         ];
-        let mut table = vec![0_u64; 5 * self.size()];
-        self.comm.all_gather_into(&mine[..], &mut table[..]);
+        let table = crate::parallel::gather_equal(self.comm, &mine);
         let local = self.agree_from_table(object, local, &table)?;
 
         let invalid = |reason: String| Err(OutputError::invalid(self.path, object, reason));

@@ -84,6 +84,17 @@ pub const SCENE_OVERRIDES_ATTR: &str = "scene_overrides";
 pub const CONTACT_PAIRS: &str = "/contact_pairs";
 /// `/hertz`: the closed-form setup `contactlink plot` draws.
 pub const HERTZ: &str = "/hertz";
+/// Attributes of `/hertz`: the contact kind (one of the two values below),
+/// the pair, the indenter radius, the effective modulus and, for a line
+/// contact, the thickness the load is spread over.
+pub const HERTZ_KIND_ATTR: &str = "kind";
+pub const HERTZ_PAIR_ATTR: &str = "pair";
+pub const HERTZ_RADIUS_ATTR: &str = "radius";
+pub const HERTZ_EFFECTIVE_MODULUS_ATTR: &str = "effective_modulus";
+pub const HERTZ_THICKNESS_ATTR: &str = "thickness";
+/// Values of [`HERTZ_KIND_ATTR`].
+pub const HERTZ_KIND_LINE: &str = "line";
+pub const HERTZ_KIND_POINT: &str = "point";
 
 /// The group name of step `index`: six digits, zero-padded, so the groups
 /// sort in step order under a plain name sort.

@@ -218,6 +218,12 @@ pub enum OutputError {
     },
 }
 
+impl From<OutputError> for crate::error::Error {
+    fn from(e: OutputError) -> Self {
+        crate::error::Error::Output(Box::new(e))
+    }
+}
+
 impl OutputError {
     pub(crate) fn invalid(path: &Path, object: &str, reason: impl Into<String>) -> Self {
         Self::Invalid {

@@ -340,17 +340,20 @@ pub fn create_result_file(
 /// (the load comes from each step's contact force).
 fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
     let (kind, thickness) = match h.kind {
-        HertzKind::Line { thickness } => ("line", Some(thickness)),
-        HertzKind::Point => ("point", None),
+        HertzKind::Line { thickness } => (layout::HERTZ_KIND_LINE, Some(thickness)),
+        HertzKind::Point => (layout::HERTZ_KIND_POINT, None),
     };
     let mut numbers = vec![
-        ("radius", h.radius),
-        ("effective_modulus", h.effective_modulus),
+        (layout::HERTZ_RADIUS_ATTR, h.radius),
+        (layout::HERTZ_EFFECTIVE_MODULUS_ATTR, h.effective_modulus),
     ];
-    numbers.extend(thickness.map(|t| ("thickness", t)));
+    numbers.extend(thickness.map(|t| (layout::HERTZ_THICKNESS_ATTR, t)));
     file.write_attributes(
         layout::HERTZ,
-        &[("kind", kind), ("pair", &h.pair)],
+        &[
+            (layout::HERTZ_KIND_ATTR, kind),
+            (layout::HERTZ_PAIR_ATTR, &h.pair),
+        ],
         &numbers,
     )?;
     Ok(())

@@ -3,6 +3,14 @@
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
+/// Concatenates every rank's slice, in rank order, on every rank, when all
+/// ranks pass slices of the same length (fingerprints, fixed-width tables).
+pub fn gather_equal(world: &impl Communicator, local: &[u64]) -> Vec<u64> {
+    let mut all = vec![0_u64; local.len() * world.size() as usize];
+    world.all_gather_into(local, &mut all[..]);
+    all
+}
+
 /// Concatenates every rank's slice, in rank order, on every rank.
 pub fn gather_all(world: &SimpleCommunicator, local: &[f64]) -> Vec<f64> {
     use mpi::datatype::PartitionMut;

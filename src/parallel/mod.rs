@@ -8,7 +8,7 @@
 //! result on every rank, carrying the lowest failing rank's message, and
 //! [`any_rank`], [`all_ranks`], [`sum`] and [`max`] are the reductions the
 //! run loop steers by; [`gather_all`] concatenates every rank's slice on
-//! every rank. [`fault`] makes one rank fail on purpose (tests only).
+//! every rank ([`gather_equal`] when all slices have one length). [`fault`] makes one rank fail on purpose (tests only).
 pub mod agree;
 pub mod fault;
 mod gather;
@@ -17,4 +17,4 @@ pub use agree::{
     agree, agree_failure, all_ranks, any_rank, broadcast_text, lowest_rank, max, sum, sum_usize,
     RankFailure,
 };
-pub use gather::gather_all;
+pub use gather::{gather_all, gather_equal};

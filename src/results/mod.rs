@@ -6,6 +6,7 @@ pub mod footprint;
 pub mod plot;
 pub mod summary;
 
+use crate::dofs::NaturalNode;
 use crate::output::{layout, list_steps, read_nodal, OutputError};
 use std::path::{Path, PathBuf};
 
@@ -136,7 +137,7 @@ pub fn nodal_pressure(path: &Path, step: usize) -> Result<Option<Vec<f64>>, Resu
 
 /// The nodes of a pair's slave surface (sorted, unique), from the
 /// `/contact_pairs` map to its facet set; None in files without the map.
-pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<usize>>, ResultsError> {
+pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<NaturalNode>>, ResultsError> {
     let Some(set) = crate::output::read_string_attr(path, layout::CONTACT_PAIRS, pair)? else {
         return Ok(None);
     };
@@ -144,7 +145,7 @@ pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<usize>>, Result
     let (ids, _) = crate::output::read_dataset::<i64>(path, &object)?;
     let mut nodes = ids
         .into_iter()
-        .map(usize::try_from)
+        .map(|id| usize::try_from(id).map(NaturalNode))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|_| ResultsError::file(path, format!("{object} holds a negative node id")))?;
     nodes.sort_unstable();

@@ -3,6 +3,7 @@
 //! from the file's `/hertz` group (written by `run` when the scene has a
 //! [hertz] check), the load from the step's total contact force.
 use super::{open_steps, slave_nodes, PairPoints, ResultsError};
+use crate::dofs::NaturalNode;
 use crate::output::{layout, read_dataset, read_f64_attr, read_nodal, read_string_attr};
 use crate::verify::{self, HertzCheck, HertzKind};
 use plotters::prelude::*;
@@ -77,12 +78,12 @@ pub fn read_hertz_setup(path: &Path) -> Result<HertzCheck, ResultsError> {
     };
     let text = |k: &str| read_string_attr(path, layout::HERTZ, k);
     let number = |k: &str| read_f64_attr(path, layout::HERTZ, k);
-    let kind = text("kind")?.ok_or_else(missing)?;
+    let kind = text(layout::HERTZ_KIND_ATTR)?.ok_or_else(missing)?;
     let kind = match kind.as_str() {
-        "line" => HertzKind::Line {
-            thickness: number("thickness")?.ok_or_else(missing)?,
+        layout::HERTZ_KIND_LINE => HertzKind::Line {
+            thickness: number(layout::HERTZ_THICKNESS_ATTR)?.ok_or_else(missing)?,
         },
-        "point" => HertzKind::Point,
+        layout::HERTZ_KIND_POINT => HertzKind::Point,
         other => {
             return Err(ResultsError::file(
                 path,
@@ -92,9 +93,9 @@ pub fn read_hertz_setup(path: &Path) -> Result<HertzCheck, ResultsError> {
     };
     Ok(HertzCheck {
         kind,
-        pair: text("pair")?.ok_or_else(missing)?,
-        radius: number("radius")?.ok_or_else(missing)?,
-        effective_modulus: number("effective_modulus")?.ok_or_else(missing)?,
+        pair: text(layout::HERTZ_PAIR_ATTR)?.ok_or_else(missing)?,
+        radius: number(layout::HERTZ_RADIUS_ATTR)?.ok_or_else(missing)?,
+        effective_modulus: number(layout::HERTZ_EFFECTIVE_MODULUS_ATTR)?.ok_or_else(missing)?,
     })
 }
 
@@ -120,13 +121,13 @@ impl NodalPressure {
         }
         // Without the pair → slave set map (older files) every loaded node
         // counts; a Hertz scene has one pair.
-        let ids: Vec<usize> = match slave_nodes(path, pair)? {
+        let ids: Vec<NaturalNode> = match slave_nodes(path, pair)? {
             Some(ids) => ids,
-            None => (0..rows).collect(),
+            None => (0..rows).map(NaturalNode).collect(),
         };
         let (points, pressure) = ids
             .into_iter()
-            .filter_map(|n| Some((nodes.get(3 * n..3 * n + 3)?, *pressure.get(n)?)))
+            .filter_map(|NaturalNode(n)| Some((nodes.get(3 * n..3 * n + 3)?, *pressure.get(n)?)))
             .filter(|(_, p)| *p > 0.0)
             .map(|(x, p)| ([x[0], x[1], x[2]], p))
             .unzip();

@@ -2,6 +2,7 @@
 //! and, per contact pair, the total force, the normal force Σ pN·w, the
 //! contact area Σ w (pN > 0), the peak pressure and the active points.
 use super::{nodal_pressure, open_steps, pair_names, slave_nodes, PairPoints, ResultsError};
+use crate::dofs::NaturalNode;
 use crate::output::{read_step_attrs, StepInfo};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -36,7 +37,7 @@ pub struct StepRow {
 pub fn summarize(path: &Path) -> Result<Vec<StepRow>, ResultsError> {
     let steps = open_steps(path)?;
     // Each pair's slave nodes, read once (the mesh does not change).
-    let mut slaves: BTreeMap<String, Option<Vec<usize>>> = BTreeMap::new();
+    let mut slaves: BTreeMap<String, Option<Vec<NaturalNode>>> = BTreeMap::new();
     let mut rows = Vec::with_capacity(steps.len());
     for step in steps {
         let info = read_step_attrs(path, step)?;
@@ -50,7 +51,7 @@ pub fn summarize(path: &Path) -> Result<Vec<StepRow>, ResultsError> {
             let max_nodal = match (nodes, &nodal) {
                 (Some(nodes), Some(p)) => nodes
                     .iter()
-                    .filter_map(|&n| p.get(n).copied())
+                    .filter_map(|&NaturalNode(n)| p.get(n).copied())
                     .fold(0.0, f64::max),
                 _ => f64::NAN,
             };

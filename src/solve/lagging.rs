@@ -9,8 +9,7 @@
 //! convergence in a few iterations. After an active-set change they do not
 //! (lagging across such changes cost hundreds of GMRES iterations on
 //! hertz-cylinder), so a change, agreed by all ranks, forces a rebuild.
-use mpi::collective::SystemOperation;
-use mpi::traits::*;
+use mpi::traits::Communicator;
 
 /// The active-set watch of one run.
 #[derive(Debug, Clone)]
@@ -60,10 +59,7 @@ impl PreconditionerLag {
     ) -> bool {
         let changed = self.built.as_deref() != Some(signatures);
         let worn = self.reused_last && last_linear_iterations > self.max_reused_iterations;
-        let mine = i32::from(changed || worn);
-        let mut any = 0;
-        world.all_reduce_into(&mine, &mut any, SystemOperation::max());
-        let rebuild = any == 1;
+        let rebuild = crate::parallel::any_rank(world, changed || worn);
         if rebuild {
             self.built = Some(signatures.to_vec());
             self.rebuilds += 1;
