@@ -108,7 +108,7 @@ impl<'m> Simulation<'m> {
             loads,
             dirichlet,
         };
-        let mut mech = mechanics(model, tangent, parts, contact)?;
+        let mut mech = mechanics(model, tangent, parts, contact, jac)?;
         let stepper = time_stepper(model, &mut mech)?;
         let (x, first_step, done) = initial_state(&world, mech.dofs, restart, mech.contact)?;
         let r = x.duplicate()?;
@@ -164,6 +164,7 @@ fn mechanics<'a>(
     tangent: TangentKind,
     parts: Parts<'a>,
     contact: &'a mut [ContactPair],
+    jac: &Matrix,
 ) -> Result<Mechanics<'a>> {
     let Parts {
         dofs,
@@ -171,6 +172,9 @@ fn mechanics<'a>(
         loads,
         dirichlet,
     } = parts;
+    // Nothing is ever added to K (no contact, inertia or follower load):
+    // the Jacobian is K itself, no second matrix.
+    let constant = contact.is_empty() && model.dynamics.is_none() && !loads.has_follower();
     let mut mech = Mechanics::new(
         dofs,
         bulk,
@@ -179,6 +183,7 @@ fn mechanics<'a>(
         contact,
         model.body_force.clone(),
         model.solver.reuse.linear_stiffness,
+        constant.then_some(jac),
     )?;
     // Only with linear bodies is the tangent fixed while the active set
     // is (a hyperelastic tangent changes every iteration anyway).
