@@ -99,14 +99,6 @@ pub(super) fn set_solver_defaults(
         petsc::options::set_default("-ksp_gmres_restart", "100")?;
     }
     petsc::options::set_default("-pc_type", "gamg")?;
-    // GAMG's Galerkin products P^T A P in one pass, without the A P
-    // intermediate and the gathered off-rank rows of P: the largest rank's
-    // peak of sphere-no-contact on 4 ranks 233 -> 184 MiB, same CG
-    // iterations (the default's buffers did not shrink with the ranks).
-    // A parallel-matrix algorithm: one rank's matrices do not know it.
-    if mpi::topology::SimpleCommunicator::world().size() > 1 {
-        petsc::options::set_default("-matptap_via", "allatonce")?;
-    }
     petsc::options::set_default("-ksp_rtol", "1e-10")?;
     if contact {
         // Eisenstat–Walker: each linear solve only as tight as Newton's
