@@ -22,6 +22,7 @@ use super::report::{
 use super::setup::{
     self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance, TangentKind,
 };
+use super::stiffness::KeepStiffness;
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
 use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
@@ -175,6 +176,11 @@ fn mechanics<'a>(
     // Nothing is ever added to K (no contact, inertia or follower load):
     // the Jacobian is K itself, no second matrix.
     let constant = contact.is_empty() && model.dynamics.is_none() && !loads.has_follower();
+    let keep = match (model.solver.reuse.linear_stiffness, constant) {
+        (false, _) => KeepStiffness::No,
+        (true, false) => KeepStiffness::Separate,
+        (true, true) => KeepStiffness::InJacobian(jac),
+    };
     let mut mech = Mechanics::new(
         dofs,
         bulk,
@@ -182,8 +188,7 @@ fn mechanics<'a>(
         dirichlet,
         contact,
         model.body_force.clone(),
-        model.solver.reuse.linear_stiffness,
-        constant.then_some(jac),
+        keep,
     )?;
     // Only with linear bodies is the tangent fixed while the active set
     // is (a hyperelastic tangent changes every iteration anyway).

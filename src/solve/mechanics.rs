@@ -5,7 +5,7 @@ use super::boundary::Dirichlet;
 use super::dynamics::Inertia;
 use super::lagging::PreconditionerLag;
 use super::phases::{Phase, PhaseTimes, Stages};
-use super::stiffness::{self, LiftWork, LinearStiffness};
+use super::stiffness::{self, KeepStiffness, LiftWork, LinearStiffness};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::DofMap;
@@ -59,8 +59,7 @@ impl<'a> Mechanics<'a> {
         dirichlet: &'a Dirichlet,
         contact: &'a mut [ContactPair],
         body_force: Vec<[f64; 3]>,
-        reuse_linear_stiffness: bool,
-        jacobian_is_stiffness: Option<&Matrix>,
+        keep: KeepStiffness<'_>,
     ) -> Result<Self> {
         let ghosts = dofs.ghost_dofs();
         let u = GhostedVector::new(dofs.num_owned_dofs(), &ghosts)?;
@@ -88,14 +87,18 @@ impl<'a> Mechanics<'a> {
             jacobian_evaluations: 0,
             bulk_tangent_assemblies: 0,
         };
-        if bulk.is_linear() && reuse_linear_stiffness {
-            me.linear_k = Some(match jacobian_is_stiffness {
-                Some(j) => LinearStiffness::Shared(stiffness::shared(j, me.u.global())?),
-                None => {
+        if bulk.is_linear() {
+            me.linear_k = match keep {
+                KeepStiffness::No => None,
+                KeepStiffness::InJacobian(j) => Some(LinearStiffness::Shared(stiffness::shared(
+                    j,
+                    me.u.global(),
+                )?)),
+                KeepStiffness::Separate => {
                     me.bulk_tangent_assemblies += 1;
-                    LinearStiffness::Separate(stiffness::separate(dofs, bulk)?)
+                    Some(LinearStiffness::Separate(stiffness::separate(dofs, bulk)?))
                 }
-            });
+            };
         }
         Ok(me)
     }

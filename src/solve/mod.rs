@@ -23,7 +23,7 @@ mod reactions;
 mod report;
 mod restart_state;
 mod setup;
-mod stiffness;
+pub mod stiffness;
 pub mod tolerance;
 mod uzawa;
 

@@ -14,6 +14,16 @@ use crate::dofs::{DofMap, DIM};
 use crate::error::Result;
 use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
 
+/// Whether and where a run keeps K (linear bodies only).
+pub enum KeepStiffness<'j> {
+    /// Assembled by elements every time.
+    No,
+    /// In a matrix of its own.
+    Separate,
+    /// In this Jacobian matrix, which nothing else is ever added to.
+    InJacobian(&'j Matrix),
+}
+
 pub(super) enum LinearStiffness {
     /// K in its own matrix, added to the Jacobian each time.
     Separate(Matrix),
