@@ -217,6 +217,17 @@ impl Matrix {
         }
     }
 
+    /// A second owning handle on the same matrix (PETSc counts references):
+    /// both see every change, and the storage goes with the last handle.
+    pub fn share(&self) -> Result<Matrix> {
+        // SAFETY: valid mat; the new handle's Drop releases this reference.
+        unsafe { petsc_call!(PetscObjectReference(self.raw as sys::PetscObject))? };
+        Ok(Matrix {
+            raw: self.raw,
+            owned: true,
+        })
+    }
+
     pub fn duplicate(&self) -> Result<Matrix> {
         let mut raw: sys::Mat = std::ptr::null_mut();
         // SAFETY: valid mat and out-pointer.

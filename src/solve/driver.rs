@@ -22,6 +22,7 @@ use super::report::{
 use super::setup::{
     self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance, TangentKind,
 };
+use super::stiffness::KeepStiffness;
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
 use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
@@ -108,7 +109,7 @@ impl<'m> Simulation<'m> {
             loads,
             dirichlet,
         };
-        let mut mech = mechanics(model, tangent, parts, contact)?;
+        let mut mech = mechanics(model, tangent, parts, contact, jac)?;
         let stepper = time_stepper(model, &mut mech)?;
         let (x, first_step, done) = initial_state(&world, mech.dofs, restart, mech.contact)?;
         let r = x.duplicate()?;
@@ -164,6 +165,7 @@ fn mechanics<'a>(
     tangent: TangentKind,
     parts: Parts<'a>,
     contact: &'a mut [ContactPair],
+    jac: &Matrix,
 ) -> Result<Mechanics<'a>> {
     let Parts {
         dofs,
@@ -171,6 +173,14 @@ fn mechanics<'a>(
         loads,
         dirichlet,
     } = parts;
+    // Nothing is ever added to K (no contact, inertia or follower load):
+    // the Jacobian is K itself, no second matrix.
+    let constant = contact.is_empty() && model.dynamics.is_none() && !loads.has_follower();
+    let keep = match (model.solver.reuse.linear_stiffness, constant) {
+        (false, _) => KeepStiffness::No,
+        (true, false) => KeepStiffness::Separate,
+        (true, true) => KeepStiffness::InJacobian(jac),
+    };
     let mut mech = Mechanics::new(
         dofs,
         bulk,
@@ -178,7 +188,7 @@ fn mechanics<'a>(
         dirichlet,
         contact,
         model.body_force.clone(),
-        model.solver.reuse.linear_stiffness,
+        keep,
     )?;
     // Only with linear bodies is the tangent fixed while the active set
     // is (a hyperelastic tangent changes every iteration anyway).

@@ -5,13 +5,14 @@ use super::boundary::Dirichlet;
 use super::dynamics::Inertia;
 use super::lagging::PreconditionerLag;
 use super::phases::{Phase, PhaseTimes, Stages};
+use super::stiffness::{self, KeepStiffness, LiftWork, LinearStiffness};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
-use crate::dofs::{DofMap, DIM};
+use crate::dofs::DofMap;
 use crate::error::{Error, Result};
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
-use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, PatternBuilder, Vector};
+use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Vector};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::Communicator;
 
@@ -42,7 +43,7 @@ pub struct Mechanics<'a> {
     u: GhostedVector,
     r: GhostedVector,
     /// Bulk stiffness when every body is linear: assembled once, reused.
-    linear_k: Option<Matrix>,
+    linear_k: Option<LinearStiffness>,
     work: Vector,
     /// Counters, for reports and for checking what is (not) recomputed.
     pub residual_evaluations: usize,
@@ -58,7 +59,7 @@ impl<'a> Mechanics<'a> {
         dirichlet: &'a Dirichlet,
         contact: &'a mut [ContactPair],
         body_force: Vec<[f64; 3]>,
-        reuse_linear_stiffness: bool,
+        keep: KeepStiffness<'_>,
     ) -> Result<Self> {
         let ghosts = dofs.ghost_dofs();
         let u = GhostedVector::new(dofs.num_owned_dofs(), &ghosts)?;
@@ -86,15 +87,18 @@ impl<'a> Mechanics<'a> {
             jacobian_evaluations: 0,
             bulk_tangent_assemblies: 0,
         };
-        if bulk.is_linear() && reuse_linear_stiffness {
-            let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
-            bulk.add_pattern(&mut pattern)?;
-            let mut k = pattern.build()?;
-            let zero = vec![0.0; DIM * dofs.num_local_nodes()];
-            bulk.add_tangent(&zero, &mut k)?;
-            k.assemble()?;
-            me.bulk_tangent_assemblies += 1;
-            me.linear_k = Some(k);
+        if bulk.is_linear() {
+            me.linear_k = match keep {
+                KeepStiffness::No => None,
+                KeepStiffness::InJacobian(j) => Some(LinearStiffness::Shared(stiffness::shared(
+                    j,
+                    me.u.global(),
+                )?)),
+                KeepStiffness::Separate => {
+                    me.bulk_tangent_assemblies += 1;
+                    Some(LinearStiffness::Separate(stiffness::separate(dofs, bulk)?))
+                }
+            };
         }
         Ok(me)
     }
@@ -128,9 +132,21 @@ impl<'a> Mechanics<'a> {
     /// takes part in the ghost accumulation and the products after it, and
     /// returns its local failure at the end (not agreed: callers agree it).
     pub fn raw_residual(&mut self, x: &Vector, out: &mut Vector) -> Result<()> {
+        self.bulk_residual(x, out, false)
+    }
+
+    /// [`Self::raw_residual`]; `free_rows_only`: its constrained entries
+    /// may be anything (the Dirichlet replacement follows), which lets a
+    /// Jacobian that is K give the bulk term.
+    fn bulk_residual(&mut self, x: &Vector, out: &mut Vector, free_rows_only: bool) -> Result<()> {
+        let lift_local = self.prepare_shared(x, free_rows_only)?;
         self.load_state(x)?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
-        let linear = self.linear_k.is_some();
+        let linear = match &self.linear_k {
+            Some(LinearStiffness::Separate(_)) => true,
+            Some(LinearStiffness::Shared(_)) => free_rows_only,
+            None => false,
+        };
         let body_force = &self.body_force;
         let fixed = self.fixed_external.as_deref();
         let contact = &mut *self.contact;
@@ -171,18 +187,52 @@ impl<'a> Mechanics<'a> {
         let r = &mut self.r;
         stages.time(Phase::HaloExchange, times, || r.accumulate_ghosts())?;
         out.copy_from(self.r.global())?;
-        let (linear_k, work, inertia) = (&self.linear_k, &mut self.work, &mut self.inertia);
+        let (linear_k, work, inertia) = (&mut self.linear_k, &mut self.work, &mut self.inertia);
         stages.time(Phase::BulkAssembly, times, || -> Result<()> {
-            if let Some(k) = linear_k {
-                k.mult(x, work)?;
-                out.axpy(1.0, work)?;
+            match linear_k {
+                Some(LinearStiffness::Separate(k)) => {
+                    k.mult(x, work)?;
+                    out.axpy(1.0, work)?;
+                }
+                Some(LinearStiffness::Shared(k)) if free_rows_only => {
+                    k.add_product(x, out, work)?;
+                }
+                _ => {}
             }
             if let Some(inertia) = inertia {
                 inertia.add_force(x, out)?;
             }
             Ok(())
         })?;
-        local
+        local.and(lift_local)
+    }
+
+    /// Collective, with a Jacobian that is K and `free_rows_only`: K in
+    /// place, and the lift formed again when some rank's constrained values
+    /// moved since (agreed: forming it is collective). It overwrites the
+    /// ghosted pair, so it comes before the state is loaded; its local
+    /// failure is returned inside.
+    fn prepare_shared(&mut self, x: &Vector, free_rows_only: bool) -> Result<Result<()>> {
+        let Some(LinearStiffness::Shared(k)) = &mut self.linear_k else {
+            return Ok(Ok(()));
+        };
+        if !free_rows_only {
+            return Ok(Ok(()));
+        }
+        if k.ensure(self.dofs, self.bulk, self.dirichlet)? {
+            self.bulk_tangent_assemblies += 1;
+        }
+        let stale = k.lift_stale(x, self.dirichlet)?;
+        if !parallel::any_rank(&self.world, stale) {
+            return Ok(Ok(()));
+        }
+        let work = LiftWork {
+            dirichlet: self.dirichlet,
+            bulk: self.bulk,
+            u: &mut self.u,
+            r: &mut self.r,
+        };
+        k.form_lift(x, work)
     }
 
     /// ‖R(x)‖ with the Dirichlet rows replaced, as SNES sees it: the first
@@ -204,7 +254,7 @@ impl<'a> Mechanics<'a> {
 
     fn residual_impl(&mut self, x: &Vector, r: &mut Vector) -> Result<()> {
         self.residual_evaluations += 1;
-        let local = self.raw_residual(x, r);
+        let local = self.bulk_residual(x, r, true);
         let factor = self.factor;
         let dirichlet = self.dirichlet;
         x.with_array(|xa| r.with_array_mut(|ra| dirichlet.constrain_residual(xa, ra, factor)))??;
@@ -216,6 +266,9 @@ impl<'a> Mechanics<'a> {
     /// final assembly run on every rank whatever this rank's part did).
     fn jacobian_impl(&mut self, x: &Vector, j: &mut Matrix) -> Result<()> {
         self.jacobian_evaluations += 1;
+        if let Some(LinearStiffness::Shared(_)) = self.linear_k {
+            return self.shared_jacobian(j);
+        }
         self.load_state(x)?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         let (stages, times) = (self.stages, &mut self.times);
@@ -227,7 +280,7 @@ impl<'a> Mechanics<'a> {
             if let Some(inertia) = inertia {
                 j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
             }
-            if let Some(k) = linear_k {
+            if let Some(LinearStiffness::Separate(k)) = linear_k {
                 j.add_scaled_subset(1.0, k)?;
             }
             // From here on only this rank's values: a failure is kept for the end.
@@ -273,6 +326,28 @@ impl<'a> Mechanics<'a> {
             j.zero_rows_columns_identity(&rows)?;
             Ok(())
         })?;
+        local
+    }
+
+    /// The Jacobian when it is K: already in place (and left untouched, so
+    /// the preconditioner sees an unchanged operator), unless an injected
+    /// fault spoiled it, which every rank then assembles again.
+    fn shared_jacobian(&mut self, j: &mut Matrix) -> Result<()> {
+        let Some(LinearStiffness::Shared(k)) = &mut self.linear_k else {
+            return Ok(());
+        };
+        let local = fault::check(FaultPhase::Jacobian);
+        if k.ensure(self.dofs, self.bulk, self.dirichlet)? {
+            self.bulk_tangent_assemblies += 1;
+        }
+        let poison = fault::fires(FaultPhase::LinearSolve);
+        if parallel::any_rank(&self.world, poison) {
+            if poison {
+                poison_diagonal(self.dofs, self.dirichlet, j)?;
+            }
+            j.assemble()?;
+            k.ready = false;
+        }
         local
     }
 

@@ -23,6 +23,7 @@ mod reactions;
 mod report;
 mod restart_state;
 mod setup;
+pub mod stiffness;
 pub mod tolerance;
 mod uzawa;
 
