@@ -691,6 +691,11 @@ fn absurd_counts_are_refused_with_the_limit() {
             "[solver] max_cutbacks = 1000 is above the limit of 30",
         ),
         (
+            GOOD.to_string() + "\n[solver]\nfirst_contact_softening = 0.5\n",
+            "first_contact_softening",
+            "[solver] first_contact_softening must be at least 1 (got 0.5)",
+        ),
+        (
             stacked(&format!("{CONTACT}max_uzawa = 5000000000")),
             "max_uzawa",
             "[[contact]] 'c' max_uzawa = 5000000000 is above the limit of 10000",

@@ -34,6 +34,10 @@ pub struct SolverSettings {
     /// fell by this factor (see `tolerance`); 0: every solve to the final
     /// tolerance.
     pub uzawa_forcing: f64,
+    /// A step that starts with no contact anywhere (every λN = 0) runs its
+    /// first Uzawa iteration with every frictionless pair's penalty divided
+    /// by this factor (1: off); see `solve::uzawa`.
+    pub first_contact_softening: f64,
 }
 
 /// Work a run reuses instead of redoing.
@@ -75,6 +79,7 @@ impl Default for SolverSettings {
             reuse: Reuse::default(),
             extrapolate: false,
             uzawa_forcing: DEFAULT_FORCING,
+            first_contact_softening: 1.0,
         }
     }
 }

@@ -153,6 +153,18 @@ impl Scene {
                     ))
                 }
             },
+            first_contact_softening: match s
+                .first_contact_softening
+                .unwrap_or(d.first_contact_softening)
+            {
+                f if f.is_finite() && f >= 1.0 => f,
+                f => {
+                    return Err(Bad::at(
+                        &key("first_contact_softening"),
+                        format!("[solver] first_contact_softening must be at least 1 (got {f})"),
+                    ))
+                }
+            },
         })
     }
 }

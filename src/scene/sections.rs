@@ -312,6 +312,9 @@ pub struct SolverSection {
     /// Relative residual reduction of Newton in non-final Uzawa iterations
     /// (0: every solve to the final tolerance).
     pub uzawa_forcing: Option<f64>,
+    /// Penalty divisor of the first Uzawa iteration of a step without
+    /// contact (default 1: off).
+    pub first_contact_softening: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Default)]

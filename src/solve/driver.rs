@@ -410,6 +410,7 @@ impl LoadSteps<'_> {
             times: &mut self.times,
             reuse_preconditioner: solver.reuse.preconditioner,
             forcing: solver.uzawa_forcing,
+            softening: solver.first_contact_softening,
         };
         self.stage_solve
             .scope(|| uzawa_loop(world, &mut ctx, mech, target))
