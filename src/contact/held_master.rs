@@ -75,9 +75,10 @@ pub struct HeldMaster {
 impl HeldMaster {
     /// This rank's own facets of `set`, and the set-wide sizes. Collective.
     pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, ranks: &dyn RankExchange) -> Result<Self> {
-        let refs = mesh.facet_sets.get(set).ok_or_else(|| {
-            Error::scene("contact", format!("facet set '{set}' does not exist"))
-        })?;
+        let refs = mesh
+            .facet_sets
+            .get(set)
+            .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
         let facet_type = mesh.cell_type.facet_type();
         let n = facet_type.nodes();
         let mut local_cell = vec![false; mesh.num_cells()];
@@ -118,7 +119,16 @@ impl HeldMaster {
             .iter()
             .map(|f| diameter(&f.x_ref[..n]))
             .fold(0.0, f64::max);
-        let mine = [own.len() as f64, size, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]];
+        let mine = [
+            own.len() as f64,
+            size,
+            lo[0],
+            lo[1],
+            lo[2],
+            hi[0],
+            hi[1],
+            hi[2],
+        ];
         let all = ranks.all_gather(&mine);
         let (mut whole, mut max_facet_size, mut boxed) = (0usize, 0.0f64, EMPTY_BOX);
         for r in all.chunks_exact(mine.len()) {
@@ -273,7 +283,10 @@ impl HeldMaster {
 
     /// The held facet with set index `set_index`, if held.
     pub fn held_facet(&self, set_index: u32) -> Option<u32> {
-        self.set_index.binary_search(&set_index).ok().map(|i| i as u32)
+        self.set_index
+            .binary_search(&set_index)
+            .ok()
+            .map(|i| i as u32)
     }
 
     /// Tail nodes (held nodes this rank does not see).

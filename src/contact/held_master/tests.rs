@@ -12,7 +12,10 @@ fn selection_keeps_the_boxes_that_meet_the_target() {
         unit_box([4.0, 0.0, 0.0]),
     ];
     // Touching counts, so a facet on the box's face is sent.
-    assert_eq!(select_in_box(&facets, unit_box([1.0, 0.5, 0.5])), vec![0, 1]);
+    assert_eq!(
+        select_in_box(&facets, unit_box([1.0, 0.5, 0.5])),
+        vec![0, 1]
+    );
     assert_eq!(
         select_in_box(&facets, ([3.5, -1.0, -1.0], [10.0, 0.0, 0.0])),
         vec![2]

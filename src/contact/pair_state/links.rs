@@ -2,9 +2,9 @@
 //! step, and the following of sliding during its Newton iterations.
 use super::assemble::LinkBuffers;
 use super::{ContactPair, MasterSide};
+use crate::assembly::RankExchange;
 use crate::contact::kernel::{self, LinkState};
 use crate::contact::projection::{self, Projection};
-use crate::assembly::RankExchange;
 use crate::contact::search::{self, SearchIndex};
 use crate::dofs::DofMap;
 use std::collections::hash_map::DefaultHasher;

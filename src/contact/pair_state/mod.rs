@@ -24,9 +24,9 @@ pub use output::PointValues;
 pub use snapshot::{FrictionRows, PairSnapshot, RestartRows};
 
 use super::dual::{norm, sub};
+use super::held_master::HeldMaster;
 use super::mortar::pair::MortarPair;
 use super::multipliers::Multipliers;
-use super::held_master::HeldMaster;
 use super::surfaces::SlaveSurface;
 use crate::assembly::{HaloFactory, RankExchange};
 use crate::dofs::DofMap;

@@ -5,10 +5,10 @@
 use super::links::Link;
 use super::{ContactPair, MasterSide};
 use crate::contact::dual::dot;
+use crate::contact::held_master::HeldMaster;
 use crate::contact::kernel::{LinkState, SlipHistory};
 use crate::contact::multipliers::{PointFriction, PointState};
 use crate::contact::projection;
-use crate::contact::held_master::HeldMaster;
 
 impl ContactPair {
     /// The point's slip origin and λT in the terms of the link's current
@@ -81,7 +81,9 @@ impl ContactPair {
                 continue;
             }
             p.origin = Some(match &self.master {
-                MasterSide::Deformable(m) => ([l.xi[0], l.xi[1], 0.0], m.set_index[l.facet as usize]),
+                MasterSide::Deformable(m) => {
+                    ([l.xi[0], l.xi[1], 0.0], m.set_index[l.facet as usize])
+                }
                 MasterSide::Rigid(spec) => {
                     let foot = spec
                         .moved(self.spec.motion, factor)
