@@ -368,16 +368,14 @@ pub fn decode(values: &[f64]) -> Vec<MasterFacet> {
                 dofs: [GlobalDof(0); 4 * DIM],
                 x_ref: [[0.0; 3]; 4],
             };
-            for a in 0..4 {
-                f.natural[a] = r[1 + a] as u64;
+            for (v, x) in f.natural.iter_mut().zip(&r[1..5]) {
+                *v = *x as u64;
             }
-            for i in 0..4 * DIM {
-                f.dofs[i] = GlobalDof(r[5 + i] as _);
+            for (d, x) in f.dofs.iter_mut().zip(&r[5..5 + 4 * DIM]) {
+                *d = GlobalDof(*x as _);
             }
-            for a in 0..4 {
-                for c in 0..3 {
-                    f.x_ref[a][c] = r[5 + 4 * DIM + 3 * a + c];
-                }
+            for (p, x) in f.x_ref.iter_mut().flatten().zip(&r[5 + 4 * DIM..]) {
+                *p = *x;
             }
             f
         })

@@ -64,11 +64,6 @@ impl MasterTail {
         out.assemble()?;
         Ok(())
     }
-
-    /// Entries in the tail on this rank.
-    pub fn len(&self) -> usize {
-        self.dofs.len()
-    }
 }
 
 /// The local form followed by the tail: the array contact reads.

@@ -150,11 +150,6 @@ impl<'a> Mechanics<'a> {
         Ok(())
     }
 
-    /// Entries of the master tail on this rank.
-    pub fn master_tail_len(&self) -> usize {
-        self.tail.len()
-    }
-
     /// Runs `f` on the ghosted local form of `x` (owned + ghost displacements)
     /// and the contact pairs: searches, Uzawa updates and output use it.
     pub fn with_state<T>(

@@ -37,7 +37,7 @@ use crate::model::{Formulation, MasterSpec, PairSpec, RigidSurface};
 /// The master side at run time.
 pub enum MasterSide {
     /// The master facets this rank holds (see `contact::held_master`).
-    Deformable(HeldMaster),
+    Deformable(Box<HeldMaster>),
     Rigid(RigidSurface),
 }
 
@@ -100,7 +100,7 @@ impl ContactPair {
             // A mortar pair searches its own replicated surfaces; it holds
             // no exchanged facets, only the set-wide sizes from here.
             MasterSpec::Surface { set } => {
-                MasterSide::Deformable(HeldMaster::new(mesh, dofs, set, ranks)?)
+                MasterSide::Deformable(Box::new(HeldMaster::new(mesh, dofs, set, ranks)?))
             }
             MasterSpec::Rigid(r) => MasterSide::Rigid(*r),
         };
