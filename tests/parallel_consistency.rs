@@ -14,12 +14,16 @@ fn run_on(ranks: usize, scene: &str, out: &std::path::Path) {
 }
 
 fn compare_ranks(scene: &str) {
+    compare_ranks_on(scene, &[1, 2, 3], 1e-8);
+}
+
+fn compare_ranks_on(scene: &str, ranks: &[usize], tol: f64) {
     let dir = scratch(&format!("parallel-{scene}"));
-    let files: Vec<_> = [1, 2, 3]
+    let files: Vec<_> = ranks
         .iter()
         .map(|n| dir.join(format!("{scene}-{n}.h5")))
         .collect();
-    for (n, f) in [1, 2, 3].iter().zip(&files) {
+    for (n, f) in ranks.iter().zip(&files) {
         run_on(*n, scene, f);
     }
     let steps = list_steps(&files[0]).unwrap();
@@ -39,16 +43,26 @@ fn compare_ranks(scene: &str) {
         u1.iter().any(|v| v.abs() > 0.0),
         "the 1-rank displacement is zero"
     );
-    for (n, f) in [2, 3].iter().zip(&files[1..]) {
+    for (n, f) in ranks[1..].iter().zip(&files[1..]) {
         let (u, r, _) = read_nodal(f, last, layout::DISPLACEMENT).unwrap();
         assert_eq!(r, rows);
         let d = relative_difference(&u1, &u);
         println!("{scene}: {n} ranks vs 1: max relative displacement difference {d:.3e}");
-        assert!(d < 1e-8, "{scene}: {n} ranks differ from 1 rank by {d:.3e}");
+        assert!(d < tol, "{scene}: {n} ranks differ from 1 rank by {d:.3e}");
         let (reaction1, _, _) = read_nodal(&files[0], last, layout::REACTION).unwrap();
         let (reaction, _, _) = read_nodal(f, last, layout::REACTION).unwrap();
         let dr = relative_difference(&reaction1, &reaction);
         assert!(dr < 1e-6, "{scene}: {n}-rank reactions differ by {dr:.3e}");
+        if let (Ok((p1, _, _)), Ok((p, _, _))) = (
+            read_nodal(&files[0], last, layout::CONTACT_PRESSURE),
+            read_nodal(f, last, layout::CONTACT_PRESSURE),
+        ) {
+            let dp = relative_difference(&p1, &p);
+            assert!(
+                dp < tol,
+                "{scene}: {n}-rank contact pressure differs by {dp:.3e}"
+            );
+        }
     }
     // Mesh arrays are in input order whatever the rank count: identical.
     let (nodes1, shape) = read_dataset::<f64>(&files[0], layout::MESH_NODES).unwrap();
@@ -85,4 +99,71 @@ fn block_compress_same_on_1_2_3_ranks() {
 #[test]
 fn cantilever_tets_same_on_1_2_3_ranks() {
     compare_ranks("cantilever");
+}
+
+/// Deformable masters held in pieces (each rank only the master facets near
+/// its slave points): the same answer on 1 to 4 ranks.
+#[test]
+fn stacked_patch_test_same_on_1_to_4_ranks() {
+    compare_ranks_on("patch-test", &[1, 2, 3, 4], 1e-10);
+}
+
+#[test]
+fn hertz_cylinder_same_on_1_to_4_ranks() {
+    compare_ranks_on("hertz-cylinder", &[1, 2, 3, 4], 1e-10);
+}
+
+/// On 4 ranks the contact zone of the stacked blocks spans ranks: the ranks
+/// hold a piece of the master, received facets included, never the whole.
+#[test]
+fn master_is_held_in_pieces_on_4_ranks() {
+    let dir = scratch("parallel-held-master");
+    // Wide, thin stacked blocks and a search distance of a few master facets, so
+    // no rank's slave points reach the whole master.
+    let root = env!("CARGO_MANIFEST_DIR");
+    let scene = std::fs::read_to_string(format!("{root}/scenes/patch-test.toml"))
+        .unwrap()
+        .replace(
+            "lower_divisions = [4, 4, 2]",
+            "lower_divisions = [32, 8, 1]",
+        )
+        .replace(
+            "upper_divisions = [3, 3, 2]",
+            "upper_divisions = [24, 6, 1]",
+        )
+        .replace(
+            "master = \"lower.top\"",
+            "master = \"lower.top\"\nsearch_distance = 0.05",
+        );
+    assert!(scene.contains("search_distance = 0.05"));
+    let path = dir.join("held-master.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.join("held-master-4.h5");
+    let o = mpirun(
+        4,
+        &[
+            "run",
+            path.to_str().unwrap(),
+            "-v",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let line = text(&o)
+        .lines()
+        .find(|l| l.contains("master facets held per rank"))
+        .map(str::to_owned)
+        .expect("the -v output names the held master facets");
+    // "... held per rank MIN..MAX of WHOLE (received at most R)"
+    let numbers: Vec<usize> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|w| !w.is_empty())
+        .map(|w| w.parse().unwrap())
+        .collect();
+    let [.., max, whole, received] = numbers[..] else {
+        panic!("unexpected line: {line}");
+    };
+    assert!(max > 0 && max < whole, "{line}");
+    assert!(received > 0, "no rank received master facets: {line}");
 }

@@ -21,3 +21,35 @@ pub trait HaloFactory {
     /// rank copies. Collective.
     fn halo(&self, n_owned: usize, ghosts: &[usize]) -> Result<Box<dyn Halo>>;
 }
+
+/// The messages between ranks that contact's master side needs: `contact`
+/// decides what to send, `solve` moves it (over MPI), so contact never names
+/// the transport.
+pub trait RankExchange {
+    fn rank(&self) -> usize;
+    fn size(&self) -> usize;
+    /// Every rank's `local`, concatenated in rank order, on every rank.
+    /// Collective.
+    fn all_gather(&self, local: &[f64]) -> Vec<f64>;
+    /// Sends `send[r]` to rank `r` and returns what every rank sent to this
+    /// one, concatenated in rank order. Collective.
+    fn all_to_all(&self, send: &[Vec<f64>]) -> Vec<f64>;
+}
+
+/// One rank alone: what a serial caller (or a test) hands contact.
+pub struct SingleRank;
+
+impl RankExchange for SingleRank {
+    fn rank(&self) -> usize {
+        0
+    }
+    fn size(&self) -> usize {
+        1
+    }
+    fn all_gather(&self, local: &[f64]) -> Vec<f64> {
+        local.to_vec()
+    }
+    fn all_to_all(&self, send: &[Vec<f64>]) -> Vec<f64> {
+        send.concat()
+    }
+}

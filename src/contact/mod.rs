@@ -1,6 +1,8 @@
 //! Contact: the ContactLink3D condition (docs/formulation.md §2–§5, §9).
 //!
 //! - `surfaces`: the slave and master sides as one rank sees them;
+//! - `held_master`: the master facets of a links pair one rank holds, and
+//!   the bounding-box exchange that decides them at every search;
 //! - `search`: spatial index, outer and inner search;
 //! - `projection`: closest-point projection onto a master facet;
 //! - `kernel`: the kernel of one link: gap, normal, contact pressure
@@ -17,6 +19,7 @@
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
 pub mod dual;
+pub mod held_master;
 pub mod kernel;
 pub mod mortar;
 pub mod multipliers;

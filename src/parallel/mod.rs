@@ -8,8 +8,10 @@
 //! result on every rank, carrying the lowest failing rank's message, and
 //! [`any_rank`], [`all_ranks`], [`sum`] and [`max`] are the reductions the
 //! run loop steers by; [`gather_all`] concatenates every rank's slice on
-//! every rank ([`gather_equal`] when all slices have one length). [`fault`] makes one rank fail on purpose (tests only).
+//! every rank ([`gather_equal`] when all slices have one length), and
+//! [`all_to_all`] sends each rank its own array. [`fault`] makes one rank fail on purpose (tests only).
 pub mod agree;
+mod exchange;
 pub mod fault;
 mod gather;
 
@@ -17,4 +19,5 @@ pub use agree::{
     agree, agree_failure, all_ranks, any_rank, broadcast_text, lowest_rank, max, sum, sum_usize,
     RankFailure,
 };
+pub use exchange::all_to_all;
 pub use gather::{gather_all, gather_equal};

@@ -340,7 +340,12 @@ impl LoadSteps<'_> {
         if !self.mech.contact.is_empty() {
             let mark = PhaseMark::new(&self.mech.times, self.mech.contact);
             let (mech, x) = (&mut self.mech, &self.x);
+            let offset = self.stepper.as_ref().map(|s| s.slip_offset());
             let searched = self.stages.scope(Phase::ContactSearch, || {
+                mech.exchange_masters(x)?;
+                if let Some(offset) = offset {
+                    mech.extend_slip_rates(offset)?;
+                }
                 mech.with_state(x, |u, pairs| {
                     let changed = pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c);
                     fault::check(FaultPhase::Search)?;

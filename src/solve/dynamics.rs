@@ -153,6 +153,11 @@ impl TimeStepper {
         })
     }
 
+    /// The offset of the last [`Self::slip_rate`] in the DOF layout.
+    pub fn slip_offset(&self) -> &Vector {
+        self.ghosted.global()
+    }
+
     /// The step converged at `x`: velocity and acceleration from the
     /// Newmark update, then `x` becomes the last converged displacement.
     pub fn advance(&mut self, x: &Vector, c: &Coefficients) -> Result<()> {

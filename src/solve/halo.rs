@@ -47,3 +47,21 @@ impl Halo for GhostedHalo {
         &self.local
     }
 }
+
+/// Contact's master exchange over the world communicator.
+pub struct MpiRanks(pub mpi::topology::SimpleCommunicator);
+
+impl crate::assembly::RankExchange for MpiRanks {
+    fn rank(&self) -> usize {
+        mpi::traits::Communicator::rank(&self.0) as usize
+    }
+    fn size(&self) -> usize {
+        mpi::traits::Communicator::size(&self.0) as usize
+    }
+    fn all_gather(&self, local: &[f64]) -> Vec<f64> {
+        crate::parallel::gather_all(&self.0, local)
+    }
+    fn all_to_all(&self, send: &[Vec<f64>]) -> Vec<f64> {
+        crate::parallel::all_to_all(&self.0, send)
+    }
+}

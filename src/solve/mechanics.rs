@@ -4,11 +4,12 @@
 use super::boundary::Dirichlet;
 use super::dynamics::Inertia;
 use super::lagging::PreconditionerLag;
+use super::master_tail::{extended, MasterTail};
 use super::phases::{Phase, PhaseTimes, Stages};
 use super::stiffness::{self, KeepStiffness, LiftWork, LinearStiffness};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
-use crate::dofs::DofMap;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
@@ -45,6 +46,10 @@ pub struct Mechanics<'a> {
     /// Bulk stiffness when every body is linear: assembled once, reused.
     linear_k: Option<LinearStiffness>,
     work: Vector,
+    /// Held master nodes this rank does not see, and their displacements at
+    /// the last loaded state.
+    tail: MasterTail,
+    u_tail: Vec<f64>,
     /// Counters, for reports and for checking what is (not) recomputed.
     pub residual_evaluations: usize,
     pub jacobian_evaluations: usize,
@@ -83,6 +88,8 @@ impl<'a> Mechanics<'a> {
             r,
             linear_k: None,
             work,
+            tail: MasterTail::new(dofs.num_owned_dofs()),
+            u_tail: Vec::new(),
             residual_evaluations: 0,
             jacobian_evaluations: 0,
             bulk_tangent_assemblies: 0,
@@ -109,6 +116,41 @@ impl<'a> Mechanics<'a> {
             u.global_mut().copy_from(x)?;
             u.update_ghosts()
         })?;
+        let tail = &mut self.tail;
+        self.u_tail = self
+            .stages
+            .time(Phase::HaloExchange, &mut self.times, || tail.values(x))?;
+        Ok(())
+    }
+
+    /// The box exchange of every links pair's master at `x`, then the tail
+    /// scatter for the facets now held. Collective.
+    pub fn exchange_masters(&mut self, x: &Vector) -> Result<()> {
+        let dofs = self.dofs;
+        let ranks = super::halo::MpiRanks(SimpleCommunicator::world());
+        self.with_state(x, |u, pairs| {
+            let u = &u[..DIM * dofs.num_local_nodes()];
+            let mut base = 0;
+            for p in pairs.iter_mut() {
+                base += p.exchange_master(u, dofs, base, &ranks);
+            }
+            Ok(())
+        })?;
+        self.tail.refresh(&self.world, self.contact)?;
+        self.load_state(x)
+    }
+
+    /// Dynamics: extends each frictional pair's velocity map over the tail,
+    /// from `offset` (the map's offset in the DOF layout). Collective.
+    pub fn extend_slip_rates(&mut self, offset: &Vector) -> Result<()> {
+        let tail = self.tail.values(offset)?;
+        let n = DIM * self.dofs.num_local_nodes();
+        for pair in self.contact.iter_mut() {
+            if let Some(rate) = &mut pair.rate {
+                rate.offset.truncate(n);
+                rate.offset.extend_from_slice(&tail);
+            }
+        }
         Ok(())
     }
 
@@ -121,7 +163,8 @@ impl<'a> Mechanics<'a> {
     ) -> Result<T> {
         self.load_state(x)?;
         let contact = &mut *self.contact;
-        self.u.with_local(|u| f(u, contact))?
+        let tail = &self.u_tail;
+        self.u.with_local(|u| f(&extended(u, tail), contact))?
     }
 
     /// f_int − f_ext + r_contact at `x`, without the Dirichlet replacement
@@ -151,6 +194,8 @@ impl<'a> Mechanics<'a> {
         let fixed = self.fixed_external.as_deref();
         let contact = &mut *self.contact;
         let u = &self.u;
+        let u_tail = &self.u_tail;
+        let mut r_tail = vec![0.0; u_tail.len()];
         let (stages, times) = (self.stages, &mut self.times);
         let local = self.r.with_local_mut(|r_local| -> Result<()> {
             r_local.fill(0.0);
@@ -171,9 +216,22 @@ impl<'a> Mechanics<'a> {
                 })?;
                 stages.time(Phase::ContactAssembly, times, || -> Result<()> {
                     fault::check(FaultPhase::ContactAssembly)?;
-                    for pair in contact.iter_mut() {
-                        pair.add_residual(dofs, u_local, factor, r_local)?;
+                    if u_tail.is_empty() {
+                        for pair in contact.iter_mut() {
+                            pair.add_residual(dofs, u_local, factor, r_local)?;
+                        }
+                        return Ok(());
                     }
+                    // Held master nodes this rank does not see: their
+                    // entries go to their owners after the ghost sum.
+                    let u_ext = extended(u_local, u_tail);
+                    let mut r_ext = extended(r_local, &r_tail);
+                    for pair in contact.iter_mut() {
+                        pair.add_residual(dofs, &u_ext, factor, &mut r_ext)?;
+                    }
+                    let n = r_local.len();
+                    r_local.copy_from_slice(&r_ext[..n]);
+                    r_tail.copy_from_slice(&r_ext[n..]);
                     Ok(())
                 })
             })?
@@ -187,6 +245,8 @@ impl<'a> Mechanics<'a> {
         let r = &mut self.r;
         stages.time(Phase::HaloExchange, times, || r.accumulate_ghosts())?;
         out.copy_from(self.r.global())?;
+        let tail = &self.tail;
+        stages.time(Phase::HaloExchange, times, || tail.add_into(&r_tail, out))?;
         let (linear_k, work, inertia) = (&mut self.linear_k, &mut self.work, &mut self.inertia);
         stages.time(Phase::BulkAssembly, times, || -> Result<()> {
             match linear_k {
@@ -273,6 +333,7 @@ impl<'a> Mechanics<'a> {
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         let (stages, times) = (self.stages, &mut self.times);
         let (u, inertia, linear_k) = (&self.u, &self.inertia, &self.linear_k);
+        let u_tail = &self.u_tail;
         let bulk_part = stages.time(Phase::BulkAssembly, times, || -> Result<Result<bool>> {
             j.zero_entries()?;
             // Whole-matrix additions (MatAXPY, collective) need the assembled
@@ -306,8 +367,9 @@ impl<'a> Mechanics<'a> {
                 stages.time(Phase::ContactAssembly, times, || {
                     u.with_local(|u_local| -> Result<()> {
                         fault::check(FaultPhase::ContactAssembly)?;
+                        let u_ext = extended(u_local, u_tail);
                         for pair in contact.iter_mut() {
-                            pair.add_tangent(dofs, u_local, factor, j)?;
+                            pair.add_tangent(dofs, &u_ext, factor, j)?;
                         }
                         Ok(())
                     })?

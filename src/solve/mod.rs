@@ -14,6 +14,7 @@ pub mod dynamics;
 mod failure;
 pub mod halo;
 pub mod lagging;
+mod master_tail;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;

@@ -25,6 +25,9 @@ pub struct ContactReport {
     /// Active points that slide (friction).
     pub sliding_points: usize,
     pub penalty: f64,
+    /// Links pair with a deformable master: facets held per rank (min, max
+    /// over ranks), facets received per rank (max) and the whole master.
+    pub master_held: Option<[usize; 4]>,
 }
 
 /// What one converged load increment did.
@@ -105,7 +108,19 @@ pub(super) fn contact_reports(
         .map(|(i, (p, f))| {
             let total = PairForce::from_array(parallel::sum(world, f.to_array()));
             let s = stats.get(i).copied().unwrap_or_default();
+            let master_held = p.held_master_facets().map(|(held, whole)| {
+                let received = p.received_master_facets().unwrap_or(0) as f64;
+                let [neg_min, max, max_received] =
+                    parallel::max(world, [-(held as f64), held as f64, received]);
+                [
+                    -neg_min as usize,
+                    max as usize,
+                    max_received as usize,
+                    whole,
+                ]
+            });
             ContactReport {
+                master_held,
                 name: p.spec.name.clone(),
                 force: total.force,
                 normal_force: total.normal,
@@ -162,5 +177,11 @@ pub(super) fn print_step(s: &StepReport) {
             "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], normal {:.6e}, tangential {:.6e}, {} active points ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
             c.name, c.force[0], c.force[1], c.force[2], c.normal_force, c.tangential_force, c.active_points, c.sliding_points, c.max_penetration, c.penalty
         );
+        if let Some([min, max, received, whole]) = c.master_held {
+            println!(
+                "     contact {}: master facets held per rank {min}..{max} of {whole} (received at most {received})",
+                c.name
+            );
+        }
     }
 }

@@ -120,18 +120,21 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     let partition = broadcast_partition(&world, mesh, rank, size)?;
     crate::footprint::checkpoint("partition");
     let mut master_nodes = Vec::new();
+    // Mortar pairs see both their surfaces whole on every rank; a links
+    // pair's master is exchanged at each search (`contact::held_master`).
     for pair in &model.contact {
+        if pair.formulation != crate::model::Formulation::Mortar {
+            continue;
+        }
         if let MasterSpec::Surface { set } = &pair.master {
             master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh, set,
             )?);
         }
-        if pair.formulation == crate::model::Formulation::Mortar {
-            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-                mesh,
-                &pair.slave,
-            )?);
-        }
+        master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
+            mesh,
+            &pair.slave,
+        )?);
     }
     let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
     crate::footprint::checkpoint("DOF map");
@@ -170,6 +173,7 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
                     p,
                     softest,
                     &super::halo::PetscHalos,
+                    &super::halo::MpiRanks(rt.world()),
                 )
             })
             .collect::<Result<Vec<_>>>(),

@@ -44,8 +44,7 @@ impl ContactPair {
                 master_nodes.sort_unstable();
                 master_nodes.dedup();
                 for &n in &master_nodes {
-                    let l = crate::dofs::LocalNode(m.node_local[n as usize] as usize);
-                    d.extend((0..DIM).map(|c| dofs.dof(l, c)));
+                    d.extend_from_slice(&m.node_dofs[n as usize]);
                 }
             }
             pattern.add_square(&d)?;
@@ -61,7 +60,7 @@ impl ContactPair {
         factor: f64,
         with_tangent: bool,
         mut sink: impl FnMut(&[u32], &[GlobalDof], &[f64], Option<&[f64]>, &LinkState) -> Result<()>,
-        dofs: &DofMap,
+        _dofs: &DofMap,
     ) -> Result<()> {
         self.follow(u_local);
         let mut buf = LinkBuffers::default();
@@ -79,7 +78,7 @@ impl ContactPair {
             if let MasterSide::Deformable(m) = &self.master {
                 let fnodes = m.facet_nodes(link.facet);
                 nodes.extend(fnodes.iter().map(|&n| m.node_local[n as usize]));
-                m.facet_dofs(link.facet, dofs, &mut link_dofs);
+                m.facet_dofs(link.facet, &mut link_dofs);
             }
             let input = self.link_input(link, u_local, factor, &mut buf);
             let n = link_dofs.len();

@@ -2,9 +2,11 @@
 //! step, and the following of sliding during its Newton iterations.
 use super::assemble::LinkBuffers;
 use super::{ContactPair, MasterSide};
+use crate::assembly::RankExchange;
 use crate::contact::kernel::{self, LinkState};
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
+use crate::dofs::DofMap;
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 
@@ -22,6 +24,77 @@ pub struct Link {
 }
 
 impl ContactPair {
+    /// Before the step's search: the box exchange that decides which master
+    /// facets this rank holds (`contact::held_master`), at the same state the
+    /// search then runs at. Done at every search, because the search's links
+    /// and patches are fixed for the step and must see every facet they may
+    /// touch; its cost is one gather of six numbers per rank and the facets
+    /// near each rank's slave points. `tail_base` is the first tail slot the
+    /// pair may use; returns how many it uses. Collective (every rank calls
+    /// it for every pair).
+    pub fn exchange_master(
+        &mut self,
+        u_local: &[f64],
+        dofs: &DofMap,
+        tail_base: usize,
+        ranks: &dyn RankExchange,
+    ) -> usize {
+        if self.mortar.is_some() {
+            return 0;
+        }
+        let MasterSide::Deformable(m) = &mut self.master else {
+            return 0;
+        };
+        let points: Vec<[f64; 3]> = (0..self.slave.num_qps())
+            .map(|q| self.slave.qp_position(q, u_local))
+            .collect();
+        // Last step's partners, by set index, across the renumbering.
+        let previous: Vec<u32> = self
+            .links
+            .iter()
+            .map(|l| m.set_index[l.facet as usize])
+            .collect();
+        let margin = self.search_distance + m.max_facet_size;
+        m.exchange(&points, margin, u_local, dofs, tail_base, ranks);
+        let mut kept = Vec::with_capacity(self.links.len());
+        for (mut l, f) in std::mem::take(&mut self.links).into_iter().zip(previous) {
+            if let Some(facet) = m.held_facet(f) {
+                l.facet = facet;
+                l.patch.clear();
+                kept.push(l);
+            }
+        }
+        self.links = kept;
+        self.positions.clear();
+        m.tail_nodes()
+    }
+
+    /// Global DOFs of the held master nodes this rank does not see (the
+    /// tail of the extended local array), node-major.
+    pub fn master_tail(&self) -> &[crate::dofs::GlobalDof] {
+        match (&self.master, &self.mortar) {
+            (MasterSide::Deformable(m), None) => &m.tail_dofs,
+            _ => &[],
+        }
+    }
+
+    /// Master facets this rank holds now, and in the whole master (None:
+    /// rigid or mortar master).
+    pub fn held_master_facets(&self) -> Option<(usize, usize)> {
+        match (&self.master, &self.mortar) {
+            (MasterSide::Deformable(m), None) => Some((m.set_index.len(), m.whole)),
+            _ => None,
+        }
+    }
+
+    /// Facets received at the last exchange (None: rigid or mortar master).
+    pub fn received_master_facets(&self) -> Option<usize> {
+        match (&self.master, &self.mortar) {
+            (MasterSide::Deformable(m), None) => Some(m.received),
+            _ => None,
+        }
+    }
+
     /// The search that starts every load step: outer search (closest master
     /// node through the spatial index) and inner search (projection onto the
     /// facets around it) for every slave point. Returns true when the coupling
@@ -104,9 +177,17 @@ impl ContactPair {
 
     fn coupling_key(&self) -> u64 {
         let mut h = DefaultHasher::new();
+        // Patches by set index: the held numbering changes between steps.
+        let global = |f: &u32| match &self.master {
+            MasterSide::Deformable(m) => m.set_index[*f as usize],
+            MasterSide::Rigid(_) => *f,
+        };
         for l in &self.links {
             (l.qp / self.slave.nqp as u32).hash(&mut h);
-            l.patch.hash(&mut h);
+            l.patch.len().hash(&mut h);
+            for f in &l.patch {
+                global(f).hash(&mut h);
+            }
         }
         self.links.len().hash(&mut h);
         h.finish()

@@ -24,11 +24,11 @@ pub use output::PointValues;
 pub use snapshot::{FrictionRows, PairSnapshot, RestartRows};
 
 use super::dual::{norm, sub};
+use super::held_master::HeldMaster;
 use super::mortar::pair::MortarPair;
 use super::multipliers::Multipliers;
-use super::search;
-use super::surfaces::{SharedSurface, SlaveSurface};
-use crate::assembly::HaloFactory;
+use super::surfaces::SlaveSurface;
+use crate::assembly::{HaloFactory, RankExchange};
 use crate::dofs::DofMap;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -36,7 +36,8 @@ use crate::model::{Formulation, MasterSpec, PairSpec, RigidSurface};
 
 /// The master side at run time.
 pub enum MasterSide {
-    Deformable(SharedSurface),
+    /// The master facets this rank holds (see `contact::held_master`).
+    Deformable(Box<HeldMaster>),
     Rigid(RigidSurface),
 }
 
@@ -91,12 +92,15 @@ impl ContactPair {
         spec: &PairSpec,
         softest_youngs: f64,
         halos: &dyn HaloFactory,
+        ranks: &dyn RankExchange,
     ) -> Result<Self> {
         let rule = spec.quadrature.rule(mesh.cell_type.facet_type());
         let slave = SlaveSurface::new(mesh, dofs, &spec.slave, &rule)?;
         let master = match &spec.master {
+            // A mortar pair searches its own replicated surfaces; it holds
+            // no exchanged facets, only the set-wide sizes from here.
             MasterSpec::Surface { set } => {
-                MasterSide::Deformable(SharedSurface::new(mesh, dofs, set)?)
+                MasterSide::Deformable(Box::new(HeldMaster::new(mesh, dofs, set, ranks)?))
             }
             MasterSpec::Rigid(r) => MasterSide::Rigid(*r),
         };
@@ -211,9 +215,7 @@ impl ContactPair {
 /// load step are linked (an open link costs only its evaluation).
 fn default_search_distance(mesh: &Mesh, master: &MasterSide, h: f64) -> f64 {
     let diag = match master {
-        MasterSide::Deformable(m) => {
-            search::points_bounding_box(&m.x_ref).map_or(0.0, |(lo, hi)| norm(&sub(&hi, &lo)))
-        }
+        MasterSide::Deformable(m) => m.reference_box.map_or(0.0, |(lo, hi)| norm(&sub(&hi, &lo))),
         MasterSide::Rigid(_) => mesh.bounding_box().map_or(0.0, |b| b.diagonal()),
     };
     (10.0 * h).max(0.1 * diag)

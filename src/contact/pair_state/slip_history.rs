@@ -5,10 +5,10 @@
 use super::links::Link;
 use super::{ContactPair, MasterSide};
 use crate::contact::dual::dot;
+use crate::contact::held_master::HeldMaster;
 use crate::contact::kernel::{LinkState, SlipHistory};
 use crate::contact::multipliers::{PointFriction, PointState};
 use crate::contact::projection;
-use crate::contact::surfaces::SharedSurface;
 
 impl ContactPair {
     /// The point's slip origin and λT in the terms of the link's current
@@ -24,22 +24,29 @@ impl ContactPair {
     ) -> SlipHistory {
         match &self.master {
             MasterSide::Deformable(m) => {
+                // The history names facets by set index (it outlives the
+                // step's held numbering). A facet no longer held (the point
+                // slid beyond the search margin within one step) starts
+                // from the link's own point and keeps λT's components.
+                let here = m.set_index[link.facet as usize];
                 let xi_n = match p.origin {
-                    Some((o, f)) if f == link.facet => [o[0], o[1]],
-                    Some((o, f)) => rebase_origin(m, f, [o[0], o[1]], link.facet, link.xi),
+                    Some((o, f)) if f == here => [o[0], o[1]],
+                    Some((o, f)) => match m.held_facet(f) {
+                        Some(from) => rebase_origin(m, from, [o[0], o[1]], link.facet, link.xi),
+                        None => link.xi,
+                    },
                     None => link.xi,
                 };
-                let lambda = if p.lambda_facet == link.facet || p.lambda == [0.0; 3] {
-                    [p.lambda[0], p.lambda[1]]
-                } else {
-                    rebase_lambda(
+                let lambda = match m.held_facet(p.lambda_facet) {
+                    Some(from) if p.lambda_facet != here && p.lambda != [0.0; 3] => rebase_lambda(
                         m,
                         &self.positions,
-                        p.lambda_facet,
+                        from,
                         [p.lambda[0], p.lambda[1]],
                         link.facet,
                         link.xi,
-                    )
+                    ),
+                    _ => [p.lambda[0], p.lambda[1]],
                 };
                 SlipHistory::Convected { xi_n, lambda }
             }
@@ -74,7 +81,9 @@ impl ContactPair {
                 continue;
             }
             p.origin = Some(match &self.master {
-                MasterSide::Deformable(_) => ([l.xi[0], l.xi[1], 0.0], l.facet),
+                MasterSide::Deformable(m) => {
+                    ([l.xi[0], l.xi[1], 0.0], m.set_index[l.facet as usize])
+                }
                 MasterSide::Rigid(spec) => {
                     let foot = spec
                         .moved(self.spec.motion, factor)
@@ -86,7 +95,7 @@ impl ContactPair {
                 }
             });
             if p.lambda == [0.0; 3] {
-                p.lambda_facet = l.facet;
+                p.lambda_facet = global_facet(&self.master, l.facet);
             }
         }
     }
@@ -121,8 +130,9 @@ impl ContactPair {
             match f.updated {
                 SlipHistory::Convected { xi_n, lambda } => {
                     p.lambda = [lambda[0], lambda[1], 0.0];
-                    p.lambda_facet = l.facet;
-                    p.next_origin = Some(([xi_n[0], xi_n[1], 0.0], l.facet));
+                    let facet = global_facet(&self.master, l.facet);
+                    p.lambda_facet = facet;
+                    p.next_origin = Some(([xi_n[0], xi_n[1], 0.0], facet));
                 }
                 SlipHistory::Spatial { point_n, lambda } => {
                     p.lambda = lambda;
@@ -142,8 +152,16 @@ impl ContactPair {
     }
 }
 
+/// The set index of held facet `facet` (0 for a rigid master).
+fn global_facet(master: &MasterSide, facet: u32) -> u32 {
+    match master {
+        MasterSide::Deformable(m) => m.set_index[facet as usize],
+        MasterSide::Rigid(_) => 0,
+    }
+}
+
 /// Tangents `∂x/∂ξ_α` of a facet with nodes `x` at `xi`.
-fn facet_tangents(m: &SharedSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
+fn facet_tangents(m: &HeldMaster, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
     let s = crate::fem::shape::facet_shape(m.facet_type, xi);
     let mut t = [[0.0; 3]; 2];
     for (xb, dn) in x.iter().zip(&s.dn) {
@@ -155,7 +173,7 @@ fn facet_tangents(m: &SharedSurface, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3];
     t
 }
 
-fn facet_points(m: &SharedSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
+fn facet_points(m: &HeldMaster, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
     m.facet_nodes(facet)
         .iter()
         .map(|&n| positions[n as usize])
@@ -165,7 +183,7 @@ fn facet_points(m: &SharedSurface, facet: u32, positions: &[[f64; 3]]) -> Vec<[f
 /// ξ̄ₙ stored on facet `from`, expressed on facet `to`: the same point of the
 /// reference surface (history data is material, so the conversion is
 /// independent of the current displacements).
-fn rebase_origin(m: &SharedSurface, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
+fn rebase_origin(m: &HeldMaster, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
     let from_x = facet_points(m, from, &m.x_ref);
     let s = crate::fem::shape::facet_shape(m.facet_type, xi);
     let mut p = [0.0; 3];
@@ -181,7 +199,7 @@ fn rebase_origin(m: &SharedSurface, from: u32, xi: [f64; 2], to: u32, guess: [f6
 /// λT's covariant components on facet `from` carried to facet `to` as the
 /// same vector (tangents of `from` at its centre, of `to` at `xi`).
 fn rebase_lambda(
-    m: &SharedSurface,
+    m: &HeldMaster,
     positions: &[[f64; 3]],
     from: u32,
     lambda: [f64; 2],
@@ -214,11 +232,10 @@ mod tests {
     /// Two unit quads side by side in z = 0 (x ∈ [0, 1] and [1, 2]), the
     /// second one's nodes listed from a different corner so its ξ axes are
     /// turned against the first's.
-    fn two_quads() -> SharedSurface {
-        SharedSurface {
-            facet_type: FacetType::Quad4,
-            node_local: (0..6).collect(),
-            x_ref: vec![
+    fn two_quads() -> HeldMaster {
+        HeldMaster::from_parts(
+            FacetType::Quad4,
+            vec![
                 [0.0, 0.0, 0.0],
                 [1.0, 0.0, 0.0],
                 [2.0, 0.0, 0.0],
@@ -226,11 +243,11 @@ mod tests {
                 [1.0, 1.0, 0.0],
                 [2.0, 1.0, 0.0],
             ],
-            facets: vec![[0, 1, 4, 3], [5, 4, 1, 2]],
-        }
+            vec![[0, 1, 4, 3], [5, 4, 1, 2]],
+        )
     }
 
-    fn point_on(m: &SharedSurface, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
+    fn point_on(m: &HeldMaster, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
         let s = crate::fem::shape::facet_shape(m.facet_type, xi);
         let mut p = [0.0; 3];
         for (&n, nb) in m.facet_nodes(facet).iter().zip(s.n) {

@@ -1,0 +1,386 @@
+//! The master facets of a links pair that one rank holds (a deformable
+//! master, docs/formulation.md §11 "Parallel model").
+//!
+//! Each rank owns the master facets of its own cells. At every contact
+//! search the ranks exchange bounding boxes: each rank's box holds its slave
+//! points (current positions) inflated by the pair's search distance plus the
+//! largest master facet, and every rank sends each other rank the own facets
+//! whose current box meets that rank's box. A rank then holds its own facets
+//! inside its box and the ones it received, and searches only those. The
+//! margin covers the search distance (every facet a point can link to) plus
+//! one facet (the patch of facets around the linked one, which the link may
+//! slide onto during the step), so the search finds what it would find on
+//! the whole master, on any number of ranks.
+//!
+//! Held nodes are numbered after this rank's local nodes where the rank does
+//! not see them itself: the displacement array contact reads is the local
+//! form followed by a tail over those nodes (which `solve` fills by a
+//! scatter from the global vector), and residual entries of tail nodes go
+//! back to their owners by the same scatter in reverse.
+use crate::assembly::RankExchange;
+use crate::contact::search;
+use crate::dofs::{DofMap, GlobalDof, NaturalNode, DIM};
+use crate::error::{Error, Result};
+use crate::fem::FacetType;
+use crate::mesh::Mesh;
+
+/// One master facet as this rank knows it, and as it travels between ranks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MasterFacet {
+    /// Position in the master facet set (identical on every rank).
+    pub set_index: u32,
+    pub natural: [u64; 4],
+    pub dofs: [GlobalDof; 4 * DIM],
+    pub x_ref: [[f64; 3]; 4],
+}
+
+/// f64 values per facet in a message: set index, natural ids, DOFs and
+/// reference coordinates of four nodes (integers below 2⁵³ are exact).
+pub const RECORD: usize = 1 + 4 + 4 * DIM + 4 * DIM;
+
+type Aabb = ([f64; 3], [f64; 3]);
+
+/// A box that meets nothing (a rank without slave points).
+pub const EMPTY_BOX: Aabb = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+
+#[derive(Debug, Clone)]
+pub struct HeldMaster {
+    pub facet_type: FacetType,
+    /// Facets of this rank's cells, by set index, and each one's local nodes.
+    own: Vec<MasterFacet>,
+    own_local: Vec<[u32; 4]>,
+    /// Facets of the whole set (all ranks).
+    pub whole: usize,
+    /// The largest facet diameter over the whole set.
+    pub max_facet_size: f64,
+    /// Reference bounding box of the whole set (None: empty set).
+    pub reference_box: Option<Aabb>,
+    /// The held facets (own inside this rank's box, and received), ordered
+    /// by set index so ids and ties go as on the whole set.
+    pub set_index: Vec<u32>,
+    /// Held facets as indices into the held node arrays (tri3 uses 3).
+    pub facets: Vec<[u32; 4]>,
+    /// Held nodes, ordered by natural id.
+    natural: Vec<u64>,
+    /// Index of each held node in the extended local array.
+    pub node_local: Vec<u32>,
+    pub node_dofs: Vec<[GlobalDof; DIM]>,
+    pub x_ref: Vec<[f64; 3]>,
+    /// Global DOFs of the tail (held nodes this rank does not see), node-major.
+    pub tail_dofs: Vec<GlobalDof>,
+    /// Facets received at the last exchange.
+    pub received: usize,
+}
+
+impl HeldMaster {
+    /// This rank's own facets of `set`, and the set-wide sizes. Collective.
+    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, ranks: &dyn RankExchange) -> Result<Self> {
+        let refs = mesh
+            .facet_sets
+            .get(set)
+            .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
+        let facet_type = mesh.cell_type.facet_type();
+        let n = facet_type.nodes();
+        let mut local_cell = vec![false; mesh.num_cells()];
+        for &c in &dofs.local_cells {
+            local_cell[c] = true;
+        }
+        let (mut own, mut own_local) = (Vec::new(), Vec::new());
+        for (i, f) in refs.iter().enumerate() {
+            if !local_cell[f.cell] {
+                continue;
+            }
+            let mut facet = MasterFacet {
+                set_index: i as u32,
+                natural: [0; 4],
+                dofs: [GlobalDof(0); 4 * DIM],
+                x_ref: [[0.0; 3]; 4],
+            };
+            let mut local = [0u32; 4];
+            for (a, v) in mesh.facet_nodes(f)?.into_iter().enumerate().take(n) {
+                let l = dofs.local(NaturalNode(v)).ok_or_else(|| {
+                    Error::Partition(format!("master node {v} not visible on rank {}", dofs.rank))
+                })?;
+                local[a] = l.0 as u32;
+                facet.natural[a] = v as u64;
+                facet.x_ref[a] = mesh.nodes[v];
+                for c in 0..DIM {
+                    facet.dofs[DIM * a + c] = dofs.dof(l, c);
+                }
+            }
+            own.push(facet);
+            own_local.push(local);
+        }
+        let (lo, hi) = own
+            .iter()
+            .flat_map(|f| f.x_ref[..n].iter())
+            .fold(EMPTY_BOX, |b, x| grow(b, *x));
+        let size = own
+            .iter()
+            .map(|f| diameter(&f.x_ref[..n]))
+            .fold(0.0, f64::max);
+        let mine = [
+            own.len() as f64,
+            size,
+            lo[0],
+            lo[1],
+            lo[2],
+            hi[0],
+            hi[1],
+            hi[2],
+        ];
+        let all = ranks.all_gather(&mine);
+        let (mut whole, mut max_facet_size, mut boxed) = (0usize, 0.0f64, EMPTY_BOX);
+        for r in all.chunks_exact(mine.len()) {
+            whole += r[0] as usize;
+            max_facet_size = max_facet_size.max(r[1]);
+            boxed = grow(grow(boxed, [r[2], r[3], r[4]]), [r[5], r[6], r[7]]);
+        }
+        Ok(HeldMaster {
+            facet_type,
+            own,
+            own_local,
+            whole,
+            max_facet_size,
+            reference_box: (whole > 0).then_some(boxed),
+            set_index: Vec::new(),
+            facets: Vec::new(),
+            natural: Vec::new(),
+            node_local: Vec::new(),
+            node_dofs: Vec::new(),
+            x_ref: Vec::new(),
+            tail_dofs: Vec::new(),
+            received: 0,
+        })
+    }
+
+    /// A held surface given whole (tests): nodes local 0..n, no tail.
+    #[cfg(test)]
+    pub fn from_parts(facet_type: FacetType, x_ref: Vec<[f64; 3]>, facets: Vec<[u32; 4]>) -> Self {
+        let n = x_ref.len();
+        HeldMaster {
+            facet_type,
+            own: Vec::new(),
+            own_local: Vec::new(),
+            whole: facets.len(),
+            max_facet_size: 0.0,
+            reference_box: None,
+            set_index: (0..facets.len() as u32).collect(),
+            facets,
+            natural: (0..n as u64).collect(),
+            node_local: (0..n as u32).collect(),
+            node_dofs: vec![[GlobalDof(0); DIM]; n],
+            x_ref,
+            tail_dofs: Vec::new(),
+            received: 0,
+        }
+    }
+
+    /// Facets of this rank's cells.
+    pub fn own_facets(&self) -> usize {
+        self.own.len()
+    }
+
+    /// The box exchange (see the module doc). `points` are this rank's slave
+    /// points, `u_local` the local displacements, `tail_base` the first tail
+    /// slot this pair may use after the `n_local` local nodes. Collective.
+    pub fn exchange(
+        &mut self,
+        points: &[[f64; 3]],
+        margin: f64,
+        u_local: &[f64],
+        dofs: &DofMap,
+        tail_base: usize,
+        ranks: &dyn RankExchange,
+    ) {
+        let n = self.facet_type.nodes();
+        let mine = match search::points_bounding_box(points) {
+            Some((lo, hi)) => (lo.map(|v| v - margin), hi.map(|v| v + margin)),
+            None => EMPTY_BOX,
+        };
+        let flat = [mine.0, mine.1].concat();
+        let boxes: Vec<Aabb> = ranks
+            .all_gather(&flat)
+            .chunks_exact(6)
+            .map(|b| ([b[0], b[1], b[2]], [b[3], b[4], b[5]]))
+            .collect();
+        let current: Vec<Aabb> = self
+            .own
+            .iter()
+            .zip(&self.own_local)
+            .map(|(f, l)| current_box(&f.x_ref[..n], &l[..n], u_local))
+            .collect();
+        let me = ranks.rank();
+        let send: Vec<Vec<f64>> = boxes
+            .iter()
+            .enumerate()
+            .map(|(r, b)| {
+                if r == me {
+                    return Vec::new();
+                }
+                let mut out = Vec::new();
+                for i in select_in_box(&current, *b) {
+                    encode(&self.own[i], &mut out);
+                }
+                out
+            })
+            .collect();
+        let received = decode(&ranks.all_to_all(&send));
+        self.received = received.len();
+        let mut held: Vec<MasterFacet> = select_in_box(&current, mine)
+            .into_iter()
+            .map(|i| self.own[i].clone())
+            .chain(received)
+            .collect();
+        held.sort_by_key(|f| f.set_index);
+        held.dedup_by_key(|f| f.set_index);
+        self.hold(&held, dofs, tail_base);
+    }
+
+    /// Numbers the held facets' nodes and finds the tail.
+    fn hold(&mut self, held: &[MasterFacet], dofs: &DofMap, tail_base: usize) {
+        let n = self.facet_type.nodes();
+        let mut nodes: Vec<(u64, [GlobalDof; DIM], [f64; 3])> = held
+            .iter()
+            .flat_map(|f| {
+                (0..n).map(move |a| {
+                    let d = [0, 1, 2].map(|c| f.dofs[DIM * a + c]);
+                    (f.natural[a], d, f.x_ref[a])
+                })
+            })
+            .collect();
+        nodes.sort_by_key(|v| v.0);
+        nodes.dedup_by_key(|v| v.0);
+        self.natural = nodes.iter().map(|v| v.0).collect();
+        self.x_ref = nodes.iter().map(|v| v.2).collect();
+        self.node_dofs = nodes.iter().map(|v| v.1).collect();
+        self.tail_dofs.clear();
+        let n_local = dofs.num_local_nodes();
+        self.node_local = nodes
+            .iter()
+            .map(|v| match dofs.local(NaturalNode(v.0 as usize)) {
+                Some(l) => l.0 as u32,
+                None => {
+                    let slot = n_local + tail_base + self.tail_dofs.len() / DIM;
+                    self.tail_dofs.extend(v.1);
+                    slot as u32
+                }
+            })
+            .collect();
+        self.set_index = held.iter().map(|f| f.set_index).collect();
+        self.facets = held
+            .iter()
+            .map(|f| {
+                let mut ids = [0u32; 4];
+                for (slot, v) in ids.iter_mut().zip(&f.natural[..n]) {
+                    // Every node of a held facet is held.
+                    *slot = self.natural.binary_search(v).unwrap_or(0) as u32;
+                }
+                ids
+            })
+            .collect();
+    }
+
+    /// The held facet with set index `set_index`, if held.
+    pub fn held_facet(&self, set_index: u32) -> Option<u32> {
+        self.set_index
+            .binary_search(&set_index)
+            .ok()
+            .map(|i| i as u32)
+    }
+
+    /// Tail nodes (held nodes this rank does not see).
+    pub fn tail_nodes(&self) -> usize {
+        self.tail_dofs.len() / DIM
+    }
+
+    /// Current positions of the held nodes from the extended local array.
+    pub fn positions(&self, u_ext: &[f64]) -> Vec<[f64; 3]> {
+        self.x_ref
+            .iter()
+            .zip(&self.node_local)
+            .map(|(xr, &l)| {
+                let b = DIM * l as usize;
+                [xr[0] + u_ext[b], xr[1] + u_ext[b + 1], xr[2] + u_ext[b + 2]]
+            })
+            .collect()
+    }
+
+    pub fn facet_nodes(&self, facet: u32) -> &[u32] {
+        &self.facets[facet as usize][..self.facet_type.nodes()]
+    }
+
+    pub fn facet_dofs(&self, facet: u32, out: &mut Vec<GlobalDof>) {
+        for &m in self.facet_nodes(facet) {
+            out.extend_from_slice(&self.node_dofs[m as usize]);
+        }
+    }
+}
+
+/// Indices of the facets whose box meets `target`.
+pub fn select_in_box(boxes: &[Aabb], target: Aabb) -> Vec<usize> {
+    boxes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| (0..3).all(|c| b.0[c] <= target.1[c] && target.0[c] <= b.1[c]))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+fn current_box(x_ref: &[[f64; 3]], local: &[u32], u_local: &[f64]) -> Aabb {
+    x_ref.iter().zip(local).fold(EMPTY_BOX, |b, (x, &l)| {
+        let d = DIM * l as usize;
+        grow(b, [0, 1, 2].map(|c| x[c] + u_local[d + c]))
+    })
+}
+
+fn grow(b: Aabb, x: [f64; 3]) -> Aabb {
+    (
+        [0, 1, 2].map(|c| b.0[c].min(x[c])),
+        [0, 1, 2].map(|c| b.1[c].max(x[c])),
+    )
+}
+
+fn diameter(x: &[[f64; 3]]) -> f64 {
+    let mut d: f64 = 0.0;
+    for a in x {
+        for b in x {
+            d = d.max(crate::vec3::distance2(*a, *b).sqrt());
+        }
+    }
+    d
+}
+
+pub fn encode(f: &MasterFacet, out: &mut Vec<f64>) {
+    out.push(f.set_index as f64);
+    out.extend(f.natural.iter().map(|&v| v as f64));
+    out.extend(f.dofs.iter().map(|v| v.0 as f64));
+    out.extend(f.x_ref.iter().flatten());
+}
+
+pub fn decode(values: &[f64]) -> Vec<MasterFacet> {
+    values
+        .chunks_exact(RECORD)
+        .map(|r| {
+            let mut f = MasterFacet {
+                set_index: r[0] as u32,
+                natural: [0; 4],
+                dofs: [GlobalDof(0); 4 * DIM],
+                x_ref: [[0.0; 3]; 4],
+            };
+            for (v, x) in f.natural.iter_mut().zip(&r[1..5]) {
+                *v = *x as u64;
+            }
+            for (d, x) in f.dofs.iter_mut().zip(&r[5..5 + 4 * DIM]) {
+                *d = GlobalDof(*x as _);
+            }
+            for (p, x) in f.x_ref.iter_mut().flatten().zip(&r[5 + 4 * DIM..]) {
+                *p = *x;
+            }
+            f
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests;
