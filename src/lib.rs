@@ -5,7 +5,8 @@
 //! The modules follow the data flow of a run:
 //!
 //! ```text
-//! scene (TOML) ──► mesh (generators, sets) ──► partition (METIS) ──► dofs (owned/ghost, PETSc numbering)
+//! scene (TOML) ──► mesh (generators, sets) ──► distribution (METIS on rank 0, one piece per rank)
+//!      ──► dofs (owned/ghost, PETSc numbering)
 //!      ──► fem (element kernels) ──► assembly (into PETSc Mat/Vec) ──► solve (load steps → SNES Newton)
 //!      ──► output (parallel HDF5 + XDMF)
 //! ```
@@ -19,6 +20,7 @@ pub mod amplitude;
 pub mod assembly;
 pub mod check;
 pub mod contact;
+pub mod distribution;
 pub mod dofs;
 pub mod error;
 pub mod fem;

@@ -42,13 +42,9 @@ impl SurfaceLoads {
         loads: &[(&[FacetRef], FacetLoad, Amplitude)],
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
-        let mut local_cell = vec![false; mesh.num_cells()];
-        for &c in &dofs.local_cells {
-            local_cell[c] = true;
-        }
         let mut facets = Vec::new();
         for (set, load, amplitude) in loads {
-            for f in set.iter().filter(|f| local_cell[f.cell]) {
+            for f in set.iter().filter(|f| dofs.is_local_cell(f.cell)) {
                 let natural = mesh.facet_nodes(f)?;
                 let nodes: Vec<u32> = natural
                     .iter()

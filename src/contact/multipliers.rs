@@ -176,7 +176,7 @@ impl Multipliers {
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
-        partition: &[i32],
+        facet_owner: &[i32],
         slave: &SlaveSurface,
         rule: &QuadRule,
         friction: bool,
@@ -188,7 +188,14 @@ impl Multipliers {
             .get(set)
             .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
         let nqp = slave.nqp;
-        let owner: Vec<usize> = facets.iter().map(|f| partition[f.cell] as usize).collect();
+        if facet_owner.len() != facets.len() {
+            return Err(Error::Internal(format!(
+                "slave set '{set}' has {} facets but {} facet owners",
+                facets.len(),
+                facet_owner.len()
+            )));
+        }
+        let owner: Vec<usize> = facet_owner.iter().map(|&o| o as usize).collect();
         let global_facet = contiguous_numbering(&owner, dofs.nranks);
         let rank = dofs.rank;
         let owned_node = |nat: usize| dofs.local(NaturalNode(nat)).filter(|&l| dofs.is_owned(l));

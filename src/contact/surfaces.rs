@@ -48,10 +48,6 @@ impl SlaveSurface {
     pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, rule: &QuadRule) -> Result<Self> {
         let facet_refs = facet_set(mesh, set)?;
         let facet_type = mesh.cell_type.facet_type();
-        let mut local_cell = vec![false; mesh.num_cells()];
-        for &c in &dofs.local_cells {
-            local_cell[c] = true;
-        }
         let mut edge_sum = 0.0;
         let mut facets = Vec::new();
         let (mut qp_zeta, mut qp_weight) = (Vec::new(), Vec::new());
@@ -69,7 +65,7 @@ impl SlaveSurface {
                 ));
             }
             edge_sum += shortest_edge(&x_ref);
-            if !local_cell[f.cell] {
+            if !dofs.is_local_cell(f.cell) {
                 continue;
             }
             for (zeta, w) in &weights {

@@ -271,7 +271,7 @@ pub fn create_result_file(
         .clone()
         .flat_map(|c| mesh.cell(c).iter().map(|&v| v as i64))
         .collect();
-    let partition: Vec<i32> = sim.partition()[cell_block.clone()].to_vec();
+    let partition: Vec<i32> = sim.partition_block().to_vec();
     let cell_body: Vec<i32> = mesh.cell_body[cell_block.clone()]
         .iter()
         .map(|&b| b as i32)

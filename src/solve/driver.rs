@@ -42,7 +42,8 @@ use std::time::Instant;
 /// pairs, Jacobian storage. Built collectively by every rank.
 pub struct Simulation<'m> {
     pub(super) model: &'m Model,
-    pub(super) partition: Vec<i32>,
+    /// Owning rank of each cell of this rank's output cell block.
+    pub(super) partition_block: Vec<i32>,
     pub(super) dofs: DofMap,
     pub(super) bulk: BulkAssembler,
     pub(super) loads: SurfaceLoads,
@@ -52,7 +53,7 @@ pub struct Simulation<'m> {
 }
 
 impl<'m> Simulation<'m> {
-    /// Partitions (METIS on rank 0, broadcast), numbers the DOFs, precomputes
+    /// Partitions (METIS on rank 0, each rank sent its piece), numbers the DOFs, precomputes
     /// element data, resolves contact pairs and allocates the Jacobian.
     /// Collective; fails on every rank if it fails on one.
     pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
@@ -60,9 +61,10 @@ impl<'m> Simulation<'m> {
         stage.scope(|| setup::setup(rt, model))
     }
 
-    /// Owning rank of every cell (global, natural order).
-    pub fn partition(&self) -> &[i32] {
-        &self.partition
+    /// Owning rank of each cell of this rank's output cell block
+    /// (`even_block(num_cells, rank, nranks)`), natural order.
+    pub fn partition_block(&self) -> &[i32] {
+        &self.partition_block
     }
 
     pub fn dofs(&self) -> &DofMap {

@@ -1,6 +1,6 @@
 //! Moving fields from PETSc's (rank-contiguous) order to the input (natural)
 //! order the output file uses, so files from any rank count compare row by row.
-use crate::dofs::{even_block, DofMap, NaturalNode, DIM};
+use crate::dofs::{even_block, DofMap, DIM};
 use crate::error::Result;
 use crate::petsc::{PetscInt, Scatter, Vector};
 
@@ -14,9 +14,18 @@ pub struct NaturalOrder {
     block: std::ops::Range<usize>,
 }
 
+/// The PETSc node of a natural node of this rank's output block, the only
+/// rows [`NaturalOrder::new`] asks for.
+fn block_row(dofs: &DofMap) -> impl Fn(usize) -> usize + '_ {
+    let start = dofs.output_node_block().start;
+    let block = dofs.output_block_petsc();
+    move |n| block[n - start] as usize
+}
+
 impl NaturalOrder {
     /// `owned_rows`: rows this rank owns in PETSc order; `petsc_row(i)`: the
-    /// PETSc row of natural row i (any i in 0..global_rows). Collective.
+    /// PETSc row of natural row i, asked only for the rows of this rank's
+    /// block `even_block(global_rows, rank, nranks)`. Collective.
     pub fn new(
         global_rows: usize,
         cols: usize,
@@ -52,7 +61,7 @@ impl NaturalOrder {
             dofs.num_global_nodes(),
             DIM,
             dofs.num_owned_nodes(),
-            |n| dofs.petsc_node(NaturalNode(n)),
+            block_row(dofs),
             dofs.rank,
             dofs.nranks,
         )
@@ -64,7 +73,7 @@ impl NaturalOrder {
             dofs.num_global_nodes(),
             1,
             dofs.num_owned_nodes(),
-            |n| dofs.petsc_node(NaturalNode(n)),
+            block_row(dofs),
             dofs.rank,
             dofs.nranks,
         )

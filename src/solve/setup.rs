@@ -1,5 +1,6 @@
 //! Setting a model up for the solver, collectively on every rank: the
-//! partition (METIS on rank 0, broadcast), DOF numbering, element data,
+//! distribution (METIS and the numbering on rank 0, each rank sent its
+//! piece), DOF numbering, element data,
 //! contact pairs and the Jacobian's storage (sparsity pattern and rigid-body
 //! near-null space); the PETSc defaults (Newton's line search, the linear
 //! solver and preconditioner) chosen from the kind of tangent, and Newton
@@ -8,6 +9,7 @@ use super::boundary::Dirichlet;
 use super::driver::Simulation;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
+use crate::distribution;
 use crate::dofs::{DofMap, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
@@ -114,11 +116,8 @@ pub(super) fn set_solver_defaults(
 /// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
 pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
     let world = rt.world();
-    let (rank, size) = (rt.rank(), rt.size());
     let mesh = &model.mesh;
     crate::footprint::checkpoint("model build");
-    let partition = broadcast_partition(&world, mesh, rank, size)?;
-    crate::footprint::checkpoint("partition");
     let mut master_nodes = Vec::new();
     // Mortar pairs see both their surfaces whole on every rank; a links
     // pair's master is exchanged at each search (`contact::held_master`).
@@ -136,7 +135,11 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
             &pair.slave,
         )?);
     }
-    let dofs = DofMap::new(mesh, &partition, rank, size, &master_nodes);
+    let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
+    let mut piece = distribution::distribute(&world, mesh, &master_nodes, &slave_sets)?;
+    let partition_block = std::mem::take(&mut piece.block_partition);
+    let slave_owners = std::mem::take(&mut piece.facet_owners);
+    let dofs = DofMap::from_piece(piece);
     crate::footprint::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
@@ -165,11 +168,12 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         model
             .contact
             .iter()
-            .map(|p| {
+            .zip(&slave_owners)
+            .map(|(p, owners)| {
                 ContactPair::new(
                     mesh,
                     &dofs,
-                    &partition,
+                    owners,
                     p,
                     softest,
                     &super::halo::PetscHalos,
@@ -184,7 +188,7 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     crate::footprint::setup_finished();
     Ok(Simulation {
         model,
-        partition,
+        partition_block,
         dofs,
         bulk,
         loads,
@@ -192,25 +196,6 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         contact,
         jac,
     })
-}
-
-/// METIS runs on rank 0 only; every rank receives its answer, so all agree
-/// on one partition.
-fn broadcast_partition(
-    world: &impl Communicator,
-    mesh: &Mesh,
-    rank: usize,
-    size: usize,
-) -> Result<Vec<i32>> {
-    let mine = if rank == 0 {
-        crate::partition::partition_cells(mesh, size)
-    } else {
-        Ok(Vec::new())
-    };
-    let mut part = parallel::agree(world, mine)?;
-    part.resize(mesh.num_cells(), 0);
-    world.process_at_rank(0).broadcast_into(&mut part[..]);
-    Ok(part)
 }
 
 /// The Jacobian's storage for the current contact couplings: bulk cells,

@@ -133,16 +133,12 @@ impl MortarPair {
             .iter()
             .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
             .collect();
-        let mut local_cell = vec![false; mesh.num_cells()];
-        for &c in &dofs.local_cells {
-            local_cell[c] = true;
-        }
         let refs = mesh
             .facet_sets
             .get(&spec.slave)
             .map(Vec::as_slice)
             .unwrap_or(&[]);
-        let assembled: Vec<bool> = refs.iter().map(|f| local_cell[f.cell]).collect();
+        let assembled: Vec<bool> = refs.iter().map(|f| dofs.is_local_cell(f.cell)).collect();
         let mut mine = vec![false; n_slave];
         for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
             for &n in &f[..nf] {

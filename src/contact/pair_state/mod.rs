@@ -84,11 +84,13 @@ pub struct ContactPair {
 }
 
 impl ContactPair {
-    /// Resolves a pair on this rank. `softest_youngs` sets the default penalty.
+    /// Resolves a pair on this rank. `slave_owner` is the owning rank of each
+    /// facet of the slave set, in set order; `softest_youngs` sets the
+    /// default penalty.
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
-        partition: &[i32],
+        slave_owner: &[i32],
         spec: &PairSpec,
         softest_youngs: f64,
         halos: &dyn HaloFactory,
@@ -108,7 +110,7 @@ impl ContactPair {
         let multipliers = Multipliers::new(
             mesh,
             dofs,
-            partition,
+            slave_owner,
             &slave,
             &rule,
             friction_spec.is_some(),

@@ -1,0 +1,113 @@
+//! Distribution: rank 0 partitions the cells (METIS on the dual graph),
+//! numbers the nodes for PETSc and hands every rank its piece — the cells it
+//! assembles, the nodes it owns and sees, their PETSc numbers, and the small
+//! natural-order blocks it writes — so that no rank below it in the data flow
+//! (DOF map, output order, contact multipliers) holds an array of the global
+//! node or cell count.
+//!
+//! The numbering rules live in [`numbering`]: a node belongs to the lowest
+//! rank among the cells containing it, and PETSc numbers the nodes rank by
+//! rank, each rank's in natural order. Pieces travel as flat `u64` words
+//! ([`wire`]), one point-to-point message per rank, built and sent one at a
+//! time so rank 0 never holds more than one foreign piece.
+mod numbering;
+mod wire;
+
+#[cfg(test)]
+mod tests;
+
+pub use numbering::Numbering;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::parallel;
+use mpi::traits::*;
+
+/// One rank's share of the mesh numbering. Every array is of local size:
+/// local cells, local nodes, this rank's output blocks, or a contact surface.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Piece {
+    pub rank: usize,
+    pub nranks: usize,
+    pub global_nodes: usize,
+    pub global_cells: usize,
+    /// First PETSc node this rank owns.
+    pub owned_node_start: usize,
+    /// Number of owned nodes (the first entries of `local_natural`).
+    pub n_owned: usize,
+    /// Natural ids of the cells this rank assembles, ascending.
+    pub local_cells: Vec<usize>,
+    /// Natural id of every local node: owned ones first (in PETSc order),
+    /// then ghosts (in PETSc order).
+    pub local_natural: Vec<usize>,
+    /// PETSc node number of every local node.
+    pub local_petsc: Vec<u32>,
+    /// Local node indices of the local cells, flat, `cell_type.nodes()` per cell.
+    pub cell_nodes: Vec<u32>,
+    /// PETSc node number of every natural node of this rank's output node
+    /// block (`even_block(global_nodes, rank, nranks)`).
+    pub block_petsc: Vec<u32>,
+    /// Owning rank of every cell of this rank's output cell block.
+    pub block_partition: Vec<i32>,
+    /// Owning rank of each facet of the requested facet sets, in set order
+    /// (empty for a set the mesh lacks). Contact slave sets: O(surface).
+    pub facet_owners: Vec<Vec<i32>>,
+}
+
+/// [start, end) of part `rank` when `n` items are split evenly over `nranks`.
+pub fn even_block(n: usize, rank: usize, nranks: usize) -> std::ops::Range<usize> {
+    let start = n * rank / nranks;
+    let end = n * (rank + 1) / nranks;
+    start..end
+}
+
+/// Collective: partitions `mesh` on rank 0 and returns this rank's piece.
+///
+/// Only rank 0 reads `mesh`, `extra_ghosts` and the sets named in
+/// `owner_sets` (the other ranks may pass what they like; today every rank
+/// still holds the same mesh). `extra_ghosts` are natural nodes every rank
+/// must see (replicated contact surfaces); `owner_sets` are the facet sets
+/// whose facet owners each rank needs (contact slave sets).
+pub fn distribute(
+    world: &impl Communicator,
+    mesh: &Mesh,
+    extra_ghosts: &[usize],
+    owner_sets: &[String],
+) -> Result<Piece> {
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let part = if rank == 0 {
+        crate::partition::partition_cells(mesh, size)
+    } else {
+        Ok(Vec::new())
+    };
+    let part = parallel::agree(world, part)?;
+    crate::footprint::checkpoint("partition");
+    if size == 1 {
+        return Ok(Numbering::new(mesh, &part, 1).piece(mesh, &part, 0, extra_ghosts, owner_sets));
+    }
+    let mine = if rank == 0 {
+        let numbering = Numbering::new(mesh, &part, size);
+        for r in 1..size {
+            let piece = numbering.piece(mesh, &part, r, extra_ghosts, owner_sets);
+            let words = wire::encode(&piece);
+            drop(piece);
+            world.process_at_rank(r as i32).send(&words[..]);
+        }
+        Ok(numbering.piece(mesh, &part, 0, extra_ghosts, owner_sets))
+    } else {
+        let (words, _status) = world.process_at_rank(0).receive_vec::<u64>();
+        wire::decode(&words).and_then(|p| check_received(p, rank, size))
+    };
+    parallel::agree(world, mine)
+}
+
+/// A received piece must be addressed to this rank and this rank count.
+fn check_received(piece: Piece, rank: usize, size: usize) -> Result<Piece> {
+    if piece.rank != rank || piece.nranks != size {
+        return Err(Error::Internal(format!(
+            "rank {rank} of {size} received the piece of rank {} of {}",
+            piece.rank, piece.nranks
+        )));
+    }
+    Ok(piece)
+}
