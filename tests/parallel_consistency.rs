@@ -152,7 +152,7 @@ fn master_is_held_in_pieces_on_4_ranks() {
     assert!(o.status.success(), "{}", text(&o));
     let line = text(&o)
         .lines()
-        .find(|l| l.contains("master facets held per rank"))
+        .find(|l| l.contains("facets held per rank"))
         .map(str::to_owned)
         .expect("the -v output names the held master facets");
     // "... held per rank MIN..MAX of WHOLE (received at most R)"

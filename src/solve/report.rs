@@ -179,7 +179,7 @@ pub(super) fn print_step(s: &StepReport) {
         );
         if let Some([min, max, received, whole]) = c.master_held {
             println!(
-                "     contact {}: master facets held per rank {min}..{max} of {whole} (received at most {received})",
+                "     master of {}: facets held per rank {min}..{max} of {whole} (received at most {received})",
                 c.name
             );
         }
