@@ -3,7 +3,7 @@
 //! states, a failed linear solve's KSP reason and the rank whose Jacobian
 //! rows are not finite.
 use super::mechanics::Mechanics;
-use super::uzawa::{PENALTY_RAISE, PENALTY_RAISES};
+use super::penalty::{PENALTY_RAISE, PENALTY_RAISES};
 use crate::contact::UzawaStats;
 use crate::error::Result;
 use crate::parallel;

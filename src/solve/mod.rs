@@ -18,6 +18,7 @@ mod master_tail;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
+mod penalty;
 pub mod phases;
 mod predictor;
 mod reactions;

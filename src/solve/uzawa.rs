@@ -5,6 +5,7 @@
 //! most `PENALTY_RAISES` times a step) before the step counts as failed.
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
+use super::penalty::{PENALTY_RAISE, PENALTY_RAISES};
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
 use super::tolerance;
 use crate::contact::{ContactPair, UzawaStats};
@@ -285,11 +286,6 @@ fn worst(stats: &[UzawaStats]) -> UzawaStats {
             sliding: a.sliding + s.sliding,
         })
 }
-
-/// How often, and by how much, a step may raise a slow pair's penalty
-/// before the Uzawa loop gives up (the raised penalty stays for the run).
-pub(super) const PENALTY_RAISES: usize = 2;
-pub(super) const PENALTY_RAISE: f64 = 10.0;
 
 /// The Uzawa test of one pair: penetration and multiplier change within the
 /// pair's tolerances.
