@@ -23,7 +23,8 @@
 //! segments' `Dual<24>` gives `∂tT_j/∂x`: the slip branch, the coupling to
 //! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
 use super::system::{
-    merged, segment_nodes, Interface, NodalData, NodeDof, NodeState, Seed, Segment,
+    for_each_slave_node, merged, segment_nodes, Interface, NodalData, NodeDof, NodeState, Seed,
+    Segment,
 };
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
 use crate::fem::MAX_FACET_NODES;
@@ -235,30 +236,18 @@ pub fn residual<T: Scalar>(
     frictions: &[NodeFriction],
     mut emit: impl FnMut(u32, usize, f64),
 ) {
-    let ns = interface.slave_type.nodes();
-    for seg in segments
-        .iter()
-        .filter(|s| interface.assembled[s.slave as usize])
-    {
-        let ids = segment_nodes(interface, seg.slave, seg.master);
-        for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
-            .iter()
-            .enumerate()
-        {
-            let Some(f) = nodal.slot_of(node).map(|j| &frictions[j]) else {
-                continue;
-            };
-            if !f.active || f.traction == [0.0; 3] {
-                continue;
-            }
-            for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
-                let c = coefficient(seg, a, b).re();
-                for (i, t) in f.traction.iter().enumerate() {
-                    emit(id, i, c * t);
-                }
+    for_each_slave_node(interface, nodal, segments, |seg, a, j, ids| {
+        let f = &frictions[j];
+        if !f.active || f.traction == [0.0; 3] {
+            return;
+        }
+        for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
+            let c = coefficient(seg, a, b).re();
+            for (i, t) in f.traction.iter().enumerate() {
+                emit(id, i, c * t);
             }
         }
-    }
+    });
 }
 
 /// Adds the exact tangent of the tangential residual. `segments` and

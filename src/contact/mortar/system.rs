@@ -264,13 +264,15 @@ fn force_coefficient<T: Scalar>(terms: &SegmentTerms<T>, a: usize, v: usize) -> 
     }
 }
 
-/// Adds the residual of the assembled segments: `emit(node, component, value)`.
-pub fn residual<T: Scalar>(
+/// Calls `visit(segment, a, j, ids)` for every assembled segment and each of
+/// its slave facet's nodes `a` that carries a nodal slot `j`; `ids` are the
+/// segment's node ids (`u32::MAX` where a position is unused). The normal and
+/// the tangential residuals walk the segments this one way.
+pub(super) fn for_each_slave_node<T: Scalar>(
     interface: &Interface,
     nodal: &NodalData,
     segments: &[Segment<T>],
-    states: &[NodeState],
-    mut emit: impl FnMut(u32, usize, f64),
+    mut visit: impl FnMut(&Segment<T>, usize, usize, &[u32]),
 ) {
     let ns = interface.slave_type.nodes();
     for seg in segments
@@ -282,24 +284,36 @@ pub fn residual<T: Scalar>(
             .iter()
             .enumerate()
         {
-            let Some(j) = nodal.slot_of(node) else {
-                continue;
-            };
-            let p = states[j].pressure;
-            if p == 0.0 {
-                continue;
-            }
-            for v in 0..SEGMENT_DOFS {
-                if ids[v / 3] != u32::MAX {
-                    emit(
-                        ids[v / 3],
-                        v % 3,
-                        p * force_coefficient(&seg.terms, a, v).re(),
-                    );
-                }
+            if let Some(j) = nodal.slot_of(node) {
+                visit(seg, a, j, &ids);
             }
         }
     }
+}
+
+/// Adds the residual of the assembled segments: `emit(node, component, value)`.
+pub fn residual<T: Scalar>(
+    interface: &Interface,
+    nodal: &NodalData,
+    segments: &[Segment<T>],
+    states: &[NodeState],
+    mut emit: impl FnMut(u32, usize, f64),
+) {
+    for_each_slave_node(interface, nodal, segments, |seg, a, j, ids| {
+        let p = states[j].pressure;
+        if p == 0.0 {
+            return;
+        }
+        for v in 0..SEGMENT_DOFS {
+            if ids[v / 3] != u32::MAX {
+                emit(
+                    ids[v / 3],
+                    v % 3,
+                    p * force_coefficient(&seg.terms, a, v).re(),
+                );
+            }
+        }
+    });
 }
 
 /// A sparse vector over node DOFs, merged (sorted, duplicates summed).
