@@ -492,4 +492,6 @@ fn interpolate_at(n: &[f64], nodal: &[[f64; 3]]) -> [f64; 3] {
 }
 
 #[cfg(test)]
+mod mass_tests;
+#[cfg(test)]
 mod tests;

@@ -58,7 +58,30 @@ impl<'m> Simulation<'m> {
     /// Collective; fails on every rank if it fails on one.
     pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
         let stage = LogStage::register("Setup")?;
-        stage.scope(|| setup::setup(rt, model))
+        let parts = stage.scope(|| setup::setup(rt, model))?;
+        Ok(Self::from_parts(model, parts))
+    }
+
+    fn from_parts(model: &'m Model, parts: setup::SetUp) -> Self {
+        let setup::SetUp {
+            partition_block,
+            dofs,
+            bulk,
+            loads,
+            dirichlet,
+            contact,
+            jac,
+        } = parts;
+        Simulation {
+            model,
+            partition_block,
+            dofs,
+            bulk,
+            loads,
+            dirichlet,
+            contact,
+            jac,
+        }
     }
 
     /// Owning rank of each cell of this rank's output cell block

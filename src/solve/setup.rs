@@ -6,7 +6,6 @@
 //! solver and preconditioner) chosen from the kind of tangent, and Newton
 //! (SNES) with the settings' tolerances.
 use super::boundary::Dirichlet;
-use super::driver::Simulation;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::distribution;
@@ -113,8 +112,19 @@ pub(super) fn set_solver_defaults(
     Ok(())
 }
 
+/// What set-up hands the driver: every rank's share of the discrete problem.
+pub(super) struct SetUp {
+    pub(super) partition_block: Vec<i32>,
+    pub(super) dofs: DofMap,
+    pub(super) bulk: BulkAssembler,
+    pub(super) loads: SurfaceLoads,
+    pub(super) dirichlet: Dirichlet,
+    pub(super) contact: Vec<ContactPair>,
+    pub(super) jac: Matrix,
+}
+
 /// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
-pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
+pub(super) fn setup(rt: &Runtime, model: &Model) -> Result<SetUp> {
     let world = rt.world();
     let mesh = &model.mesh;
     crate::footprint::checkpoint("model build");
@@ -186,8 +196,7 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
     crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
-    Ok(Simulation {
-        model,
+    Ok(SetUp {
         partition_block,
         dofs,
         bulk,

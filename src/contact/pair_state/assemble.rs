@@ -257,3 +257,15 @@ impl ContactPair {
         self.tangent_signature
     }
 }
+
+impl ContactPair {
+    /// Every link's state at `u_local` after following its sliding partner.
+    pub(super) fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
+        self.follow(u_local);
+        let mut buf = LinkBuffers::default();
+        self.links
+            .iter()
+            .map(|l| kernel::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
+            .collect()
+    }
+}

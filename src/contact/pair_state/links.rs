@@ -1,9 +1,7 @@
 //! The links of a load step: the search that makes them at the start of the
 //! step, and the following of sliding during its Newton iterations.
-use super::assemble::LinkBuffers;
 use super::{ContactPair, MasterSide};
 use crate::assembly::RankExchange;
-use crate::contact::kernel::{self, LinkState};
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
 use crate::dofs::DofMap;
@@ -222,15 +220,6 @@ impl ContactPair {
                 l.xi = p.xi;
             }
         }
-    }
-
-    pub(super) fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
-        self.follow(u_local);
-        let mut buf = LinkBuffers::default();
-        self.links
-            .iter()
-            .map(|l| kernel::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
-            .collect()
     }
 }
 

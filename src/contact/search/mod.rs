@@ -54,6 +54,8 @@
 //! several times more. [`SearchIndex::find_many`] reorders a batch by grid
 //! cell to get the former from the latter.
 
+#[cfg(test)]
+mod edge_tests;
 mod facets;
 mod grid;
 mod selection;
