@@ -91,13 +91,17 @@ bench: deps
 	$$bin | tee bench-results/search.csv
 
 # contactlink beside CalculiX (penalty surface-to-surface, one thread) on the
-# same Gmsh meshes of the graded Hertz line contact, h_c = b/5 ... b/40: DOFs,
-# wall time, Newton iterations, Hertz errors and the time ratio in one table
-# (installs gmsh and calculix-ccx if missing; about 3 minutes).
+# same meshes: the graded Hertz line contact (Gmsh, h_c = b/5 ... b/40, median
+# of 3 runs) and the built-in hertz-sphere mesh (h_c = 0.5 and 0.35, one run):
+# DOFs, wall time, Newton iterations, Hertz errors, the time ratio, and
+# contactlink's contact solve against a plain elastic solve of the same mesh
+# (installs gmsh and calculix-ccx if missing; about TIME_PLACEHOLDER).
+# A subset: make bench-peers PEERS="--cases sphere --sphere-sizes 0.5".
 bench-peers: build
 	@bash scripts/install-deps.sh --peers
 	@mkdir -p bench-results/peers
-	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),3)
+	@cd scripts/peers && $(PYTHON) -m unittest -q test_peers
+	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),3) $(PEERS)
 
 # Run time against error for the Hertz line and point contacts: mesh size ×
 # penalty × Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto
