@@ -39,7 +39,8 @@ For each size the script
 and prints one table per case: wall time of the whole process, Newton
 iterations, errors, the time ratio ours/ccx, and contactlink's contact/plain
 ratio of its own solve time (the `done:` line's seconds, start-up excluded).
-Writes <out>/peers.csv. --dry-run writes the meshes, scenes and decks (the
+Writes <out>/peers.csv (with the CPU seconds of each process too, user +
+system, less dependent on the machine's load than wall time). --dry-run writes the meshes, scenes and decks (the
 sphere's mesh comes from one plain contactlink solve) and runs nothing else.
 Needs gmsh, calculix-ccx and python3-h5py (`bash scripts/install-deps.sh
 --peers` installs them).
@@ -49,6 +50,7 @@ import csv
 import math
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -218,19 +220,25 @@ def mpi_env():
                 OMP_NUM_THREADS="1"), **os.environ)
 
 
+def children_cpu():
+    """CPU seconds (user + system) of the finished child processes so far."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run_contactlink(a, scene, contact=True):
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(a.np),
            a.bin, "run", scene, "-o", scene[:-5] + ".h5"] + a.extra
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), children_cpu()
     p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, children_cpu() - c0
     out = p.stdout + p.stderr
     d, h = DONE.search(out), HERTZ.search(out)
     if p.returncode != 0 or not d or (contact and not h):
         sys.exit(f"contactlink failed on {scene}:\n{out[-2000:]}")
     with open(scene[:-5] + ".csv") as f:
         rows = list(csv.DictReader(f))
-    r = {"wall": wall, "solve": float(d[4]), "steps": int(d[1]), "newton": int(d[2]),
+    r = {"wall": wall, "cpu": cpu, "solve": float(d[4]), "steps": int(d[1]), "newton": int(d[2]),
          "dofs": int(d[3]), "uzawa": sum(int(r["uzawa"]) for r in rows)}
     if contact:
         r.update(e_p0=float(h[3]) / 100, e_w=float(h[6]) / 100)
@@ -240,20 +248,24 @@ def run_contactlink(a, scene, contact=True):
 def median_run(a, scene, repeats, contact=True):
     runs = [run_contactlink(a, scene, contact) for _ in range(repeats)]
     row = dict(runs[0])
-    row["wall"] = statistics.median(r["wall"] for r in runs)
+    for key in ("wall", "cpu"):
+        row[key] = statistics.median(r[key] for r in runs)
     row["solve"] = statistics.median(r["solve"] for r in runs)
     return row
 
 
 def run_peer(deck, repeats):
-    walls = []
+    """(wall, CPU seconds, Newton iterations, increments) of ccx on a deck."""
+    walls, cpus = [], []
     for _ in range(repeats):
+        c0 = children_cpu()
         try:
             walls.append(ccx.run_ccx(deck))
         except RuntimeError as e:
             sys.exit(str(e))
+        cpus.append(children_cpu() - c0)
     newton, increments = ccx.ccx_newton(deck[:-4] + ".sta")
-    return statistics.median(walls), newton, increments
+    return statistics.median(walls), statistics.median(cpus), newton, increments
 
 
 def ccx_fit(job, nodes, slave_nodes, load_of, exact_of, point):
@@ -313,8 +325,10 @@ def one_line(a, divisor):
         return row
     row.update(median_run(a, scene, a.repeats))
     p = median_run(a, plain, a.repeats, contact=False)
-    row.update(plain_wall=p["wall"], plain_solve=p["solve"], plain_newton=p["newton"])
-    row["ccx_wall"], row["ccx_newton"], row["ccx_increments"] = run_peer(deck, a.repeats)
+    row.update(plain_wall=p["wall"], plain_cpu=p["cpu"], plain_solve=p["solve"],
+               plain_newton=p["newton"])
+    (row["ccx_wall"], row["ccx_cpu"], row["ccx_newton"],
+     row["ccx_increments"]) = run_peer(deck, a.repeats)
     # Half model: the load per unit length is the force over half the thickness.
     row["ccx_e_p0"], row["ccx_e_w"] = ccx_fit(
         deck[:-4], nodes, [t for q in quads["cylinder.curved"] for t in q],
@@ -340,11 +354,13 @@ def one_sphere(a, hc):
                    ["block", "sphere"], nsets, surfaces, fixed, step, "NTOP", (YOUNGS, POISSON),
                    pair=("SSLAVE", "SMASTER", 10.0 * YOUNGS / hc))
     row = {"case": "sphere", "size": f"h={hc:g}", "hc": hc, "hc_mesh": hc, "deck": deck,
-           "plain_wall": p["wall"], "plain_solve": p["solve"], "plain_newton": p["newton"]}
+           "plain_wall": p["wall"], "plain_cpu": p["cpu"], "plain_solve": p["solve"],
+           "plain_newton": p["newton"]}
     if a.dry_run:
         return row
     row.update(median_run(a, scene, a.sphere_repeats))
-    row["ccx_wall"], row["ccx_newton"], row["ccx_increments"] = run_peer(deck, a.sphere_repeats)
+    (row["ccx_wall"], row["ccx_cpu"], row["ccx_newton"],
+     row["ccx_increments"]) = run_peer(deck, a.sphere_repeats)
     row["ccx_e_p0"], row["ccx_e_w"] = ccx_fit(
         deck[:-4], nodes, [t for q in facets["sphere.curved"] for t in q],
         lambda f: abs(f[2]), lambda f: hertz.point(f, SPHERE_RADIUS, E_STAR), True)
@@ -408,14 +424,16 @@ def main():
         for s in sizes:
             r = run(a, s)
             r["ratio"] = r["wall"] / r["ccx_wall"]
+            r["cpu_ratio"] = r["cpu"] / r["ccx_cpu"]
             r["contact_plain"] = r["solve"] / r["plain_solve"]
             rows.append(r)
             print_row(r)
     if a.dry_run:
         return
-    keys = ["case", "size", "hc", "hc_mesh", "dofs", "wall", "solve", "newton", "uzawa", "steps",
-            "e_p0", "e_w", "ccx_wall", "ccx_newton", "ccx_increments", "ccx_e_p0", "ccx_e_w",
-            "ratio", "plain_wall", "plain_solve", "plain_newton", "contact_plain"]
+    keys = ["case", "size", "hc", "hc_mesh", "dofs", "wall", "cpu", "solve", "newton", "uzawa",
+            "steps", "e_p0", "e_w", "ccx_wall", "ccx_cpu", "ccx_newton", "ccx_increments",
+            "ccx_e_p0", "ccx_e_w", "ratio", "cpu_ratio", "plain_wall", "plain_cpu", "plain_solve",
+            "plain_newton", "contact_plain"]
     path = os.path.join(a.out, "peers.csv")
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
