@@ -91,13 +91,20 @@ bench: deps
 	$$bin | tee bench-results/search.csv
 
 # contactlink beside CalculiX (penalty surface-to-surface, one thread) on the
-# same Gmsh meshes of the graded Hertz line contact, h_c = b/5 ... b/40: DOFs,
-# wall time, Newton iterations, Hertz errors and the time ratio in one table
-# (installs gmsh and calculix-ccx if missing; about 3 minutes).
+# same meshes: the graded Hertz line contact (Gmsh, h_c = b/5 ... b/40) and the
+# built-in hertz-sphere mesh (h_c = 0.5 and 0.35): DOFs, wall time, Newton
+# iterations, Hertz errors, the time ratio, and contactlink's contact solve
+# against a plain elastic solve of the same mesh. One run each (REPEATS=3: the
+# median of 3 for every line size). Installs gmsh and calculix-ccx if missing;
+# about 19 minutes on 2 cores at load average 11-14, 14 of them the sphere
+# (CalculiX alone 9 at h_c = 0.35). A subset, e.g.
+#   make bench-peers PEERS="--cases sphere --sphere-sizes 0.5"
+#   make bench-peers PEERS="--cases line --sizes 5,10"
 bench-peers: build
 	@bash scripts/install-deps.sh --peers
 	@mkdir -p bench-results/peers
-	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),3)
+	@set -o pipefail; cd scripts/peers && $(PYTHON) -m unittest -q test_peers 2>&1 | tail -1
+	$(PYTHON) scripts/bench_peers.py --np 1 --repeats $(or $(REPEATS),1) --sphere-repeats 1 $(PEERS)
 
 # Run time against error for the Hertz line and point contacts: mesh size ×
 # penalty × Uzawa tolerance, median of 3 runs each, CSV + PNG with the Pareto

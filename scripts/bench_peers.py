@@ -1,184 +1,83 @@
 #!/usr/bin/python3
 """contactlink side by side with CalculiX on the same mesh.
 
-usage: bench_peers.py [--sizes 5,10,20,40] [--np 1] [--repeats 1]
+usage: bench_peers.py [--cases line,sphere] [--sizes 5,10,20,40]
+                      [--sphere-sizes 0.5,0.35] [--np 1] [--repeats 1]
+                      [--sphere-repeats 1] [--dry-run]
                       [--out bench-results/peers] [--bin target/release/contactlink]
 
-The Hertz line contact (plane strain, one hex8 layer, half model): a quarter
-disc R = 1 pressed on a 4R x 4R block (the half of 8R x 4R), displacement
-controlled so that b is about 0.1 R, meshed by Gmsh from
-scripts/peers/hertz-line.geo with contact-zone size h_c = b/5 ... b/40
-(unstructured full-quad, graded to 0.25 R). For each size the script
+Two cases, each at a few mesh sizes:
 
-  1. runs contactlink on the .msh (a scene written next to it);
-  2. writes a CalculiX deck from the same .msh: the same nodes, C3D8 cells,
-     element-face surfaces and boundary conditions, a penalty surface-to-surface
-     contact pair with the linear pressure-overclosure slope 10 E / h_c, and
-     runs `ccx` on one thread (OMP_NUM_THREADS=1);
-  3. fits the Hertz profile p^2 = p0^2 (1 - x^2/b^2) to each code's contact
+line    The Hertz line contact (plane strain, one hex8 layer, half model): a
+        quarter disc R = 1 pressed on a 4R x 4R block (the half of 8R x 4R),
+        displacement controlled so that b is about 0.1 R, meshed by Gmsh from
+        scripts/peers/hertz-line.geo with contact-zone size h_c = b/5 ... b/40
+        (unstructured full-quad, graded to 0.25 R).
+sphere  The Hertz point contact of the built-in `hertz-sphere` scene: a
+        hemisphere R = 10 pressed 0.1 into a 20 x 20 x 10 block, both
+        E = 1000, nu = 0.3, structured hex8 graded from h_c (--sphere-sizes)
+        over a 2 x 2 zone at the contact point. CalculiX gets the mesh that
+        contactlink's own result file holds (nodes and cells in natural order,
+        the facet and node sets), so both codes solve the same mesh.
+
+For each size the script
+
+  1. runs contactlink twice: the contact solve, and the plain elastic solve
+     of the same mesh, materials, conditions and solver without the contact
+     pair (one linear-elastic step, as benches/solve_costs.rs defines it);
+  2. writes a CalculiX deck of the same mesh: the same nodes, C3D8 cells,
+     element-face surfaces and boundary conditions, a penalty
+     surface-to-surface contact pair with the linear pressure-overclosure
+     slope 10 E / h_c, and runs `ccx` on one thread (OMP_NUM_THREADS=1);
+  3. fits the Hertz profile p^2 = p0^2 (1 - s^2/w^2) to each code's contact
      pressures (the fit contactlink itself reports: least squares in
-     (x^2, p^2) over the inner 90 % of the loaded zone) and compares p0 and b
-     with Hertz for the load each code's reaction force gives;
+     (s^2, p^2) over the inner 90 % of the loaded zone; contactlink's contact
+     points, CalculiX's CPRESS at the slave nodes) and compares p0 and the
+     half-width b (line) or radius a (sphere) with Hertz for the load each
+     code's reaction force gives;
 
-and prints one table (wall time of the whole process, Newton iterations,
-errors, time ratio). Writes <out>/peers.csv. Needs gmsh and calculix-ccx
-(`bash scripts/install-deps.sh --peers` installs them).
+and prints one table per case: wall time of the whole process, Newton
+iterations, errors, the time ratio ours/ccx, and contactlink's contact/plain
+ratio of its own solve time (the `done:` line's seconds, start-up excluded).
+Writes <out>/peers.csv (with the CPU seconds of each process too, user +
+system, less dependent on the machine's load than wall time). --dry-run writes the meshes, scenes and decks (the
+sphere's mesh comes from one plain contactlink solve) and runs nothing else.
+Needs gmsh, calculix-ccx and python3-h5py (`bash scripts/install-deps.sh
+--peers` installs them).
 """
 import argparse
 import csv
 import math
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "peers"))
+import ccx  # noqa: E402
+import hertz  # noqa: E402
+import meshes  # noqa: E402
+
 GEO = os.path.join(HERE, "peers", "hertz-line.geo")
 YOUNGS, POISSON = 1000.0, 0.3
+E_STAR = hertz.effective_modulus(YOUNGS, POISSON)
+
+# --- line contact ---------------------------------------------------------------
 RADIUS = 1.0
 THICKNESS = 0.01  # the one hex layer (y), as in hertz-line.geo
 # Approach of the cylinder's top that gives b ≈ 0.1 R on these meshes.
 APPROACH = 0.0183
 B_TARGET = 0.1 * RADIUS
-E_STAR = 1.0 / (2.0 * (1.0 - POISSON ** 2) / YOUNGS)
 
-# C3D8 faces (CalculiX/Abaqus numbering S1..S6) as local node indices; Gmsh
-# numbers a hexahedron's nodes like CalculiX does.
-HEX_FACES = [(0, 1, 2, 3), (4, 7, 6, 5), (0, 4, 5, 1),
-             (1, 5, 6, 2), (2, 6, 7, 3), (3, 7, 4, 0)]
+# --- point contact (scenes/hertz-sphere.toml) -------------------------------------
+SPHERE_RADIUS = 10.0
+SPHERE_PUSH = 0.1
 
-
-# --- Gmsh .msh 4.1 (ASCII), just what this mesh has -----------------------
-
-def read_msh(path):
-    """Nodes {tag: (x, y, z)}, hexes [(tag, body, [8 tags])], quads per
-    physical surface name {name: [[4 tags]]}."""
-    with open(path) as f:
-        lines = f.read().split("\n")
-    i = 0
-    names, ent_phys = {}, {}
-    nodes, hexes, quads = {}, [], {}
-
-    def section(name):
-        nonlocal i
-        while lines[i].strip() != name:
-            i += 1
-        i += 1
-
-    section("$PhysicalNames")
-    for _ in range(int(lines[i])):
-        i += 1
-        dim, tag, name = lines[i].split(maxsplit=2)
-        names[(int(dim), int(tag))] = name.strip('"')
-    section("$Entities")
-    counts = [int(v) for v in lines[i].split()]
-    i += 1
-    for dim in range(4):
-        for _ in range(counts[dim]):
-            v = lines[i].split()
-            i += 1
-            tag = int(v[0])
-            at = 4 if dim == 0 else 7
-            nphys = int(v[at])
-            ent_phys[(dim, tag)] = [int(p) for p in v[at + 1:at + 1 + nphys]]
-    section("$Nodes")
-    nblocks = int(lines[i].split()[0])
-    i += 1
-    for _ in range(nblocks):
-        n = int(lines[i].split()[3])
-        i += 1
-        tags = [int(lines[i + k]) for k in range(n)]
-        i += n
-        for k in range(n):
-            nodes[tags[k]] = tuple(float(c) for c in lines[i + k].split())
-        i += n
-    section("$Elements")
-    nblocks = int(lines[i].split()[0])
-    i += 1
-    for _ in range(nblocks):
-        dim, ent, etype, n = (int(v) for v in lines[i].split())
-        i += 1
-        phys = [names[(dim, p)] for p in ent_phys.get((dim, ent), [])]
-        for k in range(n):
-            v = [int(x) for x in lines[i + k].split()]
-            if etype == 5:
-                body = phys[0] if phys else "unnamed"
-                hexes.append((v[0], body, v[1:9]))
-            elif etype == 3:
-                for p in phys:
-                    quads.setdefault(p, []).append(v[1:5])
-        i += n
-    return nodes, hexes, quads
-
-
-def hex_volume_sign(nodes, conn):
-    """Sign of the Jacobian at the centre of a hexahedron."""
-    p = [nodes[t] for t in conn]
-
-    def d(a, b):
-        return [sum(p[k][c] for k in b) - sum(p[k][c] for k in a) for c in range(3)]
-    gx = d((0, 3, 4, 7), (1, 2, 5, 6))
-    gy = d((0, 1, 4, 5), (3, 2, 7, 6))
-    gz = d((0, 1, 2, 3), (4, 5, 6, 7))
-    det = (gx[0] * (gy[1] * gz[2] - gy[2] * gz[1])
-           - gx[1] * (gy[0] * gz[2] - gy[2] * gz[0])
-           + gx[2] * (gy[0] * gz[1] - gy[1] * gz[0]))
-    return 1 if det > 0 else -1
-
-
-def contact_size(nodes, quads):
-    """The smallest in-plane (x-z) edge of the slave surface near the first
-    contact point: the h_c the mesh really has."""
-    best = math.inf
-    for q in quads["cylinder.curved"]:
-        for a, b in zip(q, q[1:] + q[:1]):
-            pa, pb = nodes[a], nodes[b]
-            if abs(pa[1] - pb[1]) > 1e-12 or max(abs(pa[0]), abs(pb[0])) > 2 * B_TARGET:
-                continue
-            best = min(best, math.hypot(pa[0] - pb[0], pa[2] - pb[2]))
-    return best
-
-
-# --- the Hertz fit (as contactlink reports it) -------------------------------
-
-def fit_profile(xs, ps):
-    loaded = [(x * x, p) for x, p in zip(xs, ps) if p > 0.0]
-    if len(loaded) < 3:
-        return None
-    s2_max = max(s for s, _ in loaded)
-    inner = [(s, p * p) for s, p in loaded if s <= 0.81 * s2_max]
-    n = len(inner)
-    if n < 3:
-        return None
-    mx = sum(s for s, _ in inner) / n
-    my = sum(q for _, q in inner) / n
-    sxx = sum((s - mx) ** 2 for s, _ in inner)
-    sxy = sum((s - mx) * (q - my) for s, q in inner)
-    if sxx <= 0:
-        return None
-    slope = sxy / sxx
-    icpt = my - slope * mx
-    if icpt <= 0 or slope >= 0:
-        return None
-    return math.sqrt(icpt), math.sqrt(icpt / -slope)
-
-
-def hertz_errors(load, p0, b):
-    b_exact = math.sqrt(4 * load * RADIUS / (math.pi * E_STAR))
-    p0_exact = 2 * load / (math.pi * b_exact)
-    return (p0 - p0_exact) / p0_exact, (b - b_exact) / b_exact
-
-
-# --- contactlink ---------------------------------------------------------------
-
-SCENE = """title = "Hertz line contact, half model, Gmsh mesh h_c = {hc:.5g} (peer benchmark)"
-
-[mesh]
-generator = "gmsh"
-file = "{msh}"
-
+BODIES = """
 [[body]]
 name = "block"
 material = "linear-elastic"
@@ -186,11 +85,18 @@ youngs = {e}
 poisson = {nu}
 
 [[body]]
-name = "cylinder"
+name = "{indenter}"
 material = "linear-elastic"
 youngs = {e}
 poisson = {nu}
+"""
 
+LINE_SCENE = """title = "Hertz line contact, half model, Gmsh mesh h_c = {hc:.5g}{what} (peer benchmark)"
+
+[mesh]
+generator = "gmsh"
+file = "{msh}"
+""" + BODIES + """
 [[dirichlet]]
 set = "block.bottom"
 
@@ -224,20 +130,26 @@ components = ["y"]
 set = "cylinder.top"
 components = ["x", "z"]
 value = [0.0, {approach}]
+"""
 
+LINE_CONTACT = """
 [[contact]]
 name = "hertz"
 slave = "cylinder.curved"
 master = "block.top"
+"""
 
+LINE_TAIL = """
 [steps]
 count = 1
 
 [solver]
 direct_max_dofs = 1000000
+"""
 
 # Half model: the pair carries half the line load, so the load per unit
 # length is the force over half the thickness.
+LINE_HERTZ = """
 [hertz]
 kind = "line"
 pair = "hertz"
@@ -245,9 +157,60 @@ radius = {radius}
 thickness = {half}
 """
 
-DONE = re.compile(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs")
+SPHERE_SCENE = """title = "Hertz point contact, built-in hertz-sphere mesh h_c = {hc:.5g}{what} (peer benchmark)"
+
+[mesh]
+generator = "hertz-sphere"
+radius = {radius}
+block_width = 20.0
+block_height = 10.0
+fine_size = {hc}
+fine_half_width = 2.0
+level = 0
+""" + BODIES + """
+[[dirichlet]]
+set = "block.bottom"
+
+[[dirichlet]]
+set = "sphere.top"
+value = [0.0, 0.0, {push}]
+"""
+
+SPHERE_CONTACT = """
+[[contact]]
+name = "hertz"
+slave = "sphere.curved"
+master = "block.top"
+"""
+
+SPHERE_TAIL = """
+[steps]
+count = 1
+"""
+
+SPHERE_HERTZ = """
+[hertz]
+kind = "point"
+pair = "hertz"
+radius = {radius}
+"""
+
+DONE = re.compile(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs on \d+ rank\(s\), ([0-9.]+) s")
 HERTZ = re.compile(r"p0 computed ([-+0-9.e]+), analytic ([-+0-9.e]+) \(([-+0-9.]+) %\); "
                    r"half-width/radius computed ([-+0-9.e]+), analytic ([-+0-9.e]+) \(([-+0-9.]+) %\)")
+
+
+def write_scenes(stem, base, contact, tail, hertz_part, **fmt):
+    """<stem>.toml (the contact solve) and <stem>-plain.toml (the same mesh,
+    materials, conditions and solver without the contact pair)."""
+    paths = []
+    for suffix, parts, what in ((".toml", (base, contact, tail, hertz_part), ""),
+                                ("-plain.toml", (base, tail), ", no contact")):
+        path = stem + suffix
+        with open(path, "w") as f:
+            f.write("".join(parts).format(what=what, **fmt))
+        paths.append(path)
+    return paths
 
 
 def mpi_env():
@@ -257,226 +220,220 @@ def mpi_env():
                 OMP_NUM_THREADS="1"), **os.environ)
 
 
-def run_contactlink(binary, np_, scene, extra):
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           binary, "run", scene, "-o", scene[:-5] + ".h5"] + extra
-    t0 = time.perf_counter()
+def children_cpu():
+    """CPU seconds (user + system) of the finished child processes so far."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run_contactlink(a, scene, contact=True):
+    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(a.np),
+           a.bin, "run", scene, "-o", scene[:-5] + ".h5"] + a.extra
+    t0, c0 = time.perf_counter(), children_cpu()
     p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, children_cpu() - c0
     out = p.stdout + p.stderr
     d, h = DONE.search(out), HERTZ.search(out)
-    if p.returncode != 0 or not d or not h:
+    if p.returncode != 0 or not d or (contact and not h):
         sys.exit(f"contactlink failed on {scene}:\n{out[-2000:]}")
     with open(scene[:-5] + ".csv") as f:
         rows = list(csv.DictReader(f))
-    return {
-        "wall": wall, "steps": int(d[1]), "newton": int(d[2]), "dofs": int(d[3]),
-        "uzawa": sum(int(r["uzawa"]) for r in rows),
-        "ksp": sum(int(r["ksp"]) for r in rows) if "ksp" in rows[0] else None,
-        "cutbacks": sum(int(r.get("cutbacks", 0)) for r in rows),
-        "e_p0": float(h[3]) / 100, "e_b": float(h[6]) / 100,
-    }
+    r = {"wall": wall, "cpu": cpu, "solve": float(d[4]), "steps": int(d[1]), "newton": int(d[2]),
+         "dofs": int(d[3]), "uzawa": sum(int(r["uzawa"]) for r in rows)}
+    if contact:
+        r.update(e_p0=float(h[3]) / 100, e_w=float(h[6]) / 100)
+    return r
 
 
-# --- CalculiX ---------------------------------------------------------------------
-
-def write_deck(path, nodes, hexes, quads, penalty):
-    """The CalculiX deck of the same mesh, boundary conditions and load."""
-    face_of = {}
-    out = ["** Hertz line contact, half model: written by scripts/bench_peers.py",
-           "*NODE, NSET=NALL"]
-    for t in sorted(nodes):
-        x, y, z = nodes[t]
-        out.append(f"{t}, {x:.15g}, {y:.15g}, {z:.15g}")
-    for body in ("block", "cylinder"):
-        out.append(f"*ELEMENT, TYPE=C3D8, ELSET=E{body.upper()}")
-        for tag, b, conn in hexes:
-            if b != body:
-                continue
-            if hex_volume_sign(nodes, conn) < 0:
-                conn = conn[4:] + conn[:4]
-            out.append(f"{tag}, " + ", ".join(str(c) for c in conn))
-            for k, f in enumerate(HEX_FACES):
-                face_of[frozenset(conn[i] for i in f)] = (tag, k + 1)
-
-    def nset(name, sets):
-        tags = sorted({n for s in sets for q in quads[s] for n in q})
-        out.append(f"*NSET, NSET={name}")
-        out.extend(", ".join(str(t) for t in tags[i:i + 12]) for i in range(0, len(tags), 12))
-
-    def surface(name, set_name):
-        out.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
-        for q in quads[set_name]:
-            tag, face = face_of[frozenset(q)]
-            out.append(f"{tag}, S{face}")
-
-    nset("NBOTTOM", ["block.bottom"])
-    nset("NSYM", ["block.symmetry", "cylinder.symmetry"])
-    nset("NTOP", ["cylinder.top"])
-    surface("SSLAVE", "cylinder.curved")
-    surface("SMASTER", "block.top")
-    out += [
-        "*MATERIAL, NAME=STEEL",
-        "*ELASTIC",
-        f"{YOUNGS}, {POISSON}",
-        "*SOLID SECTION, ELSET=EBLOCK, MATERIAL=STEEL",
-        "*SOLID SECTION, ELSET=ECYLINDER, MATERIAL=STEEL",
-        "*SURFACE INTERACTION, NAME=HERTZ",
-        "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
-        f"{penalty:.6g}",
-        "*CONTACT PAIR, INTERACTION=HERTZ, TYPE=SURFACE TO SURFACE",
-        "SSLAVE, SMASTER",
-        "*BOUNDARY",
-        "NBOTTOM, 1, 3, 0.0",
-        "NSYM, 1, 1, 0.0",
-        "NALL, 2, 2, 0.0",
-        "*STEP",
-        "*STATIC",
-        "1.0, 1.0",
-        "*BOUNDARY",
-        "NTOP, 1, 1, 0.0",
-        f"NTOP, 3, 3, {-APPROACH}",
-        "*NODE PRINT, NSET=NTOP, TOTALS=ONLY",
-        "RF",
-        "*CONTACT FILE",
-        "CSTR",
-        "*END STEP",
-    ]
-    with open(path, "w") as f:
-        f.write("\n".join(out) + "\n")
-
-
-def run_ccx(deck):
-    job = deck[:-4]
-    t0 = time.perf_counter()
-    p = subprocess.run(["ccx", "-i", os.path.basename(job)], capture_output=True, text=True,
-                       cwd=os.path.dirname(job), env=dict(os.environ, OMP_NUM_THREADS="1"))
-    wall = time.perf_counter() - t0
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or "Job finished" not in out:
-        sys.exit(f"ccx failed on {deck}:\n{out[-2000:]}")
-    return wall
-
-
-def read_frd_pressure(path):
-    """CPRESS at the nodes of the last CONTACT block of a .frd file."""
-    pressure, inside = {}, False
-    with open(path) as f:
-        for line in f:
-            if line.startswith(" -4"):
-                inside = line.split()[1] == "CONTACT"
-                if inside:
-                    pressure = {}
-            elif inside and line.startswith(" -1"):
-                # Fixed columns: " -1", node id (10), then 12-wide values.
-                node = int(line[3:13])
-                vals = [float(line[13 + 12 * k:25 + 12 * k]) for k in range(6)]
-                pressure[node] = vals[3]
-            elif inside and line.startswith(" -3"):
-                inside = False
-    return pressure
-
-
-def read_dat_total(path):
-    """The last total force of set NTOP in a .dat file."""
-    with open(path) as f:
-        text = f.read()
-    blocks = re.findall(r"total force \(fx,fy,fz\) for set NTOP.*?\n\s*\n\s*(\S+)\s+(\S+)\s+(\S+)", text)
-    if not blocks:
-        return None
-    return [float(v) for v in blocks[-1]]
-
-
-def ccx_newton(sta):
-    """Newton iterations summed over the increments of a .sta file."""
-    total, increments = 0, 0
-    with open(sta) as f:
-        for line in f:
-            v = line.split()
-            if len(v) == 7 and v[0].isdigit() and v[1].isdigit():
-                total += int(v[3])
-                increments += 1
-    return total, increments
-
-
-def ccx_errors(job, nodes, quads):
-    """(p0 error, b error) of a CalculiX run against Hertz for its own load."""
-    force = read_dat_total(job + ".dat")
-    pressure = read_frd_pressure(job + ".frd")
-    if force is None or not pressure:
-        sys.exit(f"{job}: no total force or contact pressure in the CalculiX output")
-    slave = sorted({t for q in quads["cylinder.curved"] for t in q})
-    fit = fit_profile([nodes[t][0] for t in slave], [pressure.get(t, 0.0) for t in slave])
-    if fit is None:
-        sys.exit(f"{job}: too few loaded slave nodes for a Hertz fit")
-    # Half model: the load per unit length is the force over half the thickness.
-    return hertz_errors(2.0 * abs(force[2]) / THICKNESS, *fit)
-
-
-def one_size(a, divisor):
-    hc = B_TARGET / divisor
-    tag = f"b{divisor}"
-    msh = os.path.join(a.out, f"line-{tag}.msh")
-    subprocess.run(["gmsh", "-3", "-format", "msh41", "-setnumber", "hc", str(hc),
-                    "-setnumber", "t", str(THICKNESS), GEO, "-o", msh],
-                   check=True, capture_output=True)
-    nodes, hexes, quads = read_msh(msh)
-    h_measured = contact_size(nodes, quads)
-    scene = os.path.join(a.out, f"line-{tag}.toml")
-    with open(scene, "w") as f:
-        f.write(SCENE.format(hc=hc, msh=os.path.basename(msh), e=YOUNGS, nu=POISSON,
-                             approach=-APPROACH, radius=RADIUS, half=THICKNESS / 2))
-    ours = [run_contactlink(a.bin, a.np, scene, a.extra) for _ in range(a.repeats)]
-    row = dict(ours[0])
-    row["wall"] = statistics.median(r["wall"] for r in ours)
-    deck = os.path.join(a.out, f"ccx-{tag}.inp")
-    # The pair's penalty as the task states it: slope 10 E / h_c.
-    write_deck(deck, nodes, hexes, quads, 10.0 * YOUNGS / hc)
-    walls = []
-    for _ in range(a.repeats):
-        walls.append(run_ccx(deck))
-    ccx_newton_its, ccx_increments = ccx_newton(deck[:-4] + ".sta")
-    e_p0, e_b = ccx_errors(deck[:-4], nodes, quads)
-    row.update(size=f"b/{divisor}", hc=hc, hc_mesh=h_measured,
-               ccx_wall=statistics.median(walls), ccx_newton=ccx_newton_its,
-               ccx_increments=ccx_increments, ccx_e_p0=e_p0, ccx_e_b=e_b)
-    row["ratio"] = row["wall"] / row["ccx_wall"]
+def median_run(a, scene, repeats, contact=True):
+    runs = [run_contactlink(a, scene, contact) for _ in range(repeats)]
+    row = dict(runs[0])
+    for key in ("wall", "cpu"):
+        row[key] = statistics.median(r[key] for r in runs)
+    row["solve"] = statistics.median(r["solve"] for r in runs)
     return row
 
 
+def run_peer(deck, repeats):
+    """(wall, CPU seconds, Newton iterations, increments) of ccx on a deck."""
+    walls, cpus = [], []
+    for _ in range(repeats):
+        c0 = children_cpu()
+        try:
+            walls.append(ccx.run_ccx(deck))
+        except RuntimeError as e:
+            sys.exit(str(e))
+        cpus.append(children_cpu() - c0)
+    newton, increments = ccx.ccx_newton(deck[:-4] + ".sta")
+    return statistics.median(walls), statistics.median(cpus), newton, increments
+
+
+def ccx_fit(job, nodes, slave_nodes, load_of, exact_of, point):
+    """(p0 error, width error) of a CalculiX run against Hertz for the load
+    its own reaction gives."""
+    force = ccx.read_dat_total(job + ".dat", "NTOP")
+    pressure = ccx.read_frd_pressure(job + ".frd")
+    if force is None or not pressure:
+        sys.exit(f"{job}: no total force or contact pressure in the CalculiX output")
+    slave = sorted(set(slave_nodes))
+    fit = hertz.fit_profile([nodes[t] for t in slave], [pressure.get(t, 0.0) for t in slave],
+                            point=point)
+    if fit is None:
+        sys.exit(f"{job}: too few loaded slave nodes for a Hertz fit")
+    return hertz.errors(exact_of(load_of(force)), *fit)
+
+
+def line_contact_size(nodes, quads):
+    """The smallest in-plane (x-z) edge of the slave surface near the first
+    contact point: the h_c the mesh really has."""
+    best = math.inf
+    for q in quads["cylinder.curved"]:
+        for a, b in zip(q, q[1:] + q[:1]):
+            pa, pb = nodes[a], nodes[b]
+            if abs(pa[1] - pb[1]) > 1e-12 or max(abs(pa[0]), abs(pb[0])) > 2 * B_TARGET:
+                continue
+            best = min(best, math.hypot(pa[0] - pb[0], pa[2] - pb[2]))
+    return best
+
+
+def one_line(a, divisor):
+    hc = B_TARGET / divisor
+    stem = os.path.join(a.out, f"line-b{divisor}")
+    msh = stem + ".msh"
+    subprocess.run(["gmsh", "-3", "-format", "msh41", "-setnumber", "hc", str(hc),
+                    "-setnumber", "t", str(THICKNESS), GEO, "-o", msh],
+                   check=True, capture_output=True)
+    nodes, hexes, quads = meshes.read_msh(msh)
+    scene, plain = write_scenes(stem, LINE_SCENE, LINE_CONTACT, LINE_TAIL, LINE_HERTZ,
+                                hc=hc, msh=os.path.basename(msh), e=YOUNGS, nu=POISSON,
+                                indenter="cylinder", approach=-APPROACH, radius=RADIUS,
+                                half=THICKNESS / 2)
+    nsets = {"NBOTTOM": [t for q in quads["block.bottom"] for t in q],
+             "NSYM": [t for s in ("block.symmetry", "cylinder.symmetry") for q in quads[s] for t in q],
+             "NTOP": [t for q in quads["cylinder.top"] for t in q]}
+    surfaces = {"SSLAVE": quads["cylinder.curved"], "SMASTER": quads["block.top"]}
+    fixed = ["NBOTTOM, 1, 3, 0.0", "NSYM, 1, 1, 0.0", "NALL, 2, 2, 0.0"]
+    step = ["NTOP, 1, 1, 0.0", f"NTOP, 3, 3, {-APPROACH}"]
+    deck = os.path.join(a.out, f"ccx-line-b{divisor}.inp")
+    # The pair's penalty: slope 10 E / h_c.
+    ccx.write_deck(deck, "Hertz line contact, half model", nodes, hexes, ["block", "cylinder"],
+                   nsets, surfaces, fixed, step, "NTOP", (YOUNGS, POISSON),
+                   pair=("SSLAVE", "SMASTER", 10.0 * YOUNGS / hc))
+    row = {"case": "line", "size": f"b/{divisor}", "hc": hc,
+           "hc_mesh": line_contact_size(nodes, quads), "deck": deck}
+    if a.dry_run:
+        return row
+    row.update(median_run(a, scene, a.repeats))
+    p = median_run(a, plain, a.repeats, contact=False)
+    row.update(plain_wall=p["wall"], plain_cpu=p["cpu"], plain_solve=p["solve"],
+               plain_newton=p["newton"])
+    (row["ccx_wall"], row["ccx_cpu"], row["ccx_newton"],
+     row["ccx_increments"]) = run_peer(deck, a.repeats)
+    # Half model: the load per unit length is the force over half the thickness.
+    row["ccx_e_p0"], row["ccx_e_w"] = ccx_fit(
+        deck[:-4], nodes, [t for q in quads["cylinder.curved"] for t in q],
+        lambda f: 2.0 * abs(f[2]) / THICKNESS, lambda p: hertz.line(p, RADIUS, E_STAR), False)
+    return row
+
+
+def one_sphere(a, hc):
+    stem = os.path.join(a.out, f"sphere-h{hc:g}")
+    scene, plain = write_scenes(stem, SPHERE_SCENE, SPHERE_CONTACT, SPHERE_TAIL, SPHERE_HERTZ,
+                                hc=hc, e=YOUNGS, nu=POISSON, indenter="sphere",
+                                radius=SPHERE_RADIUS, push=-SPHERE_PUSH)
+    # The plain solve first: its result file holds the mesh the deck is
+    # written from (the contact solve's is the same mesh).
+    p = median_run(a, plain, 1 if a.dry_run else a.sphere_repeats, contact=False)
+    nodes, hexes, facets, node_sets = meshes.read_result_mesh(plain[:-5] + ".h5")
+    nsets = {"NBOTTOM": node_sets["block.bottom"], "NTOP": node_sets["sphere.top"]}
+    surfaces = {"SSLAVE": facets["sphere.curved"], "SMASTER": facets["block.top"]}
+    fixed = ["NBOTTOM, 1, 3, 0.0"]
+    step = ["NTOP, 1, 2, 0.0", f"NTOP, 3, 3, {-SPHERE_PUSH}"]
+    deck = os.path.join(a.out, f"ccx-sphere-h{hc:g}.inp")
+    ccx.write_deck(deck, "Hertz point contact, built-in hertz-sphere mesh", nodes, hexes,
+                   ["block", "sphere"], nsets, surfaces, fixed, step, "NTOP", (YOUNGS, POISSON),
+                   pair=("SSLAVE", "SMASTER", 10.0 * YOUNGS / hc))
+    row = {"case": "sphere", "size": f"h={hc:g}", "hc": hc, "hc_mesh": hc, "deck": deck,
+           "plain_wall": p["wall"], "plain_cpu": p["cpu"], "plain_solve": p["solve"],
+           "plain_newton": p["newton"]}
+    if a.dry_run:
+        return row
+    row.update(median_run(a, scene, a.sphere_repeats))
+    (row["ccx_wall"], row["ccx_cpu"], row["ccx_newton"],
+     row["ccx_increments"]) = run_peer(deck, a.sphere_repeats)
+    row["ccx_e_p0"], row["ccx_e_w"] = ccx_fit(
+        deck[:-4], nodes, [t for q in facets["sphere.curved"] for t in q],
+        lambda f: abs(f[2]), lambda f: hertz.point(f, SPHERE_RADIUS, E_STAR), True)
+    return row
+
+
+def print_row(r):
+    print(f"{r['size']:>6} {r['dofs']:>8} | {r['wall']:7.2f} {r['newton']:6d} {r['uzawa']:5d} "
+          f"{r['steps']:5d} {100 * r['e_p0']:+7.2f}% {100 * r['e_w']:+7.2f}% | "
+          f"{r['ccx_wall']:7.2f} {r['ccx_newton']:6d} {r['ccx_increments']:4d} "
+          f"{100 * r['ccx_e_p0']:+7.2f}% {100 * r['ccx_e_w']:+7.2f}% | {r['ratio']:8.2f} | "
+          f"{r['solve']:7.2f} {r['plain_solve']:7.2f} {r['plain_newton']:6d} "
+          f"{r['contact_plain']:7.2f}", flush=True)
+
+
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--sizes", default="5,10,20,40", help="h_c = b / each")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cases", default="line,sphere", help="line, sphere or both")
+    ap.add_argument("--sizes", default="5,10,20,40", help="line: h_c = b / each")
+    ap.add_argument("--sphere-sizes", default="0.5,0.35", help="sphere: h_c, each")
     ap.add_argument("--np", type=int, default=1, help="contactlink ranks (CalculiX: one thread)")
-    ap.add_argument("--repeats", type=int, default=1)
+    ap.add_argument("--repeats", type=int, default=1, help="runs per line size (median)")
+    ap.add_argument("--sphere-repeats", type=int, default=1, help="runs per sphere size (median)")
     ap.add_argument("--out", default="bench-results/peers")
     ap.add_argument("--bin", default="target/release/contactlink")
     ap.add_argument("--set", dest="extra", action="append", default=[],
                     help="a contactlink --set override for every run (repeatable)")
+    ap.add_argument("--dry-run", action="store_true",
+                    help="write meshes, scenes and decks; run no solve but the sphere's plain one")
     a = ap.parse_args()
     a.extra = [x for s in a.extra for x in ("--set", s)]
-    for tool in ("gmsh", "ccx"):
+    cases = [c.strip() for c in a.cases.split(",") if c.strip()]
+    for c in cases:
+        if c not in ("line", "sphere"):
+            sys.exit(f"--cases: '{c}' is not line or sphere")
+    for tool in ("gmsh",) * ("line" in cases) + (() if a.dry_run else ("ccx",)):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
             sys.exit(f"{tool} not found: run `bash scripts/install-deps.sh --peers`")
     os.makedirs(a.out, exist_ok=True)
+    plan = [("line", one_line, [int(v) for v in a.sizes.split(",")], a.repeats,
+             "Hertz line contact, half model, b ≈ 0.1 R"),
+            ("sphere", one_sphere, [float(v) for v in a.sphere_sizes.split(",")],
+             a.sphere_repeats, "Hertz point contact, built-in hertz-sphere mesh, a ≈ 0.1 R")]
     rows = []
-    print(f"Hertz line contact, half model, b ≈ 0.1 R; contactlink on {a.np} rank(s), "
-          f"CalculiX on one thread; wall time of the whole process, median of {a.repeats}")
-    head = (f"{'h_c':>6} {'DOFs':>8} | {'ours s':>7} {'Newton':>6} {'Uzawa':>5} {'steps':>5} "
-            f"{'e_p0':>8} {'e_b':>8} | {'ccx s':>7} {'Newton':>6} {'incs':>4} "
-            f"{'e_p0':>8} {'e_b':>8} | {'ours/ccx':>8}")
-    print(head)
-    for d in [int(v) for v in a.sizes.split(",")]:
-        r = one_size(a, d)
-        rows.append(r)
-        print(f"{r['size']:>6} {r['dofs']:>8} | {r['wall']:7.2f} {r['newton']:6d} {r['uzawa']:5d} "
-              f"{r['steps']:5d} {100 * r['e_p0']:+7.2f}% {100 * r['e_b']:+7.2f}% | "
-              f"{r['ccx_wall']:7.2f} {r['ccx_newton']:6d} {r['ccx_increments']:4d} "
-              f"{100 * r['ccx_e_p0']:+7.2f}% {100 * r['ccx_e_b']:+7.2f}% | {r['ratio']:8.2f}",
-              flush=True)
-    keys = ["size", "hc", "hc_mesh", "dofs", "wall", "newton", "uzawa", "steps", "cutbacks",
-            "e_p0", "e_b", "ccx_wall", "ccx_newton", "ccx_increments", "ccx_e_p0", "ccx_e_b",
-            "ratio"]
+    for case, run, sizes, repeats, title in plan:
+        if case not in cases:
+            continue
+        if a.dry_run:
+            for s in sizes:
+                r = run(a, s)
+                rows.append(r)
+                print(f"{case} {r['size']}: deck {r['deck']}")
+            continue
+        print(f"{title}; contactlink on {a.np} rank(s), CalculiX on one thread; wall time of "
+              f"the whole process, median of {repeats}; contact/plain: contactlink's solve "
+              f"seconds (`done:` line)")
+        print(f"{'h_c':>6} {'DOFs':>8} | {'ours s':>7} {'Newton':>6} {'Uzawa':>5} {'steps':>5} "
+              f"{'e_p0':>8} {'e_w':>8} | {'ccx s':>7} {'Newton':>6} {'incs':>4} "
+              f"{'e_p0':>8} {'e_w':>8} | {'ours/ccx':>8} | {'solve':>7} {'plain':>7} "
+              f"{'Newton':>6} {'c/plain':>7}")
+        for s in sizes:
+            r = run(a, s)
+            r["ratio"] = r["wall"] / r["ccx_wall"]
+            r["cpu_ratio"] = r["cpu"] / r["ccx_cpu"]
+            r["contact_plain"] = r["solve"] / r["plain_solve"]
+            rows.append(r)
+            print_row(r)
+    if a.dry_run:
+        return
+    keys = ["case", "size", "hc", "hc_mesh", "dofs", "wall", "cpu", "solve", "newton", "uzawa",
+            "steps", "e_p0", "e_w", "ccx_wall", "ccx_cpu", "ccx_newton", "ccx_increments",
+            "ccx_e_p0", "ccx_e_w", "ratio", "cpu_ratio", "plain_wall", "plain_cpu", "plain_solve",
+            "plain_newton", "contact_plain"]
     path = os.path.join(a.out, "peers.csv")
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
