@@ -38,6 +38,10 @@ pub struct SolverSettings {
     /// first Uzawa iteration with every frictionless pair's penalty divided
     /// by this factor (1: off); see `solve::uzawa`.
     pub first_contact_softening: f64,
+    /// The first Uzawa iteration of a step that starts with no contact
+    /// assembles the frictionless links' tangent without its terms in the
+    /// pressure times the derivatives of the normal (see `solve::uzawa`).
+    pub first_contact_main_tangent: bool,
 }
 
 /// Work a run reuses instead of redoing.
@@ -80,6 +84,7 @@ impl Default for SolverSettings {
             extrapolate: false,
             uzawa_forcing: DEFAULT_FORCING,
             first_contact_softening: 1.0,
+            first_contact_main_tangent: true,
         }
     }
 }

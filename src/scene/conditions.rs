@@ -165,6 +165,9 @@ impl Scene {
                     ))
                 }
             },
+            first_contact_main_tangent: s
+                .first_contact_main_tangent
+                .unwrap_or(d.first_contact_main_tangent),
         })
     }
 }

@@ -315,6 +315,9 @@ pub struct SolverSection {
     /// Penalty divisor of the first Uzawa iteration of a step without
     /// contact (default 1: off).
     pub first_contact_softening: Option<f64>,
+    /// Main-part contact tangent in the first Uzawa iteration of a step
+    /// without contact (default true).
+    pub first_contact_main_tangent: Option<bool>,
 }
 
 #[derive(Debug, Deserialize, Default)]

@@ -441,6 +441,7 @@ impl LoadSteps<'_> {
             reuse_preconditioner: solver.reuse.preconditioner,
             forcing: solver.uzawa_forcing,
             softening: solver.first_contact_softening,
+            main_part_tangent: solver.first_contact_main_tangent,
         };
         self.stage_solve
             .scope(|| uzawa_loop(world, &mut ctx, mech, target))

@@ -34,6 +34,9 @@ pub(super) struct StepContext<'s> {
     /// Penalty divisor of a contact-free step's first Uzawa iteration
     /// (1: off; see `soften_first_contact`).
     pub(super) softening: f64,
+    /// Whether a contact-free step's first Uzawa iteration assembles the
+    /// links' main-part tangent (see `main_part_tangent`).
+    pub(super) main_part_tangent: bool,
 }
 
 /// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
@@ -63,6 +66,8 @@ pub(super) fn uzawa_loop(
     let softening = ctx.softening;
     let mut softened =
         softening > 1.0 && !frictional && soften_first_contact(world, mech.contact, softening);
+    let mut main_part =
+        ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
     let result = uzawa_rounds(
         world,
         ctx,
@@ -70,9 +75,12 @@ pub(super) fn uzawa_loop(
         factor,
         &inner,
         (stol, max_it),
-        &mut softened,
+        (&mut softened, &mut main_part),
     );
     restore_penalties(mech, &mut softened, softening);
+    if main_part {
+        main_part_tangent(world, mech.contact, false);
+    }
     ctx.snes.set_tolerances(atol, rtol, stol, max_it)?;
     result
 }
@@ -87,7 +95,7 @@ fn uzawa_rounds(
     factor: f64,
     inner: &tolerance::InnerTolerance,
     (stol, max_it): (f64, usize),
-    softened: &mut bool,
+    (softened, main_part): (&mut bool, &mut bool),
 ) -> Result<StepResult> {
     let softening = ctx.softening;
     let StepContext {
@@ -137,6 +145,10 @@ fn uzawa_rounds(
             return Ok(Ok((outcome, 0, Vec::new())));
         }
         let stats = update_multipliers(world, stages, times, mech, x, factor)?;
+        if std::mem::take(main_part) {
+            // The multipliers carry the contact from here: the full tangent.
+            main_part_tangent(world, mech.contact, false);
+        }
         if *softened {
             // The soft iteration has given the multipliers a first
             // estimate: from here on the pairs' own penalties, and fresh
@@ -210,6 +222,41 @@ fn soften_first_contact(
         }
     }
     soften
+}
+
+/// Collective: with `on`, switches every pair to the main-part tangent
+/// when no pair has a multiplier in contact on any rank, and says whether
+/// it did; without, switches them all back (`[solver]
+/// first_contact_main_tangent`, on by default).
+///
+/// A step that starts with no contact solves its first Uzawa iteration as
+/// a pure penalty problem from a state where the first iterate penetrates
+/// deeply (the bodies move by the whole approach before any link closes),
+/// so the trial pressures εN |gN| are far above the contact pressure. The
+/// consistent tangent's terms in pN times the derivatives of the normal and
+/// of the master shape values are then large and indefinite, and the
+/// Newton steps they give open points inside the contact zone and close
+/// them again (graded Hertz line, h_c = b/20: holes across the zone at
+/// every iteration, the l2 line search cut to λ = 0.05–0.19, 10 Newton
+/// iterations in that first Uzawa iteration; b/40: 18). Without them (only
+/// εN (N ν)(N ν)ᵀ, symmetric and positive semi-definite) the zone grows
+/// monotonically to its final size: 4 iterations at b/20, 3 at b/40. The
+/// residual is unchanged, so the solution is too; the later Uzawa
+/// iterations, near the solution, use the consistent tangent again.
+fn main_part_tangent(world: &impl Communicator, pairs: &mut [ContactPair], on: bool) -> bool {
+    let switch = if on {
+        let local: usize = pairs.iter().map(|p| p.multiplier_states().0).sum();
+        let [active] = parallel::sum_usize(world, [local]);
+        !pairs.is_empty() && active == 0
+    } else {
+        true
+    };
+    if switch {
+        for p in pairs.iter_mut() {
+            p.set_main_part_tangent(on);
+        }
+    }
+    switch && on
 }
 
 /// Undoes `soften_first_contact` (once) and forgets the preconditioner

@@ -26,7 +26,14 @@ pub(super) fn link_forces<T: Scalar>(
     let n_master = master.len();
     // Closed branch (the caller decided it from the f64 gap): pN = λN − εN gN.
     let pressure = trial_pressure(input.lambda_n, input.penalty, kin.gap);
-    let mut common = dual::scale(&kin.normal, -pressure);
+    // The main-part tangent: ν and N²_b as constants, so only the pressure
+    // carries derivatives (in the f64 pass this changes nothing).
+    let main_part = input.main_part_tangent && input.friction.is_none();
+    let mut common = if main_part {
+        dual::scale(&dual::constant3::<T>(dual::re3(&kin.normal)), -pressure)
+    } else {
+        dual::scale(&kin.normal, -pressure)
+    };
     let mut master_extra = [T::from_f64(0.0); MAX_FACET_NODES];
     let mut state = None;
     if let Some(friction) = &input.friction {
@@ -92,7 +99,12 @@ pub(super) fn link_forces<T: Scalar>(
     {
         for (i, (sep, c)) in kin.separation.iter().zip(&common).enumerate() {
             let extra = *sep * *extra_b * input.weight;
-            emit(3 * (ns + b) + i, extra - *c * *n_b);
+            let n_b = if main_part {
+                T::from_f64(n_b.re())
+            } else {
+                *n_b
+            };
+            emit(3 * (ns + b) + i, extra - *c * n_b);
         }
     }
     state

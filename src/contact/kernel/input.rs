@@ -122,6 +122,11 @@ pub struct LinkInput<'a> {
     pub penalty: f64,
     /// Coulomb friction; `None` is frictionless (no tangential work at all).
     pub friction: Option<Friction<'a>>,
+    /// Frictionless only: the tangent keeps its main part `εN (N ν)(N ν)ᵀ`
+    /// and drops the terms in `pN` times the derivatives of ν and of the
+    /// master shape values (the residual is unchanged). See
+    /// `solve::uzawa::main_part_tangent`.
+    pub main_part_tangent: bool,
 }
 
 /// What a link evaluation reports (f64 values, no derivatives).

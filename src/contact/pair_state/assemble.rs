@@ -184,6 +184,7 @@ impl ContactPair {
             lambda_n: self.multipliers.lambda[qp],
             penalty: self.facet_penalty[sf],
             friction,
+            main_part_tangent: self.main_part_tangent,
         }
     }
 

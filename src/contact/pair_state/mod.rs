@@ -81,6 +81,8 @@ pub struct ContactPair {
     pub mortar: Option<MortarPair>,
     /// See `tangent_signature`.
     tangent_signature: u64,
+    /// See `set_main_part_tangent`.
+    main_part_tangent: bool,
 }
 
 impl ContactPair {
@@ -170,6 +172,7 @@ impl ContactPair {
             penalty,
             facet_penalty,
             tangent_signature: 0,
+            main_part_tangent: false,
             search_distance,
             links: Vec::new(),
             pattern_key: 0,
@@ -198,6 +201,13 @@ impl ContactPair {
     pub fn rigid_shift(&self, factor: f64) -> [f64; 3] {
         let a = self.spec.motion_amplitude.at(factor);
         self.spec.motion.map(|c| c * a)
+    }
+
+    /// Whether the frictionless links' tangent keeps only its main part
+    /// (see `kernel::LinkInput::main_part_tangent`; the residual is the
+    /// same either way). A mortar pair and friction ignore it.
+    pub fn set_main_part_tangent(&mut self, on: bool) {
+        self.main_part_tangent = on;
     }
 
     /// Whether the pair computes friction.

@@ -269,6 +269,7 @@ fn sliding_block_transmits_mu_times_pressure() {
                     history,
                     rate: None,
                 }),
+                main_part_tangent: false,
             };
             let s = evaluate(&input);
             let f = s.friction.unwrap();

@@ -72,6 +72,7 @@ impl Case {
                     dv_dx: *c,
                 }),
             }),
+            main_part_tangent: false,
         }
     }
 

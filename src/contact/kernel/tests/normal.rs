@@ -39,6 +39,32 @@ fn frictionless_tangent_is_symmetric() {
 }
 
 #[test]
+fn main_part_tangent_is_the_pressure_derivative_alone() {
+    // r = −pN w c with c = ∂gN/∂u, so the main part εN w c cᵀ is
+    // εN / (pN² w) r rᵀ; the residual itself does not change.
+    let mut geometric = 0.0f64;
+    for (name, case) in all_cases() {
+        let full = case.input();
+        let main = LinkInput {
+            main_part_tangent: true,
+            ..case.input()
+        };
+        let n = case.n();
+        let (mut r, mut k) = (vec![0.0; n], vec![0.0; n * n]);
+        let state = residual_tangent(&main, &mut r, Some(&mut k));
+        let (mut r_full, mut k_full) = (vec![0.0; n], vec![0.0; n * n]);
+        residual_tangent(&full, &mut r_full, Some(&mut k_full));
+        assert!(rel_err(&r, &r_full) < 1e-14, "{name}: residual changed");
+        let scale = full.penalty / (state.pressure * state.pressure * full.weight);
+        let outer: Vec<f64> = (0..n * n).map(|ij| scale * r[ij / n] * r[ij % n]).collect();
+        let err = rel_err(&k, &outer);
+        assert!(err < 1e-10, "{name}: main part vs εN c cᵀ = {err:e}");
+        geometric = geometric.max(rel_err(&k_full, &k));
+    }
+    assert!(geometric > 1e-3, "no case has geometric terms to drop");
+}
+
+#[test]
 fn residual_only_path_matches_dual_path() {
     for (name, case) in all_cases() {
         let (r, _, _) = case.residual_and_tangent();
@@ -172,6 +198,7 @@ fn pressed_totals(
             lambda_n: 0.7,
             penalty: 50.0,
             friction: None,
+            main_part_tangent: false,
         };
         let mut r = vec![0.0; dof_count(&input)];
         let s = residual_tangent(&input, &mut r, None);
@@ -388,6 +415,7 @@ fn rigid_sphere_values() {
         lambda_n: 0.0,
         penalty: 10.0,
         friction: None,
+        main_part_tangent: false,
     };
     let s = evaluate(&input);
     assert!((s.gap + 0.1).abs() < 1e-15);
