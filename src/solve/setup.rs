@@ -114,7 +114,7 @@ pub(super) fn set_solver_defaults(
         // Galerkin products' intermediate data (P^T A P keeps A P and the
         // transpose of P for a numeric refresh that never comes). Several
         // ranks only gain (167k-DOF plain sphere, largest of 4 ranks 226.3
-        // -> 215.5 MiB, of 2 376.2 -> 362.1, 1 rank unchanged; same CG
+        // -> 215.5 MiB, of 2 376.1 -> 361.8, 1 rank unchanged; same CG
         // iterations). Where the matrix changes and GAMG reuses its
         // interpolation, the cleared products would be formed again from
         // scratch at every set-up.
