@@ -29,6 +29,10 @@ pub(super) struct TangentKind {
     pub(super) linear_bulk: bool,
     /// The model has contact pairs.
     pub(super) contact: bool,
+    /// Nothing is ever added to the linear stiffness (linear bodies, no
+    /// contact, inertia or follower load): the Jacobian never changes, so
+    /// the preconditioner is set up once.
+    pub(super) constant: bool,
 }
 
 /// Collective: the kind of tangent the model has, the same on every rank.
@@ -46,10 +50,12 @@ pub(super) fn tangent_kind(
     let follower = parallel::any_rank(world, loads.has_follower());
     let symmetric =
         !follower && !unsymmetric && model.materials.iter().all(Material::tangent_is_symmetric);
+    let linear_bulk = model.materials.iter().all(Material::is_linear);
     TangentKind {
         symmetric,
-        linear_bulk: model.materials.iter().all(Material::is_linear),
+        linear_bulk,
         contact: !contact.is_empty(),
+        constant: linear_bulk && contact.is_empty() && !follower && model.dynamics.is_none(),
     }
 }
 
@@ -63,6 +69,7 @@ pub(super) fn set_solver_defaults(
         symmetric,
         linear_bulk,
         contact,
+        constant,
     } = tangent;
     petsc::options::clear_defaults()?;
     petsc::options::insert_string_defaults(&settings.petsc_options)?;
@@ -101,6 +108,17 @@ pub(super) fn set_solver_defaults(
     }
     petsc::options::set_default("-pc_type", "gamg")?;
     petsc::options::set_default("-ksp_rtol", "1e-10")?;
+    if constant && settings.reuse.linear_stiffness {
+        // The Jacobian is set once, so GAMG's set-up runs once: free the
+        // Galerkin products' intermediate data (P^T A P keeps A P and the
+        // transpose of P for a numeric refresh that never comes). Several
+        // ranks only gain (167k-DOF plain sphere, largest of 4 ranks 226.3
+        // -> 215.5 MiB, of 2 376.1 -> 361.8, 1 rank unchanged; same CG
+        // iterations). Where the matrix changes and GAMG reuses its
+        // interpolation, the cleared products would be formed again from
+        // scratch at every set-up.
+        petsc::options::set_default("-mat_product_clear", "true")?;
+    }
     if contact {
         // Eisenstat–Walker: each linear solve only as tight as Newton's
         // progress needs (hertz-sphere h = 0.35, 2 ranks: 977 -> 152 GMRES

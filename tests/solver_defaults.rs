@@ -1,0 +1,57 @@
+//! The PETSc defaults each kind of run gets (`-options_view` prints the
+//! option table at the end of the run, defaults included).
+mod common;
+use common::*;
+
+/// The option table a run ended with.
+fn option_table(args: &[&str]) -> String {
+    let mut all = vec!["run"];
+    all.extend_from_slice(args);
+    all.push("-options_view");
+    let o = run(&all);
+    let t = text(&o);
+    assert!(o.status.success(), "{args:?} failed:\n{t}");
+    t
+}
+
+#[test]
+fn a_plain_linear_iterative_run_frees_the_galerkin_intermediates() {
+    // Linear bodies, no contact: the Jacobian is set once, so GAMG's
+    // products need not keep their intermediate data.
+    let t = option_table(&[
+        "scenes/cantilever.toml",
+        "--set",
+        "solver.direct_max_dofs=0",
+    ]);
+    assert!(t.contains("-pc_type gamg"), "{t}");
+    assert!(t.contains("-mat_product_clear true"), "{t}");
+}
+
+#[test]
+fn runs_whose_matrix_changes_keep_the_galerkin_intermediates() {
+    // Contact, a hyperelastic body, the stiffness assembled every time:
+    // GAMG reuses its interpolation and refreshes the products numerically.
+    for args in [
+        &[
+            "scenes/block-on-plane.toml",
+            "--set",
+            "solver.direct_max_dofs=0",
+        ][..],
+        &[
+            "scenes/uniaxial-stretch.toml",
+            "--set",
+            "solver.direct_max_dofs=0",
+        ][..],
+        &[
+            "scenes/cantilever.toml",
+            "--set",
+            "solver.direct_max_dofs=0",
+            "--set",
+            "solver.reuse_linear_stiffness=false",
+        ][..],
+    ] {
+        let t = option_table(args);
+        assert!(t.contains("-pc_type gamg"), "{args:?}: {t}");
+        assert!(!t.contains("-mat_product_clear"), "{args:?}: {t}");
+    }
+}
