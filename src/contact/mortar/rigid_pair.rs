@@ -83,6 +83,11 @@ struct RigidEvaluation<T> {
 }
 
 impl MortarPair {
+    /// Whether the master is a rigid analytic surface.
+    pub fn is_rigid(&self) -> bool {
+        self.rigid.is_some()
+    }
+
     fn rigid_master(&self) -> &RigidMaster {
         match &self.rigid {
             Some(r) => r,

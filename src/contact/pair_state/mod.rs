@@ -204,9 +204,11 @@ impl ContactPair {
 
     /// Whether the pair's tangent is symmetric: frictionless links (the
     /// Hessian of a potential). The mortar residual is not a gradient (the
-    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric.
+    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric;
+    /// against a rigid master it is (−p_j ∂g̃_j/∂x exactly, nothing held
+    /// fixed: docs/formulation.md §13.5), symmetric to rounding.
     pub fn tangent_is_symmetric(&self) -> bool {
-        !self.has_friction() && self.mortar.is_none()
+        !self.has_friction() && self.mortar.as_ref().is_none_or(MortarPair::is_rigid)
     }
 }
 
