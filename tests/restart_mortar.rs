@@ -1,8 +1,9 @@
 //! `run --restart` of mortar pairs: a frictional mortar run cut short and
 //! continued from its last converged step (nodal λ, λT and slip origins read
 //! back) gives the uninterrupted run's steps, against a rigid plane and
-//! against a deformable block, on 1 and 2 ranks; without λT or the slip
-//! origins it would not.
+//! against a deformable block, on 1 and 2 ranks, and with a penalty the
+//! first run raised; without λT, the slip origins or the raised penalty it
+//! would not.
 mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_nodal};
@@ -215,4 +216,17 @@ fn frictional_mortar_between_blocks_continues_exactly() {
     ] {
         continued_run_matches(scene, &[], 6, ranks, "interface", history);
     }
+}
+
+#[test]
+fn a_raised_mortar_penalty_carries_over() {
+    // Two Uzawa iterations allowed: the pulled block's steps raise the
+    // penalty ×10, and the continued run must go on with the raised one.
+    let extra = [
+        "--set",
+        "contact.formulation=mortar",
+        "--set",
+        "contact.max_uzawa=2",
+    ];
+    continued_run_matches("block-slide", &extra, 11, 1, "floor", layout::PAIR_PENALTY);
 }
