@@ -8,7 +8,7 @@
 //! same contact pairs; anything else is an error naming the file and what
 //! differs, raised before any solve.
 use crate::contact::multipliers::FrictionRecord;
-use crate::contact::pair_state::{FrictionRows, RestartRows};
+use crate::contact::pair_state::{FrictionRows, MortarRows, RestartRows};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::output::{layout, read_dataset, read_nodal, read_step_attrs, OutputError};
@@ -43,7 +43,21 @@ pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
     let pairs = model
         .contact
         .iter()
-        .map(|p| read_pair(path, step, &p.name, p.active_friction().is_some()))
+        .map(|p| {
+            let mut rows = read_pair(path, step, &p.name, p.active_friction().is_some())?;
+            if p.formulation == crate::model::Formulation::Mortar {
+                let friction = p.active_friction().is_some();
+                rows.mortar = Some(read_mortar(
+                    path,
+                    step,
+                    &p.name,
+                    n,
+                    friction,
+                    info.load_factor,
+                )?);
+            }
+            Ok(rows)
+        })
         .collect::<Result<Vec<_>>>()?;
     Ok(RestartState {
         path: path.to_path_buf(),
@@ -133,6 +147,37 @@ fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<Res
         penalty,
         lambda,
         friction,
+        mortar: None,
+    })
+}
+
+/// A mortar pair's nodal datasets (`nodes` rows each).
+fn read_mortar(
+    path: &Path,
+    step: usize,
+    name: &str,
+    nodes: usize,
+    friction: bool,
+    load_factor: f64,
+) -> Result<MortarRows> {
+    let field = |f: &str| layout::pair_dataset(name, f);
+    let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
+        let v = read_columns(path, step, &field(f), nodes, 3)?;
+        Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    };
+    let (lambda_t, slip_origin) = if friction {
+        (
+            Some(triples(layout::PAIR_NODE_LAMBDA_T)?),
+            Some(triples(layout::PAIR_NODE_SLIP_ORIGIN)?),
+        )
+    } else {
+        (None, None)
+    };
+    Ok(MortarRows {
+        lambda: read_columns(path, step, &field(layout::PAIR_NODE_LAMBDA), nodes, 1)?,
+        lambda_t,
+        slip_origin,
+        load_factor,
     })
 }
 

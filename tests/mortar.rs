@@ -392,17 +392,4 @@ fn bad_formulation_is_a_scene_error_naming_the_line() {
             .expect("the error line");
         assert!(line.contains("bad.toml:"), "{line}");
     }
-    // Mortar needs a master facet set.
-    let rigid = case.scene("mortar").replace(
-        "master = \"lower.top\"",
-        "rigid = { kind = \"plane\", point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }",
-    );
-    let scene = write(dir.as_path(), "rigid.toml", &rigid);
-    let o = run(&["run", scene.to_str().unwrap(), "-q", "-o", "/dev/null"]);
-    assert!(!o.status.success());
-    assert!(
-        text(&o).contains("needs a master facet set"),
-        "{}",
-        text(&o)
-    );
 }

@@ -73,6 +73,10 @@ pub const PAIR_HISTORY_IDS: &str = "history_ids";
 pub const PAIR_NODE_LAMBDA: &str = "node_lambda";
 pub const PAIR_NODE_WEIGHTED_GAP: &str = "node_weighted_gap";
 pub const PAIR_NODE_TRACTION: &str = "node_traction";
+/// A frictional mortar pair's history for `--restart` (N,3): λT_j, and
+/// where the next step measures slip from (the pair nodes' positions).
+pub const PAIR_NODE_LAMBDA_T: &str = "node_lambda_t";
+pub const PAIR_NODE_SLIP_ORIGIN: &str = "node_slip_origin";
 /// ...and the pair's totals, `(3,)` and `(1,)`.
 pub const PAIR_FORCE: &str = "force";
 pub const PAIR_PENALTY: &str = "penalty";

@@ -150,7 +150,8 @@ impl Hdf5Sink {
 
 impl Hdf5Sink {
     /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
-    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`.
+    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`
+    /// and, with friction, `node_lambda_t` and `node_slip_origin`.
     fn write_mortar_nodes(
         &mut self,
         step: usize,
@@ -158,11 +159,20 @@ impl Hdf5Sink {
         m: &crate::contact::mortar::pair::NodeFields,
     ) -> Result<()> {
         let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
-        for (label, cols, values) in [
+        let flat = |v: &Option<Vec<[f64; 3]>>| -> Option<Vec<f64>> {
+            v.as_ref().map(|l| l.iter().flatten().copied().collect())
+        };
+        let (lambda_t, origin) = (flat(&m.lambda_t), flat(&m.slip_origin));
+        let mut fields = vec![
             (layout::PAIR_NODE_LAMBDA, 1, &m.lambda),
             (layout::PAIR_NODE_WEIGHTED_GAP, 1, &m.weighted_gap),
             (layout::PAIR_NODE_TRACTION, 3, &traction),
-        ] {
+        ];
+        if let (Some(l), Some(o)) = (&lambda_t, &origin) {
+            fields.push((layout::PAIR_NODE_LAMBDA_T, 3, l));
+            fields.push((layout::PAIR_NODE_SLIP_ORIGIN, 3, o));
+        }
+        for (label, cols, values) in fields {
             let order = if cols == 3 {
                 &mut self.natural
             } else {

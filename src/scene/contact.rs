@@ -84,8 +84,7 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
     }
     spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))
         .map_err(|m| Bad::at(&key("motion_amplitude"), m))?;
-    spec.formulation =
-        formulation(mesh, c, &spec, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
+    spec.formulation = formulation(mesh, c, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
     spec.quadrature = match c.quadrature.as_deref() {
         None => default_quadrature(mesh),
         Some("gauss") => SlaveQuadrature::Gauss,
@@ -169,11 +168,10 @@ pub(super) fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 }
 
 /// The pair's `formulation`, checked against what the mortar formulation
-/// supports (a master facet set of quad4 or tri3 facets).
+/// supports (quad4 or tri3 facets; a master facet set or a rigid surface).
 pub(super) fn formulation(
     mesh: &Mesh,
     c: &ContactSection,
-    spec: &PairSpec,
     at: &str,
 ) -> std::result::Result<Formulation, String> {
     let f = match c.formulation.as_deref() {
@@ -190,11 +188,6 @@ pub(super) fn formulation(
         return Err(format!(
             "{at}: formulation \"mortar\" does not support {} facets",
             facet.name()
-        ));
-    }
-    if spec.master.is_rigid() {
-        return Err(format!(
-            "{at}: formulation \"mortar\" needs a master facet set, not a rigid surface"
         ));
     }
     if c.quadrature.is_some() {

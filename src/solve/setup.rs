@@ -42,8 +42,9 @@ pub(super) fn tangent_kind(
     loads: &SurfaceLoads,
     contact: &[ContactPair],
 ) -> TangentKind {
-    // Frictionless links keep the tangent symmetric (it is the Hessian
-    // of a potential); friction, mortar pairs and follower loads do not.
+    // Frictionless links and frictionless mortar pairs on rigid masters
+    // keep the tangent symmetric (it is the Hessian of a potential);
+    // friction, other mortar pairs and follower loads do not.
     // A follower load's facets may sit on some ranks only: the choice is
     // agreed, or the ranks would factor one matrix as LU and LDLᵀ at once.
     let unsymmetric = contact.iter().any(|p| !p.tangent_is_symmetric());

@@ -58,6 +58,8 @@ pub struct Rate<'a> {
     pub dt: f64,
     pub dv_du: f64,
     pub offset: &'a [f64],
+    /// Velocity of a rigid master (its prescribed motion per unit time).
+    pub master_velocity: [f64; 3],
 }
 
 /// One segment's contributions to the node aggregates.
@@ -188,34 +190,45 @@ pub fn node_frictions<T: Scalar>(
         }
     }
     (0..nn)
-        .map(|j| {
-            if !states[j].closed {
-                return NodeFriction::default();
-            }
-            let law = Law {
-                lambda_n: nodal.lambda[j],
-                penalty_n: nodal.penalty[j],
-                area: nodal.area[j],
-                lambda_t: friction.lambda[j],
-                penalty_t: friction.penalty[j],
-                mu: friction.mu,
-            };
-            let var = |v: f64, i: usize| Dual::<AGGREGATES>::variable(v, i);
-            let (t, s, sliding) = traction(
-                var(states[j].weighted_gap, 0),
-                &[0, 1, 2].map(|i| var(normal[j][i], 1 + i)),
-                &[0, 1, 2].map(|i| var(slip[j][i], 4 + i)),
-                &law,
-            );
-            NodeFriction {
-                active: true,
-                sliding,
-                traction: dual::re3(&t),
-                slip: dual::re3(&s),
-                derivative: t.map(|c| c.eps),
-            }
-        })
+        .map(|j| node_law(nodal, friction, states, j, &normal[j], &slip[j]))
         .collect()
+}
+
+/// The law at node `j` (slot) from its aggregates `a_j` (`normal`) and
+/// `ũ_j` (`slip`), with their derivatives; an open node carries none.
+pub(super) fn node_law(
+    nodal: &NodalData,
+    friction: &NodalFriction,
+    states: &[NodeState],
+    j: usize,
+    normal: &[f64; 3],
+    slip: &[f64; 3],
+) -> NodeFriction {
+    if !states[j].closed {
+        return NodeFriction::default();
+    }
+    let law = Law {
+        lambda_n: nodal.lambda[j],
+        penalty_n: nodal.penalty[j],
+        area: nodal.area[j],
+        lambda_t: friction.lambda[j],
+        penalty_t: friction.penalty[j],
+        mu: friction.mu,
+    };
+    let var = |v: f64, i: usize| Dual::<AGGREGATES>::variable(v, i);
+    let (t, s, sliding) = traction(
+        var(states[j].weighted_gap, 0),
+        &[0, 1, 2].map(|i| var(normal[i], 1 + i)),
+        &[0, 1, 2].map(|i| var(slip[i], 4 + i)),
+        &law,
+    );
+    NodeFriction {
+        active: true,
+        sliding,
+        traction: dual::re3(&t),
+        slip: dual::re3(&s),
+        derivative: t.map(|c| c.eps),
+    }
 }
 
 /// The tangential force coefficient of slave row `a` on segment node slot

@@ -12,15 +12,27 @@
 //! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
 //!   state at run time;
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
-//!   tangent of a set of segments.
+//!   tangent of a set of segments;
+//! - `rigid`, `rigid_friction`: the same against a rigid analytic master
+//!   (integrals over the slave facets alone), `rigid_pair` their run-time
+//!   side;
+//! - `pair_output`: the pair's nodal fields, force and point values;
+//!   `pair_restart`: taking them over from a result file.
 pub mod friction;
 pub mod geometry;
 pub mod pair;
+mod pair_output;
+pub mod pair_restart;
+pub mod rigid;
+pub mod rigid_friction;
+mod rigid_pair;
 pub mod segment;
 pub mod system;
 mod tangential;
 
 #[cfg(test)]
 mod friction_tests;
+#[cfg(test)]
+mod rigid_tests;
 #[cfg(test)]
 mod tests;

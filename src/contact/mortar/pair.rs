@@ -11,18 +11,19 @@
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
+use super::rigid_pair::RigidMaster;
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
-use crate::contact::outcome::{PairForce, UzawaStats};
+use crate::contact::outcome::UzawaStats;
 use crate::contact::surfaces::SharedSurface;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
 use crate::mesh::Mesh;
-use crate::model::{FrictionSpec, PairSpec};
+use crate::model::{FrictionSpec, PairSpec, RigidSurface};
 
 /// The nodal fields the output writes, one entry per owned mesh node of
 /// this rank (zero at nodes off the slave surface).
@@ -35,6 +36,11 @@ pub struct NodeFields {
     /// Contact traction on the slave at the node: −λ_j ν_j − λT_j, ν_j the
     /// D-weighted mean of its segments' normals (λT_j = 0 frictionless).
     pub traction: Vec<[f64; 3]>,
+    /// A frictional pair's history a restart reads back (None frictionless):
+    /// the nodal λT_j, and where the next step measures slip from (every
+    /// pair node's position at the end of the step, master nodes included).
+    pub lambda_t: Option<Vec<[f64; 3]>>,
+    pub slip_origin: Option<Vec<[f64; 3]>>,
 }
 
 /// What a cut-back step restores: λ_j and λT_j of the last converged step.
@@ -46,36 +52,49 @@ pub struct MortarSnapshot {
 
 /// One evaluation of the pair: segments, node states and (with friction)
 /// the segments' slip terms and the nodes' friction.
-struct Evaluation<T> {
-    segments: Vec<Segment<T>>,
-    states: Vec<NodeState>,
-    slips: Vec<SegmentSlip<T>>,
-    frictions: Vec<NodeFriction>,
+pub(super) struct Evaluation<T> {
+    pub segments: Vec<Segment<T>>,
+    pub states: Vec<NodeState>,
+    pub slips: Vec<SegmentSlip<T>>,
+    pub frictions: Vec<NodeFriction>,
 }
 
 pub struct MortarPair {
-    facet_type: FacetType,
+    pub(super) facet_type: FacetType,
     /// Slave nodes are ids `0..n`, master nodes follow (n = slave nodes).
-    node_local: Vec<u32>,
-    x_ref: Vec<[f64; 3]>,
-    slave_facets: Vec<[u32; MAX_FACET_NODES]>,
-    master_facets: Vec<[u32; MAX_FACET_NODES]>,
-    assembled: Vec<bool>,
+    pub(super) node_local: Vec<u32>,
+    pub(super) x_ref: Vec<[f64; 3]>,
+    pub(super) slave_facets: Vec<[u32; MAX_FACET_NODES]>,
+    pub(super) master_facets: Vec<[u32; MAX_FACET_NODES]>,
+    pub(super) assembled: Vec<bool>,
     /// Slave facets this rank evaluates (ascending).
-    evaluated: Vec<u32>,
+    pub(super) evaluated: Vec<u32>,
     pub nodal: NodalData,
     /// Per slot: all of the node's facets are evaluated here ...
-    complete: Vec<bool>,
+    pub(super) complete: Vec<bool>,
     /// ... and this rank owns the node.
-    owned: Vec<bool>,
+    pub(super) owned: Vec<bool>,
     /// Per slot: the node's element size (mean shortest edge of its facets).
-    h: Vec<f64>,
-    candidates: Vec<(u32, u32)>,
-    search_distance: f64,
-    rules: MortarRules,
+    pub(super) h: Vec<f64>,
+    pub(super) candidates: Vec<(u32, u32)>,
+    pub(super) search_distance: f64,
+    pub(super) rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
-    owned_mesh_nodes: usize,
-    friction: Option<PairFriction>,
+    pub(super) owned_mesh_nodes: usize,
+    pub(super) friction: Option<PairFriction>,
+    /// A rigid analytic master instead of master facets (none then).
+    pub(super) rigid: Option<RigidMaster>,
+    /// Every pair node's natural (file) number, for restarts.
+    pub(super) natural: Vec<usize>,
+}
+
+/// The master side of a mortar pair.
+#[derive(Debug, Clone, Copy)]
+pub enum MortarMaster<'a> {
+    /// A facet set of a deformable body.
+    Facets(&'a str),
+    /// A rigid analytic surface.
+    Rigid(RigidSurface),
 }
 
 fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
@@ -110,27 +129,31 @@ fn signature<T>(e: &Evaluation<T>) -> u64 {
 }
 
 impl MortarPair {
-    /// `penalty(h)`: the pair's εN for a node of element size `h`;
-    /// `friction`: the pair's Coulomb friction, if it computes any (μ > 0).
+    /// `master`: the master facet set or rigid surface; `penalty(h)`: the
+    /// pair's εN for a node of element size `h`; `friction`: the pair's
+    /// Coulomb friction, if it computes any (μ > 0).
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
         spec: &PairSpec,
-        master_set: &str,
+        master: MortarMaster,
         penalty: impl Fn(f64) -> f64,
         search_distance: f64,
         friction: Option<FrictionSpec>,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
-        let master = SharedSurface::new(mesh, dofs, master_set)?;
+        let (master, rigid) = match master {
+            MortarMaster::Facets(set) => (Some(SharedSurface::new(mesh, dofs, set)?), None),
+            MortarMaster::Rigid(r) => (None, Some(r)),
+        };
         let n_slave = slave.x_ref.len();
         let offset = n_slave as u32;
         let nf = facet_type.nodes();
         let slave_facets: Vec<_> = slave.facets.iter().map(|f| facet_row(&f[..nf])).collect();
         let master_facets: Vec<_> = master
-            .facets
             .iter()
+            .flat_map(|m| &m.facets)
             .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
             .collect();
         let refs = mesh
@@ -207,9 +230,16 @@ impl MortarPair {
             ));
         }
         let mut node_local = slave.node_local;
-        node_local.extend(&master.node_local);
+        let rigid = rigid.map(|r| RigidMaster::new(r, spec, &slots, &h_count));
         let mut x_ref = slave.x_ref;
-        x_ref.extend(&master.x_ref);
+        if let Some(m) = &master {
+            node_local.extend(&m.node_local);
+            x_ref.extend(&m.x_ref);
+        }
+        let natural = node_local
+            .iter()
+            .map(|&l| dofs.natural(LocalNode(l as usize)).0)
+            .collect();
         let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
             facet_type,
@@ -228,10 +258,12 @@ impl MortarPair {
             rules: MortarRules::default(),
             owned_mesh_nodes: dofs.num_owned_nodes(),
             friction,
+            rigid,
+            natural,
         })
     }
 
-    fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
+    pub(super) fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
         self.node_local
             .iter()
             .zip(&self.x_ref)
@@ -262,7 +294,10 @@ impl MortarPair {
     /// The search of a load step: every (evaluated slave, master) facet pair
     /// whose bounding boxes, grown by the search distance, meet. Returns
     /// whether the candidates changed.
-    pub fn search(&mut self, u_local: &[f64]) -> bool {
+    pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
+        if self.rigid.is_some() {
+            return self.rigid_search(u_local, factor);
+        }
         let x = self.positions(u_local);
         let nf = self.facet_type.nodes();
         let bbox = |f: &[u32; MAX_FACET_NODES]| {
@@ -301,17 +336,20 @@ impl MortarPair {
         changed
     }
 
-    fn local_dof(&self, id: u32, c: usize) -> usize {
+    pub(super) fn local_dof(&self, id: u32, c: usize) -> usize {
         DIM * self.node_local[id as usize] as usize + c
     }
 
-    fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
+    pub(super) fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
         dofs.dof(LocalNode(self.node_local[id as usize] as usize), c)
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
     /// (all nodes of its candidate segments), squared into the pattern.
     pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
+        if self.rigid.is_some() {
+            return self.rigid_pattern(dofs, pattern);
+        }
         let nf = self.facet_type.nodes();
         let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
         for &(s, m) in &self.candidates {
@@ -341,7 +379,7 @@ impl MortarPair {
         Ok(())
     }
 
-    fn evaluate<T: system::Seed>(
+    pub(super) fn evaluate<T: system::Seed>(
         &self,
         x: &[[f64; 3]],
         u_local: &[f64],
@@ -379,7 +417,16 @@ impl MortarPair {
         }
     }
 
-    pub fn add_residual(&self, u_local: &[f64], rate: Option<&Rate>, r_local: &mut [f64]) {
+    pub fn add_residual(
+        &self,
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        factor: f64,
+        r_local: &mut [f64],
+    ) {
+        if self.rigid.is_some() {
+            return self.rigid_residual(u_local, rate, factor, r_local);
+        }
         let x = self.positions(u_local);
         let e = self.evaluate::<f64>(&x, u_local, rate);
         let interface = self.interface(&x);
@@ -401,8 +448,12 @@ impl MortarPair {
         dofs: &DofMap,
         u_local: &[f64],
         rate: Option<&Rate>,
+        factor: f64,
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
+        if self.rigid.is_some() {
+            return self.rigid_tangent(dofs, u_local, rate, factor, k);
+        }
         let x = self.positions(u_local);
         let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
         let interface = self.interface(&x);
@@ -419,6 +470,17 @@ impl MortarPair {
                 &mut add,
             );
         }
+        self.add_entries(dofs, entries, k)?;
+        Ok(signature(&e))
+    }
+
+    /// Adds tangent entries `(row, col, value)` by rows into `k`.
+    pub(super) fn add_entries(
+        &self,
+        dofs: &DofMap,
+        mut entries: Vec<(NodeDof, NodeDof, f64)>,
+        k: &mut dyn MatrixSink,
+    ) -> Result<()> {
         entries.sort_by_key(|e| (e.0, e.1));
         let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
         let mut i = 0;
@@ -439,16 +501,26 @@ impl MortarPair {
             }
             k.add_block(&[self.global_dof(dofs, row.0, row.1)], &cols, &vals)?;
         }
-        Ok(signature(&e))
+        Ok(())
     }
 
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
     /// weighted gap is complete on this rank; statistics over the nodes this
     /// rank owns.
-    pub fn uzawa_update(&mut self, u_local: &[f64], rate: Option<&Rate>) -> UzawaStats {
+    pub fn uzawa_update(
+        &mut self,
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        factor: f64,
+    ) -> UzawaStats {
         let x = self.positions(u_local);
-        let e = self.evaluate::<f64>(&x, u_local, rate);
-        let states = e.states;
+        let (states, frictions) = match &self.rigid {
+            Some(_) => self.rigid_outcome(&x, u_local, rate, factor),
+            None => {
+                let e = self.evaluate::<f64>(&x, u_local, rate);
+                (e.states, e.frictions)
+            }
+        };
         let mut stats = UzawaStats::default();
         for (j, s) in states.iter().enumerate() {
             if !self.complete[j] {
@@ -458,7 +530,7 @@ impl MortarPair {
             self.nodal.lambda[j] = s.pressure;
             let area = self.nodal.area[j];
             if let Some(f) = &mut self.friction {
-                let n = &e.frictions[j];
+                let n = &frictions[j];
                 let change = crate::contact::dual::norm(&crate::contact::dual::sub(
                     &n.traction,
                     &f.nodal.lambda[j],
@@ -489,6 +561,9 @@ impl MortarPair {
         if let Some(f) = &mut self.friction {
             f.last = x;
         }
+        if let Some(r) = &mut self.rigid {
+            r.last_factor = factor;
+        }
         stats
     }
 
@@ -496,6 +571,9 @@ impl MortarPair {
     pub fn commit(&mut self) {
         if let Some(f) = &mut self.friction {
             f.start.clone_from(&f.last);
+        }
+        if let Some(r) = &mut self.rigid {
+            r.start_factor = r.last_factor;
         }
     }
 
@@ -537,144 +615,5 @@ impl MortarPair {
         (0..self.owned.len())
             .filter(|&j| self.owned[j] && self.nodal.lambda[j] > 0.0)
             .count()
-    }
-
-    /// Owned slave nodes: reference position and λ_j.
-    pub fn node_values(&self) -> Vec<([f64; 3], f64)> {
-        (0..self.owned.len())
-            .filter(|&j| self.owned[j])
-            .map(|j| {
-                (
-                    self.x_ref[self.nodal.nodes[j] as usize],
-                    self.nodal.lambda[j],
-                )
-            })
-            .collect()
-    }
-
-    /// Nodal output of the owned nodes and this rank's part of the pair's
-    /// force on the slave, `Σ_j λ_j D_jk ν` summed over `k` (`D` of the
-    /// current segments, so the force is the one the residual applied).
-    pub fn output(&self, u_local: &[f64], rate: Option<&Rate>) -> (NodeFields, PairForce) {
-        let x = self.positions(u_local);
-        let Evaluation {
-            segments, states, ..
-        } = self.evaluate::<f64>(&x, u_local, rate);
-        let zero = [0.0; 3];
-        let lambda_t = |j: usize| self.friction.as_ref().map_or(&zero, |f| &f.nodal.lambda[j]);
-        let nf = self.facet_type.nodes();
-        let mut normal_sum = vec![[0.0; 3]; self.nodal.nodes.len()];
-        let mut force = PairForce::default();
-        for seg in segments.iter().filter(|s| self.assembled[s.slave as usize]) {
-            for (a, &n) in self.slave_facets[seg.slave as usize][..nf]
-                .iter()
-                .enumerate()
-            {
-                let Some(j) = self.nodal.slot_of(n) else {
-                    continue;
-                };
-                let d: f64 = seg.terms.d[a][..nf].iter().sum();
-                let lambda = self.nodal.lambda[j];
-                for ((sum, f), nc) in normal_sum[j]
-                    .iter_mut()
-                    .zip(force.force.iter_mut())
-                    .zip(seg.terms.normal)
-                {
-                    *sum += d * nc;
-                    *f -= lambda * d * nc;
-                }
-                force.normal += lambda * d;
-                let t = lambda_t(j);
-                for (f, tc) in force.force.iter_mut().zip(t) {
-                    *f -= tc * d;
-                }
-                force.tangential += crate::contact::dual::norm(t) * d;
-            }
-        }
-        let n = self.owned_mesh_nodes;
-        let mut out = NodeFields {
-            lambda: vec![0.0; n],
-            weighted_gap: vec![0.0; n],
-            traction: vec![[0.0; 3]; n],
-        };
-        for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
-            let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
-            if l >= n {
-                continue;
-            }
-            out.lambda[l] = self.nodal.lambda[j];
-            out.weighted_gap[l] = states[j].weighted_gap;
-            let len = crate::contact::dual::norm(&normal_sum[j]);
-            if len > 0.0 {
-                let t = lambda_t(j);
-                out.traction[l] =
-                    [0, 1, 2].map(|i| -self.nodal.lambda[j] * normal_sum[j][i] / len - t[i]);
-            }
-        }
-        (out, force)
-    }
-
-    /// Adds λ_j of every owned node into the nodal contact-pressure field
-    /// (indexed by owned local node; the denominator counts the pairs).
-    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) {
-        for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
-            let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
-            if let (Some(n), Some(d)) = (numerator.get_mut(l), denominator.get_mut(l)) {
-                *n += self.nodal.lambda[j];
-                *d += 1.0;
-            }
-        }
-    }
-
-    /// Friction at the slave points of `slave` (output): the nodal traction
-    /// on the slave (−λT_j) and slip interpolated like the pressure, and the
-    /// state (0 open where `pressure` is 0, else 2 if a node of the facet
-    /// slides, else 1). Empty for a frictionless pair.
-    pub fn point_friction(
-        &self,
-        slave: &crate::contact::surfaces::SlaveSurface,
-        pressure: &[f64],
-    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) {
-        use crate::contact::multipliers::PointState;
-        let Some(f) = &self.friction else {
-            return Default::default();
-        };
-        let by_node: std::collections::HashMap<u32, usize> = (0..self.nodal.nodes.len())
-            .map(|j| (self.node_local[self.nodal.nodes[j] as usize], j))
-            .collect();
-        let mut out: (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) = Default::default();
-        for (q, p) in pressure.iter().enumerate() {
-            let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
-            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
-            for (n, na) in slave.facets[q / slave.nqp].nodes.iter().zip(s.n) {
-                if let Some(&j) = by_node.get(n) {
-                    for c in 0..3 {
-                        t[c] -= na * f.nodal.lambda[j][c];
-                        slip[c] += na * f.slip[j][c];
-                    }
-                    sliding |= f.sliding[j];
-                }
-            }
-            let state = match (*p > 0.0, sliding) {
-                (false, _) => PointState::Open,
-                (true, false) => PointState::Stick,
-                (true, true) => PointState::Slip,
-            };
-            out.0.push(t);
-            out.1.push(slip);
-            out.2.push(state as i8);
-        }
-        out
-    }
-
-    /// λ_j by the slave node's local index, for the nodes this rank holds
-    /// (the point output interpolates them with the standard shape functions).
-    pub fn lambda_by_local_node(&self) -> std::collections::HashMap<u32, f64> {
-        self.nodal
-            .nodes
-            .iter()
-            .zip(&self.nodal.lambda)
-            .map(|(&id, &l)| (self.node_local[id as usize], l))
-            .collect()
     }
 }

@@ -197,7 +197,7 @@ impl ContactPair {
         r_local: &mut [f64],
     ) -> Result<()> {
         if let Some(m) = &self.mortar {
-            m.add_residual(u_local, self.mortar_rate().as_ref(), r_local);
+            m.add_residual(u_local, self.mortar_rate().as_ref(), factor, r_local);
             return Ok(());
         }
         self.for_each_link(
@@ -226,7 +226,7 @@ impl ContactPair {
     ) -> Result<()> {
         if let Some(m) = &self.mortar {
             let rate = self.mortar_rate();
-            self.tangent_signature = m.add_tangent(dofs, u_local, rate.as_ref(), k)?;
+            self.tangent_signature = m.add_tangent(dofs, u_local, rate.as_ref(), factor, k)?;
             return Ok(());
         }
         // Which links are closed, on which master facets, sticking or

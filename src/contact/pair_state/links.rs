@@ -99,7 +99,7 @@ impl ContactPair {
     /// pattern differs from the previous step's.
     pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
         if let Some(m) = &mut self.mortar {
-            return m.search(u_local);
+            return m.search(u_local, factor);
         }
         let nq = self.slave.num_qps();
         let points: Vec<[f64; 3]> = (0..nq)

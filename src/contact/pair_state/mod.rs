@@ -21,11 +21,11 @@ mod uzawa;
 pub use super::outcome::{PairForce, UzawaStats};
 pub use links::Link;
 pub use output::PointValues;
-pub use snapshot::{FrictionRows, PairSnapshot, RestartRows};
+pub use snapshot::{FrictionRows, MortarRows, PairSnapshot, RestartRows};
 
 use super::dual::{norm, sub};
 use super::held_master::HeldMaster;
-use super::mortar::pair::MortarPair;
+use super::mortar::pair::{MortarMaster, MortarPair};
 use super::multipliers::Multipliers;
 use super::surfaces::SlaveSurface;
 use crate::assembly::{HaloFactory, RankExchange};
@@ -138,11 +138,14 @@ impl ContactPair {
             .unwrap_or_else(|| default_search_distance(mesh, &master, slave.h));
         let mortar = match (&spec.formulation, &spec.master) {
             (Formulation::Links, _) => None,
-            (Formulation::Mortar, MasterSpec::Surface { set }) => Some(MortarPair::new(
+            (Formulation::Mortar, master) => Some(MortarPair::new(
                 mesh,
                 dofs,
                 spec,
-                set,
+                match master {
+                    MasterSpec::Surface { set } => MortarMaster::Facets(set),
+                    MasterSpec::Rigid(r) => MortarMaster::Rigid(*r),
+                },
                 |h| spec.penalty.unwrap_or(10.0 * softest_youngs / h),
                 // Candidates are fixed for a step and every one widens the
                 // Jacobian pattern: one element size of margin, not the
@@ -150,12 +153,6 @@ impl ContactPair {
                 search_distance.min(slave.h),
                 friction_spec,
             )?),
-            (Formulation::Mortar, MasterSpec::Rigid(_)) => {
-                return Err(Error::scene(
-                    "contact",
-                    format!("pair '{}': mortar needs a master facet set", spec.name),
-                ))
-            }
         };
         let friction = friction_spec.map(|f| PairFriction {
             mu: f.mu,
@@ -217,9 +214,11 @@ impl ContactPair {
 
     /// Whether the pair's tangent is symmetric: frictionless links (the
     /// Hessian of a potential). The mortar residual is not a gradient (the
-    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric.
+    /// forces hold D, M and ν fixed), so its exact tangent is not symmetric;
+    /// against a rigid master it is (−p_j ∂g̃_j/∂x exactly, nothing held
+    /// fixed: docs/formulation.md §13.5), symmetric to rounding.
     pub fn tangent_is_symmetric(&self) -> bool {
-        !self.has_friction() && self.mortar.is_none()
+        !self.has_friction() && self.mortar.as_ref().is_none_or(MortarPair::is_rigid)
     }
 }
 

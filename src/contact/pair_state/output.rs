@@ -75,7 +75,7 @@ impl ContactPair {
         factor: f64,
     ) -> Result<(PointValues, PairForce)> {
         if self.mortar.is_some() {
-            return Ok(self.mortar_point_values(u_local));
+            return Ok(self.mortar_point_values(u_local, factor));
         }
         let nq = self.slave.num_qps();
         let states = self.evaluate_links(u_local, factor);
@@ -129,7 +129,7 @@ impl ContactPair {
     /// Mortar pair: the slave points carry λ interpolated from the nodes
     /// with the standard shape functions (Σ N_a λ_a, the smooth nodal
     /// traction; the mortar field Σ Φ_a λ_a itself oscillates inside a facet).
-    fn mortar_point_values(&self, u_local: &[f64]) -> (PointValues, PairForce) {
+    fn mortar_point_values(&self, u_local: &[f64], factor: f64) -> (PointValues, PairForce) {
         let Some(m) = &self.mortar else {
             return (PointValues::empty(), PairForce::default());
         };
@@ -146,7 +146,7 @@ impl ContactPair {
                 .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
                 .sum();
         }
-        let (fields, force) = m.output(u_local, self.mortar_rate().as_ref());
+        let (fields, force) = m.output(u_local, self.mortar_rate().as_ref(), factor);
         let mut values = PointValues {
             points: (0..nq)
                 .map(|q| self.slave.qp_position(q, u_local))
@@ -175,6 +175,7 @@ impl ContactPair {
                 dt: r.dt,
                 dv_du: r.dv_du,
                 offset: &r.offset,
+                master_velocity: r.rigid_velocity,
             })
     }
 

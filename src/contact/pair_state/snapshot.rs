@@ -2,6 +2,7 @@
 //! commit that ends a converged step, and the restart from a result file.
 use super::ContactPair;
 use crate::contact::mortar::pair::{MortarPair, MortarSnapshot};
+pub use crate::contact::mortar::pair_restart::MortarRows;
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::error::{Error, Result};
 
@@ -13,6 +14,8 @@ pub struct RestartRows {
     pub penalty: Option<f64>,
     pub lambda: Vec<f64>,
     pub friction: Option<FrictionRows>,
+    /// A mortar pair's nodal state (rows by natural node).
+    pub mortar: Option<MortarRows>,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -50,10 +53,7 @@ impl ContactPair {
     /// facet × quadrature point), then commits them as the step end did.
     pub fn restart_from(&mut self, rows: &RestartRows) -> Result<()> {
         if self.mortar.is_some() {
-            return Err(Error::Restart(format!(
-                "contact pair '{}': restarting a mortar pair is not supported",
-                self.spec.name
-            )));
+            return self.restart_mortar(rows);
         }
         let nqp = self.slave.nqp;
         let row_of = |i: usize| self.slave.facets[i / nqp].set_index * nqp + i % nqp;
@@ -90,6 +90,28 @@ impl ContactPair {
             mortar: None,
         })?;
         self.commit()
+    }
+
+    /// A mortar pair's [`ContactPair::restart_from`]: the nodal multipliers,
+    /// λT and slip origins by natural node.
+    fn restart_mortar(&mut self, rows: &RestartRows) -> Result<()> {
+        let name = self.spec.name.clone();
+        let misfit = |what: &str| {
+            Error::Restart(format!(
+                "contact pair '{name}': the file's {what} does not fit this mortar pair (another scene, or a file written before mortar restarts existed?)"
+            ))
+        };
+        let Some(m_rows) = &rows.mortar else {
+            return Err(misfit("node_lambda"));
+        };
+        if let Some(p) = rows.penalty.filter(|p| p.is_finite() && *p > 0.0) {
+            // Raised during the first run: continue with the same penalty.
+            self.raise_penalty(p / self.penalty);
+        }
+        match &mut self.mortar {
+            Some(m) => m.restart(m_rows).map_err(misfit),
+            None => Ok(()),
+        }
     }
 
     fn restart_error(&self, what: &str) -> Error {

@@ -18,8 +18,9 @@ impl ContactPair {
                     dt: r.dt,
                     dv_du: r.dv_du,
                     offset: &r.offset,
+                    master_velocity: r.rigid_velocity,
                 });
-            return Ok(m.uzawa_update(u_local, rate.as_ref()));
+            return Ok(m.uzawa_update(u_local, rate.as_ref(), factor));
         }
         let before = self.multipliers.nodal_forces()?;
         let before_t = self.multipliers.nodal_tangential_forces()?;
