@@ -93,11 +93,25 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// See [`MortarPair::add_tangent`].
-fn signature<T>(e: &Evaluation<T>) -> u64 {
+/// See [`MortarPair::add_tangent`]. Only the segments of facets with a
+/// closed node enter: the others add nothing to the tangent, and overlaps
+/// appearing or vanishing away from the contact (the flank of a curved
+/// slave projected onto the master moves with every iterate) would
+/// otherwise force new factors of an unchanged matrix structure.
+fn signature<T>(
+    e: &Evaluation<T>,
+    slave_facets: &[[u32; MAX_FACET_NODES]],
+    nodes: usize,
+    nodal: &NodalData,
+) -> u64 {
     use std::hash::{Hash, Hasher};
+    let closed = |f: u32| {
+        slave_facets[f as usize][..nodes]
+            .iter()
+            .any(|&n| nodal.slot_of(n).is_some_and(|j| e.states[j].closed))
+    };
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    for s in &e.segments {
+    for s in e.segments.iter().filter(|s| closed(s.slave)) {
         (s.slave, s.master).hash(&mut h);
     }
     for s in &e.states {
@@ -459,7 +473,12 @@ impl MortarPair {
             }
             k.add_block(&[dof_of(row)], &cols, &vals)?;
         }
-        Ok(signature(&e))
+        Ok(signature(
+            &e,
+            &self.slave_facets,
+            self.facet_type.nodes(),
+            &self.nodal,
+        ))
     }
 
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
