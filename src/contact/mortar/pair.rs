@@ -365,6 +365,56 @@ impl MortarPair {
         let segments = system::segments::<T>(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
+        self.with_friction(&interface, segments, states, x, u_local, rate)
+    }
+
+    /// The evaluation the tangent needs: the node states from the segments
+    /// in f64, then the derivatives only on the candidates of slave facets
+    /// with a closed node (the tangent of an open node is zero, and a
+    /// closed node's facets are all among them, so its terms are complete).
+    /// On a curved slave most overlaps lie away from the contact: on
+    /// hertz-sphere the dual numbers went through every one of them.
+    fn evaluate_tangent(
+        &self,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<Dual<{ system::SEGMENT_DOFS }>> {
+        let interface = self.interface(x);
+        let values = system::segments::<f64>(&interface, &self.rules);
+        let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &values);
+        let states = system::node_states(&self.nodal, &gap, &covered);
+        let nf = self.facet_type.nodes();
+        let closed = |f: u32| {
+            self.slave_facets[f as usize][..nf]
+                .iter()
+                .any(|&n| self.nodal.slot_of(n).is_some_and(|j| states[j].closed))
+        };
+        let live: Vec<(u32, u32)> = self
+            .candidates
+            .iter()
+            .copied()
+            .filter(|&(s, _)| closed(s))
+            .collect();
+        let interface = Interface {
+            candidates: &live,
+            ..interface
+        };
+        let segments = system::segments(&interface, &self.rules);
+        self.with_friction(&interface, segments, states, x, u_local, rate)
+    }
+
+    /// Completes an evaluation with the segments' slip terms and the nodes'
+    /// friction (nothing for a frictionless pair).
+    fn with_friction<T: system::Seed>(
+        &self,
+        interface: &Interface,
+        segments: Vec<Segment<T>>,
+        states: Vec<NodeState>,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<T> {
         let (slips, frictions) = match &self.friction {
             Some(f) => {
                 let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
@@ -372,9 +422,9 @@ impl MortarPair {
                     value: &value,
                     slope,
                 };
-                let slips = friction::segment_slips(&interface, &segments, &inc);
+                let slips = friction::segment_slips(interface, &segments, &inc);
                 let frictions = friction::node_frictions(
-                    &interface,
+                    interface,
                     &self.nodal,
                     &f.nodal,
                     &states,
@@ -418,7 +468,7 @@ impl MortarPair {
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
         let x = self.positions(u_local);
-        let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
+        let e = self.evaluate_tangent(&x, u_local, rate);
         let interface = self.interface(&x);
         // Entries bucketed by row (pair DOF `3 id + c`), in emission order:
         // each row is then merged through a dense scatter, so the cost is
