@@ -11,8 +11,9 @@
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
+use super::rows::{signature, Rows};
 use super::segment::MortarRules;
-use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use super::system::{self, Interface, NodalData, NodeState, Segment};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
@@ -91,36 +92,6 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
             crate::contact::dual::norm(&crate::contact::dual::sub(&x[i], &x[(i + 1) % x.len()]))
         })
         .fold(f64::INFINITY, f64::min)
-}
-
-/// See [`MortarPair::add_tangent`]. Only the segments of facets with a
-/// closed node enter: the others add nothing to the tangent, and overlaps
-/// appearing or vanishing away from the contact (the flank of a curved
-/// slave projected onto the master moves with every iterate) would
-/// otherwise force new factors of an unchanged matrix structure.
-fn signature<T>(
-    e: &Evaluation<T>,
-    slave_facets: &[[u32; MAX_FACET_NODES]],
-    nodes: usize,
-    nodal: &NodalData,
-) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let closed = |f: u32| {
-        slave_facets[f as usize][..nodes]
-            .iter()
-            .any(|&n| nodal.slot_of(n).is_some_and(|j| e.states[j].closed))
-    };
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    for s in e.segments.iter().filter(|s| closed(s.slave)) {
-        (s.slave, s.master).hash(&mut h);
-    }
-    for s in &e.states {
-        s.closed.hash(&mut h);
-    }
-    for f in &e.frictions {
-        f.sliding.hash(&mut h);
-    }
-    h.finish()
 }
 
 impl MortarPair {
@@ -470,16 +441,8 @@ impl MortarPair {
         let x = self.positions(u_local);
         let e = self.evaluate_tangent(&x, u_local, rate);
         let interface = self.interface(&x);
-        // Entries bucketed by row (pair DOF `3 id + c`), in emission order:
-        // each row is then merged through a dense scatter, so the cost is
-        // linear in the entries (a sort of all of them took a quarter of a
-        // frictional run). Sums keep the emission order.
-        let n = DIM * self.node_local.len();
-        let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); n];
-        let pair_dof = |d: NodeDof| DIM * d.0 as usize + d.1;
-        let mut add = |r: NodeDof, c: NodeDof, v: f64| {
-            rows[pair_dof(r)].push((pair_dof(c) as u32, v));
-        };
+        let mut rows = Rows::new(self.node_local.len());
+        let mut add = |r, c, v| rows.add(r, c, v);
         system::tangent(&interface, &self.nodal, &e.segments, &e.states, &mut add);
         if self.friction.is_some() {
             friction::tangent(
@@ -491,40 +454,11 @@ impl MortarPair {
                 &mut add,
             );
         }
-        let mut sum = vec![0.0; n];
-        let mut seen = vec![false; n];
-        let mut touched: Vec<u32> = Vec::new();
-        let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
-        let dof_of = |p: usize| self.global_dof(dofs, (p / DIM) as u32, p % DIM);
-        for (row, entries) in rows.iter().enumerate().filter(|r| !r.1.is_empty()) {
-            touched.clear();
-            for &(c, v) in entries {
-                let c_us = c as usize;
-                if !seen[c_us] {
-                    seen[c_us] = true;
-                    touched.push(c);
-                }
-                sum[c_us] += v;
-            }
-            touched.sort_unstable();
-            cols.clear();
-            vals.clear();
-            for &c in &touched {
-                let c_us = c as usize;
-                let (g, v) = (dof_of(c_us), sum[c_us]);
-                sum[c_us] = 0.0;
-                seen[c_us] = false;
-                if cols.last() == Some(&g) {
-                    *vals.last_mut().unwrap_or(&mut 0.0) += v;
-                } else {
-                    cols.push(g);
-                    vals.push(v);
-                }
-            }
-            k.add_block(&[dof_of(row)], &cols, &vals)?;
-        }
+        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
         Ok(signature(
-            &e,
+            &e.segments,
+            &e.states,
+            &e.frictions,
             &self.slave_facets,
             self.facet_type.nodes(),
             &self.nodal,
