@@ -22,7 +22,7 @@ export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
 cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
 
-.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing ironing-compare friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing ironing-compare mortar-cost friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -156,6 +156,12 @@ ironing-compare: build
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing-mortar.h5 --set contact.formulation=mortar
 	$(PYTHON) scripts/ironing_ratio.py out/ironing.csv out/ironing-mortar.csv
+
+# Mortar against links on the same scenes, alternated, median of REPEATS
+# runs each, 1 rank (the README's mortar cost table).
+mortar-cost: build
+	@mkdir -p out
+	$(PYTHON) scripts/mortar_cost.py target/release/contactlink $(or $(REPEATS),3)
 
 # The friction and dynamics figures of the README (block-slide, ironing, impact).
 friction-figures: ironing

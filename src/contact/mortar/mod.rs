@@ -9,6 +9,8 @@
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//! - `rows`: the tangent as the solver gets it (entries merged into matrix
+//!   rows, active-set signature);
 //! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
 //!   state at run time;
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
@@ -26,6 +28,7 @@ pub mod pair_restart;
 pub mod rigid;
 pub mod rigid_friction;
 mod rigid_pair;
+mod rows;
 pub mod segment;
 pub mod system;
 mod tangential;

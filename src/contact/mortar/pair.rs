@@ -12,8 +12,9 @@
 //! that counts it in the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
 use super::rigid_pair::RigidMaster;
+use super::rows::{signature, Rows};
 use super::segment::MortarRules;
-use super::system::{self, Interface, NodalData, NodeDof, NodeState, Segment};
+use super::system::{self, Interface, NodalData, NodeState, Segment};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
@@ -110,22 +111,6 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
             crate::contact::dual::norm(&crate::contact::dual::sub(&x[i], &x[(i + 1) % x.len()]))
         })
         .fold(f64::INFINITY, f64::min)
-}
-
-/// See [`MortarPair::add_tangent`].
-fn signature<T>(e: &Evaluation<T>) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    for s in &e.segments {
-        (s.slave, s.master).hash(&mut h);
-    }
-    for s in &e.states {
-        s.closed.hash(&mut h);
-    }
-    for f in &e.frictions {
-        f.sliding.hash(&mut h);
-    }
-    h.finish()
 }
 
 impl MortarPair {
@@ -389,6 +374,56 @@ impl MortarPair {
         let segments = system::segments::<T>(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
+        self.with_friction(&interface, segments, states, x, u_local, rate)
+    }
+
+    /// The evaluation the tangent needs: the node states from the segments
+    /// in f64, then the derivatives only on the candidates of slave facets
+    /// with a closed node (the tangent of an open node is zero, and a
+    /// closed node's facets are all among them, so its terms are complete).
+    /// On a curved slave most overlaps lie away from the contact: on
+    /// hertz-sphere the dual numbers went through every one of them.
+    fn evaluate_tangent(
+        &self,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<Dual<{ system::SEGMENT_DOFS }>> {
+        let interface = self.interface(x);
+        let values = system::segments::<f64>(&interface, &self.rules);
+        let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &values);
+        let states = system::node_states(&self.nodal, &gap, &covered);
+        let nf = self.facet_type.nodes();
+        let closed = |f: u32| {
+            self.slave_facets[f as usize][..nf]
+                .iter()
+                .any(|&n| self.nodal.slot_of(n).is_some_and(|j| states[j].closed))
+        };
+        let live: Vec<(u32, u32)> = self
+            .candidates
+            .iter()
+            .copied()
+            .filter(|&(s, _)| closed(s))
+            .collect();
+        let interface = Interface {
+            candidates: &live,
+            ..interface
+        };
+        let segments = system::segments(&interface, &self.rules);
+        self.with_friction(&interface, segments, states, x, u_local, rate)
+    }
+
+    /// Completes an evaluation with the segments' slip terms and the nodes'
+    /// friction (nothing for a frictionless pair).
+    fn with_friction<T: system::Seed>(
+        &self,
+        interface: &Interface,
+        segments: Vec<Segment<T>>,
+        states: Vec<NodeState>,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+    ) -> Evaluation<T> {
         let (slips, frictions) = match &self.friction {
             Some(f) => {
                 let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
@@ -396,9 +431,9 @@ impl MortarPair {
                     value: &value,
                     slope,
                 };
-                let slips = friction::segment_slips(&interface, &segments, &inc);
+                let slips = friction::segment_slips(interface, &segments, &inc);
                 let frictions = friction::node_frictions(
-                    &interface,
+                    interface,
                     &self.nodal,
                     &f.nodal,
                     &states,
@@ -455,10 +490,10 @@ impl MortarPair {
             return self.rigid_tangent(dofs, u_local, rate, factor, k);
         }
         let x = self.positions(u_local);
-        let e = self.evaluate::<Dual<{ system::SEGMENT_DOFS }>>(&x, u_local, rate);
+        let e = self.evaluate_tangent(&x, u_local, rate);
         let interface = self.interface(&x);
-        let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
-        let mut add = |r, c, v| entries.push((r, c, v));
+        let mut rows = Rows::new(self.node_local.len());
+        let mut add = |r, c, v| rows.add(r, c, v);
         system::tangent(&interface, &self.nodal, &e.segments, &e.states, &mut add);
         if self.friction.is_some() {
             friction::tangent(
@@ -470,38 +505,15 @@ impl MortarPair {
                 &mut add,
             );
         }
-        self.add_entries(dofs, entries, k)?;
-        Ok(signature(&e))
-    }
-
-    /// Adds tangent entries `(row, col, value)` by rows into `k`.
-    pub(super) fn add_entries(
-        &self,
-        dofs: &DofMap,
-        mut entries: Vec<(NodeDof, NodeDof, f64)>,
-        k: &mut dyn MatrixSink,
-    ) -> Result<()> {
-        entries.sort_by_key(|e| (e.0, e.1));
-        let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
-        let mut i = 0;
-        while i < entries.len() {
-            let row = entries[i].0;
-            cols.clear();
-            vals.clear();
-            while i < entries.len() && entries[i].0 == row {
-                let (col, v) = (entries[i].1, entries[i].2);
-                let g = self.global_dof(dofs, col.0, col.1);
-                if cols.last() == Some(&g) {
-                    *vals.last_mut().unwrap_or(&mut 0.0) += v;
-                } else {
-                    cols.push(g);
-                    vals.push(v);
-                }
-                i += 1;
-            }
-            k.add_block(&[self.global_dof(dofs, row.0, row.1)], &cols, &vals)?;
-        }
-        Ok(())
+        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
+        Ok(signature(
+            &e.segments,
+            &e.states,
+            &e.frictions,
+            &self.slave_facets,
+            self.facet_type.nodes(),
+            &self.nodal,
+        ))
     }
 
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose

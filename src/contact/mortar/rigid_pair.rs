@@ -12,7 +12,8 @@ use super::pair::MortarPair;
 use super::pair_output::OutputRows;
 use super::rigid::{self, RigidFacet, RigidInterface, RD};
 use super::rigid_friction::{self, RigidSlip};
-use super::system::{self, NodeDof, NodeState, Seed};
+use super::rows::Rows;
+use super::system::{self, NodeState, Seed};
 use crate::amplitude::Amplitude;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::dofs::{DofMap, GlobalDof, DIM};
@@ -258,8 +259,8 @@ impl MortarPair {
         let x = self.positions(u_local);
         let e = self.rigid_evaluate::<RD>(&x, u_local, rate, factor);
         let interface = self.rigid_interface(&x, factor);
-        let mut entries: Vec<(NodeDof, NodeDof, f64)> = Vec::new();
-        let mut add = |r, c, v| entries.push((r, c, v));
+        let mut rows = Rows::new(self.node_local.len());
+        let mut add = |r, c, v| rows.add(r, c, v);
         rigid::tangent(&interface, &self.nodal, &e.facets, &e.states, &mut add);
         if self.friction.is_some() {
             rigid_friction::tangent(
@@ -271,7 +272,7 @@ impl MortarPair {
                 &mut add,
             );
         }
-        self.add_entries(dofs, entries, k)?;
+        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         for f in &e.facets {

@@ -210,16 +210,26 @@ fn point_on<T: Scalar>(n: &[T; MAX_FACET_NODES], x: &[Vec3<T>], nodes: usize) ->
 }
 
 /// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.
+/// The facet is fixed, so the value depends on the segment variables only
+/// through `ζ`: it is computed with the two derivatives along `ζ` and
+/// chained, `J₀(ζ₀) + ∂J₀/∂ζ · (ζ − ζ₀)`, instead of carrying every segment
+/// variable through the cross product (a tenth of a frictional mortar run).
 fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T; 2]) -> T {
-    let dn = shape_gradients(facet, zeta);
-    let zero = dual::constant3::<T>([0.0; 3]);
+    use crate::contact::dual::Dual;
+    let z: [Dual<2>; 2] = [
+        Dual::variable(zeta[0].re(), 0),
+        Dual::variable(zeta[1].re(), 1),
+    ];
+    let dn = shape_gradients(facet, &z);
+    let zero = dual::constant3::<Dual<2>>([0.0; 3]);
     let (mut t1, mut t2) = (zero, zero);
     for (d, x) in dn.iter().zip(x_ref).take(facet.nodes()) {
-        let x = dual::constant3::<T>(*x);
+        let x = dual::constant3::<Dual<2>>(*x);
         t1 = dual::add(&t1, &dual::scale(&x, d[0]));
         t2 = dual::add(&t2, &dual::scale(&x, d[1]));
     }
-    dual::norm(&dual::cross(&t1, &t2))
+    let j = dual::norm(&dual::cross(&t1, &t2));
+    T::from_f64(j.re) + (zeta[0] - zeta[0].re()) * j.eps[0] + (zeta[1] - zeta[1].re()) * j.eps[1]
 }
 
 /// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane.
