@@ -173,9 +173,9 @@ fn run_model_with(
         println!(
             "{}: {} cells, {} nodes, {} DOFs, {} rank(s), {} load step(s)",
             model.name,
-            model.mesh.num_cells(),
-            model.mesh.num_nodes(),
-            3 * model.mesh.num_nodes(),
+            sim.local_mesh().global_cells,
+            sim.local_mesh().global_nodes,
+            3 * sim.local_mesh().global_nodes,
             rt.size(),
             model.steps
         );
@@ -206,8 +206,8 @@ fn run_model_with(
         report,
         hertz: hertz.last,
         output: output.map(Path::to_path_buf),
-        cells: model.mesh.num_cells(),
-        nodes: model.mesh.num_nodes(),
+        cells: sim.local_mesh().global_cells,
+        nodes: sim.local_mesh().global_nodes,
     })
 }
 

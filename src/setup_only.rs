@@ -22,8 +22,8 @@ pub fn setup_only(rt: &Runtime, scene: &str, overrides: &[String]) -> Result<Set
     let sim = Simulation::setup(rt, &model)?;
     Ok(SetupSummary {
         model_name: model.name.clone(),
-        cells: model.mesh.num_cells(),
-        nodes: model.mesh.num_nodes(),
+        cells: sim.local_mesh().global_cells,
+        nodes: sim.local_mesh().global_nodes,
         global_dofs: 3 * sim.dofs().num_global_nodes(),
     })
 }

@@ -59,7 +59,7 @@ impl Hdf5Sink {
             natural: NaturalOrder::nodal(dofs)?,
             natural_scalar: NaturalOrder::nodal_scalar(dofs)?,
             pairs,
-            nodes: sim.model().mesh.num_nodes(),
+            nodes: dofs.num_global_nodes(),
         })
     }
 
@@ -258,53 +258,44 @@ pub fn create_result_file(
 ) -> Result<ResultFile> {
     let model = sim.model();
     let mesh = &model.mesh;
+    let local = sim.local_mesh();
     let (rank, size) = (rt.rank(), rt.size());
-    let node_block = even_block(mesh.num_nodes(), rank, size);
-    let cell_block = even_block(mesh.num_cells(), rank, size);
-    let nodes: Vec<f64> = mesh.nodes[node_block.clone()]
-        .iter()
-        .flatten()
-        .copied()
-        .collect();
-    let npc = mesh.cell_type.nodes();
-    let cells: Vec<i64> = cell_block
-        .clone()
-        .flat_map(|c| mesh.cell(c).iter().map(|&v| v as i64))
-        .collect();
+    let node_block = even_block(local.global_nodes, rank, size);
+    let cell_block = even_block(local.global_cells, rank, size);
+    let nodes: Vec<f64> = local.block.nodes.iter().flatten().copied().collect();
+    let npc = local.cell_type.nodes();
+    let cells: Vec<i64> = local.block.cells.iter().map(|&v| v as i64).collect();
     let partition: Vec<i32> = sim.partition_block().to_vec();
-    let cell_body: Vec<i32> = mesh.cell_body[cell_block.clone()]
-        .iter()
-        .map(|&b| b as i32)
-        .collect();
+    let cell_body: Vec<i32> = local.block.cell_body.iter().map(|&b| b as i32).collect();
     let facet_sets = facet_sets_out(mesh)?;
     let header = MeshHeader {
-        cell_type: mesh.cell_type.name(),
-        facet_type: mesh.cell_type.facet_type().name(),
+        cell_type: local.cell_type.name(),
+        facet_type: local.cell_type.facet_type().name(),
         nodes: BlockRows {
-            global_rows: mesh.num_nodes(),
+            global_rows: local.global_nodes,
             start: node_block.start,
             cols: 3,
             data: &nodes,
         },
         cells: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: npc,
             data: &cells,
         },
         partition: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: 1,
             data: &partition,
         },
         cell_body: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: 1,
             data: &cell_body,
         },
-        bodies: &mesh.bodies,
+        bodies: &local.bodies,
         node_sets: &mesh.node_sets,
         facet_sets: &facet_sets,
     };

@@ -10,10 +10,10 @@ use super::driver::Simulation;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::distribution;
-use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::distribution::LocalMesh;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
-use crate::mesh::Mesh;
 use crate::model::MasterSpec;
 use crate::model::{Model, SolverSettings};
 use crate::parallel;
@@ -119,6 +119,7 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
     let mesh = &model.mesh;
     crate::footprint::checkpoint("model build");
     let mut master_nodes = Vec::new();
+    let mut shared_sets = Vec::new();
     // Mortar pairs see both their surfaces whole on every rank; a links
     // pair's master is exchanged at each search (`contact::held_master`).
     for pair in &model.contact {
@@ -129,34 +130,41 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
             master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
                 mesh, set,
             )?);
+            shared_sets.push(set.clone());
         }
         master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
             mesh,
             &pair.slave,
         )?);
+        shared_sets.push(pair.slave.clone());
     }
     let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
-    let mut piece = distribution::distribute(&world, mesh, &master_nodes, &slave_sets)?;
+    let wanted = distribution::Wanted {
+        extra_ghosts: &master_nodes,
+        slave_sets: &slave_sets,
+        shared_sets: &shared_sets,
+    };
+    let mut piece = distribution::distribute(&world, mesh, &wanted)?;
+    drop(master_nodes);
     let partition_block = std::mem::take(&mut piece.block_partition);
-    let slave_owners = std::mem::take(&mut piece.facet_owners);
-    let dofs = DofMap::from_piece(piece);
+    let (dofs, mut local) = DofMap::from_piece(piece);
     crate::footprint::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
-        BulkAssembler::new(mesh, &dofs, model.materials.clone()),
+        BulkAssembler::new(&local, &dofs, model.materials.clone()),
     )?;
     crate::footprint::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();
     for (set, load, amplitude) in &model.facet_loads {
-        let facets = mesh.facet_sets.get(set).ok_or_else(|| {
+        let facets = local.facet_set(set).ok_or_else(|| {
             Error::scene(
                 "loads",
                 format!("facet set '{set}' does not exist in the mesh"),
             )
         })?;
-        facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
+        facet_loads.push((facets, load.clone(), amplitude.clone()));
     }
-    let loads = parallel::agree(&world, SurfaceLoads::new(mesh, &dofs, &facet_loads))?;
+    let loads = parallel::agree(&world, SurfaceLoads::new(&local, &dofs, &facet_loads))?;
     let dirichlet = parallel::agree(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
     let softest = model
         .materials
@@ -168,12 +176,12 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         model
             .contact
             .iter()
-            .zip(&slave_owners)
-            .map(|(p, owners)| {
+            .zip(&local.slaves)
+            .map(|(p, slave)| {
                 ContactPair::new(
-                    mesh,
+                    &local,
                     &dofs,
-                    owners,
+                    slave,
                     p,
                     softest,
                     &super::halo::PetscHalos,
@@ -183,12 +191,18 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
             .collect::<Result<Vec<_>>>(),
     )?;
     crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
-    let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
+    // The contact pairs hold what they need of the slave sets and shared
+    // surfaces; the rest of the local mesh stays for the near-null space,
+    // the dynamics and the output.
+    local.slaves = Vec::new();
+    local.shared = Default::default();
+    let jac = build_jacobian(&dofs, &bulk, &loads, &[], &local)?;
     crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
     Ok(Simulation {
         model,
         partition_block,
+        local,
         dofs,
         bulk,
         loads,
@@ -205,7 +219,7 @@ pub(super) fn build_jacobian(
     bulk: &BulkAssembler,
     loads: &SurfaceLoads,
     contact: &[ContactPair],
-    mesh: &Mesh,
+    mesh: &LocalMesh,
 ) -> Result<Matrix> {
     let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
     bulk.add_pattern(&mut pattern)?;
@@ -221,12 +235,12 @@ pub(super) fn build_jacobian(
 
 /// This rank's owned node coordinates, blocked like the displacement (for
 /// the rigid-body near-null space).
-fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
+fn owned_coordinates(mesh: &LocalMesh, dofs: &DofMap) -> Result<Vector> {
     let mut v = Vector::new_mpi(dofs.num_owned_dofs())?;
     v.set_block_size(DIM)?;
     v.with_array_mut(|a| {
         for l in 0..dofs.num_owned_nodes() {
-            let p = mesh.nodes[dofs.natural(LocalNode(l)).0];
+            let p = mesh.nodes[l];
             a[DIM * l..DIM * l + DIM].copy_from_slice(&p);
         }
     })?;
@@ -242,10 +256,10 @@ pub(super) struct StepTolerance {
 }
 
 /// Newton (SNES) with the settings' tolerances, the options applied.
-pub(super) fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
+pub(super) fn newton_solver(model: &Model, local: &LocalMesh) -> Result<(Snes, StepTolerance)> {
     let mut snes = Snes::new()?;
     let user_atol = petsc::options::has("-snes_atol")?;
-    let atol_floor = 1e-14 * force_scale(model);
+    let atol_floor = 1e-14 * force_scale(model, local);
     snes.set_tolerances(
         model.solver.atol.unwrap_or(atol_floor),
         model.solver.rtol,
@@ -264,15 +278,14 @@ pub(super) fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
 
 /// A force scale for the default absolute tolerance: largest Young's modulus
 /// times the squared size of the model.
-pub(super) fn force_scale(model: &Model) -> f64 {
+pub(super) fn force_scale(model: &Model, local: &LocalMesh) -> f64 {
     let e = model
         .materials
         .iter()
         .map(Material::youngs)
         .fold(0.0, f64::max);
-    let l = model
-        .mesh
-        .bounding_box()
+    let l = local
+        .bounding_box
         .map_or(1.0, |b| b.size().into_iter().fold(0.0, f64::max));
     (e * l * l).max(f64::MIN_POSITIVE)
 }
