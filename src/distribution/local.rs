@@ -50,11 +50,14 @@ pub struct SlaveSetPiece {
     pub ghosts: Vec<GhostFacet>,
 }
 
-/// A facet set every rank sees whole (both sides of a mortar pair): O(surface).
+/// A facet set every rank sees whole (the result file's header, both sides
+/// of a mortar pair): O(surface).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SharedSet {
     /// Natural cell of each facet, in set order.
     pub cells: Vec<usize>,
+    /// Local face of each facet's cell.
+    pub faces: Vec<u8>,
     /// Natural node ids, `facet_type.nodes()` per facet, outward order.
     pub nodes: Vec<usize>,
 }
@@ -92,8 +95,10 @@ pub struct LocalMesh {
     pub facet_sets: BTreeMap<String, LocalFacetSet>,
     /// The contact slave sets asked for, in request order.
     pub slaves: Vec<SlaveSetPiece>,
-    /// The sets every rank sees whole, by name.
+    /// Every facet set of the mesh whole, by name (surface-sized).
     pub shared: BTreeMap<String, SharedSet>,
+    /// Every node set of the mesh whole (surface-sized).
+    pub node_sets: BTreeMap<String, Vec<usize>>,
     pub block: OutputBlock,
 }
 

@@ -66,8 +66,6 @@ pub struct Wanted<'a> {
     pub extra_ghosts: &'a [usize],
     /// Contact slave sets: facet owners, mean edge and ghost facets of each.
     pub slave_sets: &'a [String],
-    /// Facet sets every rank sees whole (mortar surfaces).
-    pub shared_sets: &'a [String],
 }
 
 /// [start, end) of part `rank` when `n` items are split evenly over `nranks`.

@@ -98,16 +98,22 @@ impl Numbering {
             .map(|set| self.slave_piece(mesh, partition, rank, set))
             .collect();
         let mut shared = BTreeMap::new();
-        for set in wanted.shared_sets {
-            if let Some(facets) = mesh.facet_sets.get(set) {
-                let nodes = facets
-                    .iter()
-                    .filter_map(|f| mesh.facet_nodes_iter(f).ok())
-                    .flatten()
-                    .collect();
-                let cells = facets.iter().map(|f| f.cell).collect();
-                shared.insert(set.clone(), SharedSet { cells, nodes });
-            }
+        for (set, facets) in &mesh.facet_sets {
+            let nodes = facets
+                .iter()
+                .filter_map(|f| mesh.facet_nodes_iter(f).ok())
+                .flatten()
+                .collect();
+            let cells = facets.iter().map(|f| f.cell).collect();
+            let faces = facets.iter().map(|f| f.face).collect();
+            shared.insert(
+                set.clone(),
+                SharedSet {
+                    cells,
+                    faces,
+                    nodes,
+                },
+            );
         }
         let npc = mesh.cell_type.nodes();
         let block = OutputBlock {
@@ -127,6 +133,7 @@ impl Numbering {
             facet_sets,
             slaves,
             shared,
+            node_sets: mesh.node_sets.clone(),
             block,
         };
         Piece {

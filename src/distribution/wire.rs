@@ -75,7 +75,13 @@ fn put_mesh(w: &mut Vec<u64>, m: &LocalMesh) {
     for (name, set) in &m.shared {
         put_str(w, name);
         put(w, set.cells.iter().map(|&v| v as u64));
+        put(w, set.faces.iter().map(|&v| u64::from(v)));
         put(w, set.nodes.iter().map(|&v| v as u64));
+    }
+    w.push(m.node_sets.len() as u64);
+    for (name, ids) in &m.node_sets {
+        put_str(w, name);
+        put(w, ids.iter().map(|&v| v as u64));
     }
     put_points(w, &m.block.nodes);
     put(w, m.block.cells.iter().map(|&v| v as u64));
@@ -198,8 +204,21 @@ fn read_mesh(r: &mut Reader) -> Result<LocalMesh> {
     for _ in 0..r.scalar()? {
         let name = r.string()?;
         let cells = r.array(|v| v as usize)?;
+        let faces = r.array(|v| v as u8)?;
         let nodes = r.array(|v| v as usize)?;
-        shared.insert(name, SharedSet { cells, nodes });
+        shared.insert(
+            name,
+            SharedSet {
+                cells,
+                faces,
+                nodes,
+            },
+        );
+    }
+    let mut node_sets = std::collections::BTreeMap::new();
+    for _ in 0..r.scalar()? {
+        let name = r.string()?;
+        node_sets.insert(name, r.array(|v| v as usize)?);
     }
     let block = OutputBlock {
         nodes: r.points()?,
@@ -218,6 +237,7 @@ fn read_mesh(r: &mut Reader) -> Result<LocalMesh> {
         facet_sets,
         slaves,
         shared,
+        node_sets,
         block,
     })
 }

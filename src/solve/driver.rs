@@ -61,7 +61,20 @@ impl<'m> Simulation<'m> {
     /// Collective; fails on every rank if it fails on one.
     pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
         let stage = LogStage::register("Setup")?;
-        stage.scope(|| setup::setup(rt, model))
+        stage.scope(|| setup::setup(rt, model, std::borrow::Cow::Borrowed(&model.mesh)))
+    }
+
+    /// [`Simulation::setup`] with the mesh moved out of the model: it is
+    /// freed as soon as the pieces are cut, so no rank holds the global mesh
+    /// past the distribution (`model.mesh` is left as it was handed over,
+    /// normally empty, and nothing after set-up reads it).
+    pub fn setup_with_mesh(
+        rt: &Runtime,
+        model: &'m Model,
+        mesh: crate::mesh::Mesh,
+    ) -> Result<Self> {
+        let stage = LogStage::register("Setup")?;
+        stage.scope(|| setup::setup(rt, model, std::borrow::Cow::Owned(mesh)))
     }
 
     /// Owning rank of each cell of this rank's output cell block

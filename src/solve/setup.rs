@@ -14,12 +14,14 @@ use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
+use crate::mesh::Mesh;
 use crate::model::MasterSpec;
 use crate::model::{Model, SolverSettings};
 use crate::parallel;
 use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
 use crate::runtime::Runtime;
 use mpi::traits::*;
+use std::borrow::Cow;
 
 /// What the default solver choice depends on.
 #[derive(Debug, Clone, Copy)]
@@ -113,13 +115,17 @@ pub(super) fn set_solver_defaults(
     Ok(())
 }
 
-/// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
-pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>> {
+/// Partition, number, precompute element data, resolve contact, allocate the
+/// Jacobian. `mesh` is the model's mesh (borrowed, or moved out of the model
+/// so that it is freed once the pieces are cut).
+pub(super) fn setup<'m>(
+    rt: &Runtime,
+    model: &'m Model,
+    mesh: Cow<'_, Mesh>,
+) -> Result<Simulation<'m>> {
     let world = rt.world();
-    let mesh = &model.mesh;
     crate::footprint::checkpoint("model build");
     let mut master_nodes = Vec::new();
-    let mut shared_sets = Vec::new();
     // Mortar pairs see both their surfaces whole on every rank; a links
     // pair's master is exchanged at each search (`contact::held_master`).
     for pair in &model.contact {
@@ -128,24 +134,28 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
         }
         if let MasterSpec::Surface { set } = &pair.master {
             master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-                mesh, set,
+                &mesh, set,
             )?);
-            shared_sets.push(set.clone());
         }
         master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-            mesh,
+            &mesh,
             &pair.slave,
         )?);
-        shared_sets.push(pair.slave.clone());
     }
     let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
     let wanted = distribution::Wanted {
         extra_ghosts: &master_nodes,
         slave_sets: &slave_sets,
-        shared_sets: &shared_sets,
     };
-    let mut piece = distribution::distribute(&world, mesh, &wanted)?;
+    let mut piece = distribution::distribute(&world, &mesh, &wanted)?;
+    // From here on nothing reads the global mesh: an owned one (a scene's
+    // run) is freed before the element data and the Jacobian are allocated.
+    let owned = matches!(mesh, Cow::Owned(_));
+    drop(mesh);
     drop(master_nodes);
+    if owned {
+        crate::footprint::checkpoint("pieces cut, global mesh freed");
+    }
     let partition_block = std::mem::take(&mut piece.block_partition);
     let (dofs, mut local) = DofMap::from_piece(piece);
     crate::footprint::checkpoint("DOF map");
@@ -191,11 +201,10 @@ pub(super) fn setup<'m>(rt: &Runtime, model: &'m Model) -> Result<Simulation<'m>
             .collect::<Result<Vec<_>>>(),
     )?;
     crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
-    // The contact pairs hold what they need of the slave sets and shared
-    // surfaces; the rest of the local mesh stays for the near-null space,
-    // the dynamics and the output.
+    // The contact pairs hold what they need of the slave sets; the rest of
+    // the local mesh stays for the near-null space, the dynamics and the
+    // output.
     local.slaves = Vec::new();
-    local.shared = Default::default();
     let jac = build_jacobian(&dofs, &bulk, &loads, &[], &local)?;
     crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
