@@ -6,13 +6,16 @@ use super::{even_block, Piece, Wanted};
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;
 
-/// Node owners and PETSc numbers of a partitioned mesh. O(N) memory; it
-/// lives only while pieces are cut.
+/// Node owners, PETSc numbers and node bodies of a partitioned mesh. O(N)
+/// memory; it lives only while pieces are cut.
 #[derive(Debug, Clone)]
 pub struct Numbering {
     nranks: usize,
     node_owner: Vec<i32>,
     petsc_node: Vec<u32>,
+    /// Body of every node: that of the highest natural cell holding it
+    /// (`u32::MAX` for a node in no cell).
+    node_body: Vec<u32>,
     /// First PETSc node of each rank.
     rank_start: Vec<usize>,
 }
@@ -39,10 +42,17 @@ impl Numbering {
             petsc_node[nat] = next[o as usize] as u32;
             next[o as usize] += 1;
         }
+        let mut node_body = vec![u32::MAX; node_owner.len()];
+        for (c, nodes) in mesh.cells_iter().enumerate() {
+            for &v in nodes {
+                node_body[v] = mesh.cell_body[c];
+            }
+        }
         Numbering {
             nranks,
             node_owner,
             petsc_node,
+            node_body,
             rank_start,
         }
     }
@@ -129,7 +139,10 @@ impl Numbering {
             global_cells: mesh.num_cells(),
             nodes: local_natural.iter().map(|&v| mesh.nodes[v]).collect(),
             cell_body: local_cells.iter().map(|&c| mesh.cell_body[c]).collect(),
-            owned_body: self.owned_bodies(mesh, &local_natural[..n_owned]),
+            owned_body: local_natural[..n_owned]
+                .iter()
+                .map(|&v| self.node_body[v])
+                .collect(),
             facet_sets,
             slaves,
             shared,
@@ -187,20 +200,6 @@ impl Numbering {
             owners,
             ghosts,
         }
-    }
-
-    /// The body of each of `owned` (natural ids, ascending): that of the
-    /// highest natural cell holding it. One walk over the cells.
-    fn owned_bodies(&self, mesh: &Mesh, owned: &[usize]) -> Vec<u32> {
-        let mut body = vec![u32::MAX; owned.len()];
-        for (c, nodes) in mesh.cells_iter().enumerate() {
-            for &v in nodes {
-                if let Ok(i) = owned.binary_search(&v) {
-                    body[i] = mesh.cell_body[c];
-                }
-            }
-        }
-        body
     }
 }
 
