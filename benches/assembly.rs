@@ -92,8 +92,9 @@ fn main() {
         let mut part =
             contactlink::partition::partition_cells(&m.mesh, rt.size()).expect("partition");
         rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
-        let dofs = DofMap::new(&m.mesh, &part, rt.rank(), rt.size(), &[]);
-        let bulk = BulkAssembler::new(&m.mesh, &dofs, m.materials.clone()).expect("bulk");
+        let wanted = contactlink::distribution::Wanted::default();
+        let (dofs, local) = DofMap::with_mesh(&m.mesh, &part, rt.rank(), rt.size(), &wanted);
+        let bulk = BulkAssembler::new(&local, &dofs, m.materials.clone()).expect("bulk");
         let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM).expect("pattern");
         bulk.add_pattern(&mut pattern).expect("pattern");
         let mut jac = pattern.build().expect("matrix");

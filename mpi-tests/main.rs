@@ -53,7 +53,59 @@ const CASES: &[Case] = &[
         "agreement_carries_the_lowest_failing_rank_everywhere",
         agreement_carries_the_lowest_failing_rank,
     ),
+    (
+        "a_rank_holds_a_share_of_the_mesh_after_set_up",
+        a_rank_holds_a_share_of_the_mesh,
+    ),
 ];
+
+/// Set up with the mesh moved out of the model: the set-up consumes it
+/// (freed once the pieces are cut), and each rank's local mesh is its share
+/// of the nodes plus one ghost layer, not the whole mesh: on P ranks at most
+/// N/P + N/4 nodes (METIS on a 12³ box; the ghost layer of a piece is a few
+/// planes of nodes), so on 4 ranks at most half the mesh.
+fn a_rank_holds_a_share_of_the_mesh(rt: &Runtime) -> Result<(), String> {
+    let mesh = generate::graded_box(&BoxSpec {
+        divisions: [12, 12, 12],
+        ..BoxSpec::default()
+    })
+    .map_err(|e| e.to_string())?;
+    let n = mesh.num_nodes();
+    let cells = mesh.num_cells();
+    let mut model = model_with(mesh, linear(), Vec::new(), 1);
+    let mesh = model.take_mesh();
+    let sim = contactlink::solve::Simulation::setup_with_mesh(rt, &model, mesh)
+        .map_err(|e| e.to_string())?;
+    ensure(
+        model.mesh.num_nodes() == 0 && model.mesh.num_cells() == 0,
+        || "the model still holds a mesh after take_mesh".into(),
+    )?;
+    let local = sim.local_mesh();
+    ensure(
+        local.global_nodes == n && local.global_cells == cells,
+        || {
+            format!(
+                "local mesh of {} nodes / {} cells, the mesh has {n} / {cells}",
+                local.global_nodes, local.global_cells
+            )
+        },
+    )?;
+    let p = rt.size();
+    let held = local.num_nodes();
+    let bound = if p == 1 { n } else { n / p + n / 4 };
+    ensure(held <= bound, || {
+        format!(
+            "rank {} of {p} holds {held} of {n} nodes (bound {bound})",
+            rt.rank()
+        )
+    })?;
+    ensure(local.block.nodes.len() <= n / p + 1, || {
+        format!(
+            "output block of {} nodes on {p} ranks",
+            local.block.nodes.len()
+        )
+    })
+}
 
 fn main() -> ExitCode {
     let rt = match Runtime::start(&[]) {

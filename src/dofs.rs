@@ -6,7 +6,7 @@
 //! - [`LocalNode`]: index into this rank's owned-then-ghost node arrays;
 //! - [`GlobalDof`]: PETSc row/column, 3·(PETSc node) + component, contiguous per rank.
 pub use crate::distribution::even_block;
-use crate::distribution::{Numbering, Piece};
+use crate::distribution::{LocalMesh, Numbering, Piece, Wanted};
 use crate::mesh::Mesh;
 use crate::petsc::PetscInt;
 use std::collections::HashMap;
@@ -64,19 +64,36 @@ impl DofMap {
         nranks: usize,
         extra_ghosts: &[usize],
     ) -> Self {
-        let numbering = Numbering::new(mesh, partition, nranks);
-        Self::from_piece(numbering.piece(mesh, partition, rank, extra_ghosts, &[]))
+        let wanted = Wanted {
+            extra_ghosts,
+            ..Wanted::default()
+        };
+        Self::with_mesh(mesh, partition, rank, nranks, &wanted).0
     }
 
-    /// This rank's numbering from its piece (local-size arrays only).
-    pub fn from_piece(piece: Piece) -> Self {
+    /// [`DofMap::new`] with the rank's local mesh, cut from the global one on
+    /// this process (tests, benchmarks, code-built models).
+    pub fn with_mesh(
+        mesh: &Mesh,
+        partition: &[i32],
+        rank: usize,
+        nranks: usize,
+        wanted: &Wanted,
+    ) -> (Self, LocalMesh) {
+        let numbering = Numbering::new(mesh, partition, nranks);
+        Self::from_piece(numbering.piece(mesh, partition, rank, wanted))
+    }
+
+    /// This rank's numbering and local mesh from its piece (local-size
+    /// arrays only).
+    pub fn from_piece(piece: Piece) -> (Self, LocalMesh) {
         let local_of_natural = piece
             .local_natural
             .iter()
             .enumerate()
             .map(|(l, &nat)| (nat, l as u32))
             .collect();
-        DofMap {
+        let dofs = DofMap {
             rank: piece.rank,
             nranks: piece.nranks,
             local_cells: piece.local_cells,
@@ -88,7 +105,8 @@ impl DofMap {
             owned_node_start: piece.owned_node_start,
             global_nodes: piece.global_nodes,
             block_petsc: piece.block_petsc,
-        }
+        };
+        (dofs, piece.mesh)
     }
 
     pub fn num_owned_nodes(&self) -> usize {

@@ -79,7 +79,7 @@ fn build_model(
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
     crate::parallel::fault::arm(rt.rank())?;
     let src = SceneSource::resolve(name_or_path)?;
-    let (model, scene_out, mut inputs) = build_model(&src, &opts.overrides)?;
+    let (mut model, scene_out, mut inputs) = build_model(&src, &opts.overrides)?;
     let output = opts.output.clone().or(scene_out.map(PathBuf::from));
     let restart = match &opts.restart {
         Some(from) => Some(read_restart(from, output.as_deref(), &model)?),
@@ -101,9 +101,12 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
         header: !opts.quiet,
         steps: opts.echo && !opts.quiet,
     };
+    // The set-up frees the mesh once each rank has its piece.
+    let mesh = model.take_mesh();
     run_model_with(
         rt,
         &model,
+        Some(mesh),
         output.as_deref(),
         printing,
         Some(&provenance),
@@ -146,12 +149,15 @@ pub fn run_model(
         header: echo,
         steps: echo,
     };
-    run_model_with(rt, model, output, printing, None, None)
+    run_model_with(rt, model, None, output, printing, None, None)
 }
 
+/// `mesh`: the model's mesh moved out of it (freed after the distribution),
+/// or None to set up from `model.mesh`.
 fn run_model_with(
     rt: &Runtime,
     model: &Model,
+    mesh: Option<crate::mesh::Mesh>,
     output: Option<&Path>,
     printing: Printing,
     provenance: Option<&Provenance>,
@@ -168,14 +174,17 @@ fn run_model_with(
         // would otherwise show up only after set-up.
         check_output_writable(rt, path)?;
     }
-    let mut sim = Simulation::setup(rt, model)?;
+    let mut sim = match mesh {
+        Some(mesh) => Simulation::setup_with_mesh(rt, model, mesh)?,
+        None => Simulation::setup(rt, model)?,
+    };
     if printing.header && rt.rank() == 0 {
         println!(
             "{}: {} cells, {} nodes, {} DOFs, {} rank(s), {} load step(s)",
             model.name,
-            model.mesh.num_cells(),
-            model.mesh.num_nodes(),
-            3 * model.mesh.num_nodes(),
+            sim.local_mesh().global_cells,
+            sim.local_mesh().global_nodes,
+            3 * sim.local_mesh().global_nodes,
             rt.size(),
             model.steps
         );
@@ -206,8 +215,8 @@ fn run_model_with(
         report,
         hertz: hertz.last,
         output: output.map(Path::to_path_buf),
-        cells: model.mesh.num_cells(),
-        nodes: model.mesh.num_nodes(),
+        cells: sim.local_mesh().global_cells,
+        nodes: sim.local_mesh().global_nodes,
     })
 }
 

@@ -18,12 +18,13 @@ pub struct SetupSummary {
 /// Collective: builds the model and the set-up of a run on every rank.
 pub fn setup_only(rt: &Runtime, scene: &str, overrides: &[String]) -> Result<SetupSummary> {
     crate::parallel::fault::arm(rt.rank())?;
-    let (model, _) = load_model(scene, overrides)?;
-    let sim = Simulation::setup(rt, &model)?;
+    let (mut model, _) = load_model(scene, overrides)?;
+    let mesh = model.take_mesh();
+    let sim = Simulation::setup_with_mesh(rt, &model, mesh)?;
     Ok(SetupSummary {
         model_name: model.name.clone(),
-        cells: model.mesh.num_cells(),
-        nodes: model.mesh.num_nodes(),
+        cells: sim.local_mesh().global_cells,
+        nodes: sim.local_mesh().global_nodes,
         global_dofs: 3 * sim.dofs().num_global_nodes(),
     })
 }

@@ -2,10 +2,10 @@
 //! consistent mass and stored energy.
 use super::{element_dofs, gather_nodal, scatter_add};
 use super::{MatrixSink, PatternSink};
+use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
-use crate::mesh::Mesh;
 
 /// Everything a rank needs to evaluate its cells, computed once: reference
 /// geometry (shape gradients at the quadrature points), materials and DOFs.
@@ -26,7 +26,7 @@ pub struct BulkAssembler {
 impl BulkAssembler {
     /// `materials[b]` is the material of body b. Fails naming the cell when an
     /// element is inverted in the reference configuration.
-    pub fn new(mesh: &Mesh, dofs: &DofMap, materials: Vec<Material>) -> Result<Self> {
+    pub fn new(mesh: &LocalMesh, dofs: &DofMap, materials: Vec<Material>) -> Result<Self> {
         let cell_type = mesh.cell_type;
         let npc = cell_type.nodes();
         let rule = quadrature_rule(cell_type);
@@ -36,7 +36,8 @@ impl BulkAssembler {
         let mut cell_material = Vec::with_capacity(dofs.local_cells.len());
         let mut scratch = Vec::new();
         for (i, &c) in dofs.local_cells.iter().enumerate() {
-            let x_ref: Vec<[f64; 3]> = mesh.cell(c).iter().map(|&v| mesh.nodes[v]).collect();
+            let nodes = dofs.cell_local_nodes(i, npc);
+            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| mesh.nodes[l as usize]).collect();
             let geom = ElementGeometry::new(cell_type, &x_ref, &rule).map_err(|e| match e {
                 FemError::InvertedElement { qp, det_j } => {
                     Error::InvertedCell { cell: c, qp, det_j }
@@ -47,11 +48,10 @@ impl BulkAssembler {
                 },
             })?;
             geometry.push(geom);
-            let nodes = dofs.cell_local_nodes(i, npc);
             cell_nodes.extend_from_slice(nodes);
             element_dofs(dofs, nodes, &mut scratch);
             cell_dofs.extend_from_slice(&scratch);
-            cell_material.push(mesh.cell_body[c]);
+            cell_material.push(mesh.cell_body[i]);
         }
         Ok(BulkAssembler {
             cell_type,
@@ -267,11 +267,11 @@ impl BulkAssembler {
     }
 
     /// Adds ∫ N b(X) dV for a body force given as a function of the reference
-    /// position (manufactured solutions), into `f_local`.
+    /// position (manufactured solutions), into `f_local`; `local_nodes` are
+    /// the local mesh's coordinates.
     pub fn add_body_force_fn(
         &self,
-        mesh_nodes: &[[f64; 3]],
-        natural: impl Fn(u32) -> usize,
+        local_nodes: &[[f64; 3]],
         b: &dyn Fn([f64; 3]) -> [f64; 3],
         f_local: &mut [f64],
     ) -> Result<()> {
@@ -279,7 +279,7 @@ impl BulkAssembler {
         let mut fe = [0.0; 24];
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
-            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| mesh_nodes[natural(l)]).collect();
+            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| local_nodes[l as usize]).collect();
             fem::body_force_fn(geom, &x_ref, b, &mut fe[..3 * n])
                 .map_err(|e| self.cell_error(i, e))?;
             scatter_add(f_local, nodes, &fe[..3 * n], 1.0);
@@ -309,7 +309,7 @@ fn quadrature_rule(cell_type: CellType) -> QuadRule {
 mod tests {
     use super::*;
     use crate::dofs::LocalNode;
-    use crate::mesh::{stacked_blocks, Perturbation, StackedSpec};
+    use crate::mesh::{stacked_blocks, Mesh, Perturbation, StackedSpec};
 
     const RANKS: usize = 2;
 
@@ -333,8 +333,9 @@ mod tests {
         let partition: Vec<i32> = (0..mesh.num_cells()).map(|c| (c % RANKS) as i32).collect();
         (0..RANKS)
             .map(|rank| {
-                let dofs = DofMap::new(mesh, &partition, rank, RANKS, &[]);
-                let bulk = BulkAssembler::new(mesh, &dofs, materials.to_vec()).unwrap();
+                let wanted = crate::distribution::Wanted::default();
+                let (dofs, local) = DofMap::with_mesh(mesh, &partition, rank, RANKS, &wanted);
+                let bulk = BulkAssembler::new(&local, &dofs, materials.to_vec()).unwrap();
                 (dofs, bulk)
             })
             .collect()

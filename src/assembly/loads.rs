@@ -1,10 +1,10 @@
 //! Surface loads on facet sets: dead tractions and follower pressures.
 use super::{element_dofs, gather_nodal, scatter_add, MatrixSink, PatternSink};
 use crate::amplitude::Amplitude;
-use crate::dofs::{DofMap, GlobalDof, NaturalNode};
+use crate::distribution::{LocalFacetSet, LocalMesh};
+use crate::dofs::{DofMap, GlobalDof};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
-use crate::mesh::{FacetRef, Mesh};
 use crate::model::FacetLoad;
 
 struct LocalFacet {
@@ -34,27 +34,19 @@ pub struct SurfaceLoads {
 }
 
 impl SurfaceLoads {
-    /// `loads` pairs a facet set's facets with the load applied to them and
-    /// its amplitude.
+    /// `loads` pairs this rank's facets of a facet set with the load applied
+    /// to them and its amplitude.
     pub fn new(
-        mesh: &Mesh,
+        mesh: &LocalMesh,
         dofs: &DofMap,
-        loads: &[(&[FacetRef], FacetLoad, Amplitude)],
+        loads: &[(&LocalFacetSet, FacetLoad, Amplitude)],
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let mut facets = Vec::new();
         for (set, load, amplitude) in loads {
-            for f in set.iter().filter(|f| dofs.is_local_cell(f.cell)) {
-                let natural = mesh.facet_nodes(f)?;
-                let nodes: Vec<u32> = natural
-                    .iter()
-                    .map(|&v| {
-                        dofs.local(NaturalNode(v))
-                            .expect("nodes of a local cell are local")
-                            .0 as u32
-                    })
-                    .collect();
-                let x_ref = natural.iter().map(|&v| mesh.nodes[v]).collect();
+            for f in &set.facets {
+                let nodes: Vec<u32> = f.nodes[..facet_type.nodes()].to_vec();
+                let x_ref = mesh.facet_x_ref(f);
                 let mut d = Vec::new();
                 element_dofs(dofs, &nodes, &mut d);
                 facets.push(LocalFacet {

@@ -19,10 +19,10 @@
 //! back to their owners by the same scatter in reverse.
 use crate::assembly::RankExchange;
 use crate::contact::search;
-use crate::dofs::{DofMap, GlobalDof, NaturalNode, DIM};
+use crate::distribution::LocalMesh;
+use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::FacetType;
-use crate::mesh::Mesh;
 
 /// One master facet as this rank knows it, and as it travels between ranks.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,36 +74,31 @@ pub struct HeldMaster {
 
 impl HeldMaster {
     /// This rank's own facets of `set`, and the set-wide sizes. Collective.
-    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, ranks: &dyn RankExchange) -> Result<Self> {
+    pub fn new(
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        set: &str,
+        ranks: &dyn RankExchange,
+    ) -> Result<Self> {
         let refs = mesh
-            .facet_sets
-            .get(set)
+            .facet_set(set)
             .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
         let facet_type = mesh.cell_type.facet_type();
         let n = facet_type.nodes();
-        let mut local_cell = vec![false; mesh.num_cells()];
-        for &c in &dofs.local_cells {
-            local_cell[c] = true;
-        }
         let (mut own, mut own_local) = (Vec::new(), Vec::new());
-        for (i, f) in refs.iter().enumerate() {
-            if !local_cell[f.cell] {
-                continue;
-            }
+        for f in &refs.facets {
             let mut facet = MasterFacet {
-                set_index: i as u32,
+                set_index: f.set_index as u32,
                 natural: [0; 4],
                 dofs: [GlobalDof(0); 4 * DIM],
                 x_ref: [[0.0; 3]; 4],
             };
             let mut local = [0u32; 4];
-            for (a, v) in mesh.facet_nodes(f)?.into_iter().enumerate().take(n) {
-                let l = dofs.local(NaturalNode(v)).ok_or_else(|| {
-                    Error::Partition(format!("master node {v} not visible on rank {}", dofs.rank))
-                })?;
+            for (a, &l) in f.nodes.iter().enumerate().take(n) {
+                let l = LocalNode(l as usize);
                 local[a] = l.0 as u32;
-                facet.natural[a] = v as u64;
-                facet.x_ref[a] = mesh.nodes[v];
+                facet.natural[a] = dofs.natural(l).0 as u64;
+                facet.x_ref[a] = mesh.nodes[l.0];
                 for c in 0..DIM {
                     facet.dofs[DIM * a + c] = dofs.dof(l, c);
                 }

@@ -15,10 +15,10 @@
 use super::kernel::{contact_pressure, reference_weights};
 use super::surfaces::SlaveSurface;
 use crate::assembly::{Halo, HaloFactory};
+use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, QuadRule};
-use crate::mesh::Mesh;
 
 /// The Uzawa update of one multiplier: the contact pressure of the converged
 /// Newton solution, pN = ⟨λN − εN gN⟩ (never negative: contact cannot pull).
@@ -174,47 +174,32 @@ pub struct Multipliers {
 
 impl Multipliers {
     pub fn new(
-        mesh: &Mesh,
         dofs: &DofMap,
-        facet_owner: &[i32],
+        piece: &SlaveSetPiece,
         slave: &SlaveSurface,
         rule: &QuadRule,
         friction: bool,
         halos: &dyn HaloFactory,
     ) -> Result<Self> {
         let set = &slave.set;
-        let facets = mesh
-            .facet_sets
-            .get(set)
-            .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
         let nqp = slave.nqp;
-        if facet_owner.len() != facets.len() {
+        if piece.owners.len() != slave.global_facets {
             return Err(Error::Internal(format!(
                 "slave set '{set}' has {} facets but {} facet owners",
-                facets.len(),
-                facet_owner.len()
+                slave.global_facets,
+                piece.owners.len()
             )));
         }
-        let owner: Vec<usize> = facet_owner.iter().map(|&o| o as usize).collect();
+        let owner: Vec<usize> = piece.owners.iter().map(|&o| o as usize).collect();
         let global_facet = contiguous_numbering(&owner, dofs.nranks);
-        let rank = dofs.rank;
         let owned_node = |nat: usize| dofs.local(NaturalNode(nat)).filter(|&l| dofs.is_owned(l));
-        // Ghost facets: other ranks' facets with a node this rank owns.
-        let mut ghost_facets = Vec::new();
-        for (i, f) in facets.iter().enumerate() {
-            if owner[i] != rank
-                && mesh
-                    .facet_nodes(f)?
-                    .into_iter()
-                    .any(|v| owned_node(v).is_some())
-            {
-                ghost_facets.push(i);
-            }
-        }
+        // Ghost facets: other ranks' facets with a node this rank owns, as
+        // the piece lists them.
+        let ghost_facets = &piece.ghosts;
         let ghosts: Vec<usize> = ghost_facets
             .iter()
-            .flat_map(|&i| {
-                let first = global_facet[i] * nqp;
+            .flat_map(|g| {
+                let first = global_facet[g.set_index] * nqp;
                 (0..nqp).map(move |q| first + q)
             })
             .collect();
@@ -223,16 +208,15 @@ impl Multipliers {
         let mut nodal = Vec::new();
         let mut owned_nodes: Vec<(u32, [f64; 3])> = Vec::new();
         let mut slot_of: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
-        let mut add_facet = |set_index: usize, first_slot: usize| -> Result<()> {
-            let natural = mesh.facet_nodes(&facets[set_index])?;
-            let x_ref: Vec<[f64; 3]> = natural.iter().map(|&v| mesh.nodes[v]).collect();
-            let points = reference_weights(slave.facet_type, &x_ref, rule);
+        let nf = slave.facet_type.nodes();
+        let mut add_facet = |natural: &[usize], x_ref: &[[f64; 3]], first_slot: usize| {
+            let points = reference_weights(slave.facet_type, x_ref, rule);
             for (q, (zeta, w)) in points.iter().enumerate() {
                 let s = facet_shape(slave.facet_type, *zeta);
                 for (a, &v) in natural.iter().enumerate() {
                     if let Some(LocalNode(l)) = owned_node(v) {
                         let owned_slot = *slot_of.entry(l as u32).or_insert_with(|| {
-                            owned_nodes.push((l as u32, mesh.nodes[v]));
+                            owned_nodes.push((l as u32, x_ref[a]));
                             (owned_nodes.len() - 1) as u32
                         });
                         nodal.push(NodalWeight {
@@ -244,13 +228,17 @@ impl Multipliers {
                     }
                 }
             }
-            Ok(())
         };
         for (k, f) in slave.facets.iter().enumerate() {
-            add_facet(f.set_index, k * nqp)?;
+            let natural: Vec<usize> = f
+                .nodes
+                .iter()
+                .map(|&l| dofs.natural(LocalNode(l as usize)).0)
+                .collect();
+            add_facet(&natural, &f.x_ref, k * nqp);
         }
-        for (k, &i) in ghost_facets.iter().enumerate() {
-            add_facet(i, n_owned + k * nqp)?;
+        for (k, g) in ghost_facets.iter().enumerate() {
+            add_facet(&g.natural[..nf], &g.x_ref[..nf], n_owned + k * nqp);
         }
         let tangential = if friction {
             let wide: Vec<usize> = ghosts

@@ -5,10 +5,11 @@
 //! their nodes are ghosted on every rank (the master halo), so each rank
 //! searches and evaluates its own slave points without further messages.
 use super::kernel::reference_weights;
+use crate::distribution::{LocalFacetSet, LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule};
-use crate::mesh::{FacetRef, Mesh};
+use crate::mesh::Mesh;
 
 /// A slave facet this rank evaluates.
 #[derive(Debug, Clone)]
@@ -45,15 +46,23 @@ pub struct SlaveSurface {
 }
 
 impl SlaveSurface {
-    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str, rule: &QuadRule) -> Result<Self> {
-        let facet_refs = facet_set(mesh, set)?;
+    /// This rank's facets of `set` (those of its cells); `piece` carries
+    /// the set-wide mean edge. A degenerate facet fails on the rank that
+    /// holds it (the caller agrees the outcome over the ranks).
+    pub fn new(
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        set: &str,
+        piece: &SlaveSetPiece,
+        rule: &QuadRule,
+    ) -> Result<Self> {
+        let local_set = facet_set(mesh, set)?;
         let facet_type = mesh.cell_type.facet_type();
-        let mut edge_sum = 0.0;
         let mut facets = Vec::new();
         let (mut qp_zeta, mut qp_weight) = (Vec::new(), Vec::new());
-        for (set_index, f) in facet_refs.iter().enumerate() {
-            let natural = mesh.facet_nodes(f)?;
-            let x_ref: Vec<[f64; 3]> = natural.iter().map(|&v| mesh.nodes[v]).collect();
+        for f in &local_set.facets {
+            let set_index = f.set_index;
+            let x_ref = mesh.facet_x_ref(f);
             let weights = reference_weights(facet_type, &x_ref, rule);
             if weights.is_empty() {
                 return Err(Error::scene(
@@ -64,18 +73,11 @@ impl SlaveSurface {
                     ),
                 ));
             }
-            edge_sum += shortest_edge(&x_ref);
-            if !dofs.is_local_cell(f.cell) {
-                continue;
-            }
             for (zeta, w) in &weights {
                 qp_zeta.push(*zeta);
                 qp_weight.push(*w);
             }
-            let nodes: Vec<u32> = natural
-                .iter()
-                .map(|&v| local_node(dofs, v))
-                .collect::<Result<_>>()?;
+            let nodes: Vec<u32> = f.nodes[..facet_type.nodes()].to_vec();
             let facet_dofs = nodes
                 .iter()
                 .flat_map(|&l| (0..DIM).map(move |c| (l, c)))
@@ -89,7 +91,7 @@ impl SlaveSurface {
                 dofs: facet_dofs,
             });
         }
-        let global_facets = facet_refs.len();
+        let global_facets = local_set.global_len;
         Ok(SlaveSurface {
             set: set.to_owned(),
             facet_type,
@@ -98,7 +100,7 @@ impl SlaveSurface {
             qp_zeta,
             qp_weight,
             global_facets,
-            h: edge_sum / global_facets.max(1) as f64,
+            h: piece.mean_edge,
         })
     }
 
@@ -147,8 +149,13 @@ pub struct SharedSurface {
 impl SharedSurface {
     /// The natural ids of the master nodes, which every rank must ghost.
     pub fn natural_nodes(mesh: &Mesh, set: &str) -> Result<Vec<usize>> {
+        let known = || mesh.facet_sets.keys().map(String::as_str).collect();
+        let facets = mesh
+            .facet_sets
+            .get(set)
+            .ok_or_else(|| unknown_set(set, known()))?;
         let mut nodes: Vec<usize> = Vec::new();
-        for f in facet_set(mesh, set)? {
+        for f in facets {
             nodes.extend(mesh.facet_nodes(f)?);
         }
         nodes.sort_unstable();
@@ -156,17 +163,26 @@ impl SharedSurface {
         Ok(nodes)
     }
 
-    pub fn new(mesh: &Mesh, dofs: &DofMap, set: &str) -> Result<Self> {
-        let natural = Self::natural_nodes(mesh, set)?;
+    /// The whole set as every rank received it (`mesh.shared`); its nodes
+    /// are ghosted on every rank, so their coordinates are local.
+    pub fn new(mesh: &LocalMesh, dofs: &DofMap, set: &str) -> Result<Self> {
+        let shared = mesh
+            .shared
+            .get(set)
+            .ok_or_else(|| unknown_set(set, mesh.facet_set_names()))?;
+        let nf = mesh.cell_type.facet_type().nodes();
+        let mut natural = shared.nodes.clone();
+        natural.sort_unstable();
+        natural.dedup();
         let node_local = natural
             .iter()
             .map(|&v| local_node(dofs, v))
             .collect::<Result<Vec<_>>>()?;
-        let x_ref = natural.iter().map(|&v| mesh.nodes[v]).collect();
+        let x_ref = node_local.iter().map(|&l| mesh.nodes[l as usize]).collect();
         let mut facets = Vec::new();
-        for f in facet_set(mesh, set)? {
+        for facet in shared.nodes.chunks_exact(nf) {
             let mut ids = [0u32; 4];
-            for (slot, v) in ids.iter_mut().zip(mesh.facet_nodes(f)?) {
+            for (slot, &v) in ids.iter_mut().zip(facet) {
                 // `natural` is sorted, so the compact index is a binary search away.
                 *slot = natural
                     .binary_search(&v)
@@ -224,17 +240,19 @@ fn current_positions(nodes: &[u32], x_ref: &[[f64; 3]], u_local: &[f64], out: &m
     }
 }
 
-fn facet_set<'m>(mesh: &'m Mesh, set: &str) -> Result<&'m [FacetRef]> {
-    mesh.facet_sets.get(set).map(Vec::as_slice).ok_or_else(|| {
-        let known: Vec<&str> = mesh.facet_sets.keys().map(String::as_str).collect();
-        Error::scene(
-            "contact",
-            format!(
-                "facet set '{set}' does not exist (facet sets: {})",
-                known.join(", ")
-            ),
-        )
-    })
+fn facet_set<'m>(mesh: &'m LocalMesh, set: &str) -> Result<&'m LocalFacetSet> {
+    mesh.facet_set(set)
+        .ok_or_else(|| unknown_set(set, mesh.facet_set_names()))
+}
+
+fn unknown_set(set: &str, known: Vec<&str>) -> Error {
+    Error::scene(
+        "contact",
+        format!(
+            "facet set '{set}' does not exist (facet sets: {})",
+            known.join(", ")
+        ),
+    )
 }
 
 fn local_node(dofs: &DofMap, natural: usize) -> Result<u32> {

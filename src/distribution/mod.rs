@@ -10,12 +10,17 @@
 //! rank, each rank's in natural order. Pieces travel as flat `u64` words
 //! ([`wire`]), one point-to-point message per rank, built and sent one at a
 //! time so rank 0 never holds more than one foreign piece.
+mod local;
 mod numbering;
 mod wire;
 
 #[cfg(test)]
 mod tests;
 
+pub use local::{
+    shortest_edge, GhostFacet, LocalFacet, LocalFacetSet, LocalMesh, OutputBlock, SharedSet,
+    SlaveSetPiece,
+};
 pub use numbering::Numbering;
 
 use crate::error::{Error, Result};
@@ -25,7 +30,7 @@ use mpi::traits::*;
 
 /// One rank's share of the mesh numbering. Every array is of local size:
 /// local cells, local nodes, this rank's output blocks, or a contact surface.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Piece {
     pub rank: usize,
     pub nranks: usize,
@@ -49,9 +54,18 @@ pub struct Piece {
     pub block_petsc: Vec<u32>,
     /// Owning rank of every cell of this rank's output cell block.
     pub block_partition: Vec<i32>,
-    /// Owning rank of each facet of the requested facet sets, in set order
-    /// (empty for a set the mesh lacks). Contact slave sets: O(surface).
-    pub facet_owners: Vec<Vec<i32>>,
+    /// This rank's mesh: local coordinates, cell bodies, facet-set pieces,
+    /// the output block's nodes and cells, and the surface-sized sets asked for.
+    pub mesh: LocalMesh,
+}
+
+/// What, beyond its own cells, each rank's piece must carry.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Wanted<'a> {
+    /// Natural nodes every rank must see (replicated contact surfaces).
+    pub extra_ghosts: &'a [usize],
+    /// Contact slave sets: facet owners, mean edge and ghost facets of each.
+    pub slave_sets: &'a [String],
 }
 
 /// [start, end) of part `rank` when `n` items are split evenly over `nranks`.
@@ -63,17 +77,9 @@ pub fn even_block(n: usize, rank: usize, nranks: usize) -> std::ops::Range<usize
 
 /// Collective: partitions `mesh` on rank 0 and returns this rank's piece.
 ///
-/// Only rank 0 reads `mesh`, `extra_ghosts` and the sets named in
-/// `owner_sets` (the other ranks may pass what they like; today every rank
-/// still holds the same mesh). `extra_ghosts` are natural nodes every rank
-/// must see (replicated contact surfaces); `owner_sets` are the facet sets
-/// whose facet owners each rank needs (contact slave sets).
-pub fn distribute(
-    world: &impl Communicator,
-    mesh: &Mesh,
-    extra_ghosts: &[usize],
-    owner_sets: &[String],
-) -> Result<Piece> {
+/// Only rank 0 reads `mesh` and `wanted` (the other ranks may pass what
+/// they like; today every rank still holds the same mesh).
+pub fn distribute(world: &impl Communicator, mesh: &Mesh, wanted: &Wanted) -> Result<Piece> {
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let part = if rank == 0 {
         crate::partition::partition_cells(mesh, size)
@@ -83,17 +89,17 @@ pub fn distribute(
     let part = parallel::agree(world, part)?;
     crate::footprint::checkpoint("partition");
     if size == 1 {
-        return Ok(Numbering::new(mesh, &part, 1).piece(mesh, &part, 0, extra_ghosts, owner_sets));
+        return Ok(Numbering::new(mesh, &part, 1).piece(mesh, &part, 0, wanted));
     }
     let mine = if rank == 0 {
         let numbering = Numbering::new(mesh, &part, size);
         for r in 1..size {
-            let piece = numbering.piece(mesh, &part, r, extra_ghosts, owner_sets);
+            let piece = numbering.piece(mesh, &part, r, wanted);
             let words = wire::encode(&piece);
             drop(piece);
             world.process_at_rank(r as i32).send(&words[..]);
         }
-        Ok(numbering.piece(mesh, &part, 0, extra_ghosts, owner_sets))
+        Ok(numbering.piece(mesh, &part, 0, wanted))
     } else {
         let (words, _status) = world.process_at_rank(0).receive_vec::<u64>();
         wire::decode(&words).and_then(|p| check_received(p, rank, size))

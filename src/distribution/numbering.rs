@@ -1,16 +1,21 @@
 //! The global numbering, computed once on the rank that holds the mesh:
 //! node owners and PETSc node numbers (two arrays of the node count), from
 //! which each rank's [`Piece`] is cut.
-use super::{even_block, Piece};
+use super::local::{self, GhostFacet, LocalMesh, OutputBlock, SharedSet, SlaveSetPiece};
+use super::{even_block, Piece, Wanted};
 use crate::mesh::Mesh;
+use std::collections::BTreeMap;
 
-/// Node owners and PETSc numbers of a partitioned mesh. O(N) memory; it
-/// lives only while pieces are cut.
+/// Node owners, PETSc numbers and node bodies of a partitioned mesh. O(N)
+/// memory; it lives only while pieces are cut.
 #[derive(Debug, Clone)]
 pub struct Numbering {
     nranks: usize,
     node_owner: Vec<i32>,
     petsc_node: Vec<u32>,
+    /// Body of every node: that of the highest natural cell holding it
+    /// (`u32::MAX` for a node in no cell).
+    node_body: Vec<u32>,
     /// First PETSc node of each rank.
     rank_start: Vec<usize>,
 }
@@ -37,10 +42,17 @@ impl Numbering {
             petsc_node[nat] = next[o as usize] as u32;
             next[o as usize] += 1;
         }
+        let mut node_body = vec![u32::MAX; node_owner.len()];
+        for (c, nodes) in mesh.cells_iter().enumerate() {
+            for &v in nodes {
+                node_body[v] = mesh.cell_body[c];
+            }
+        }
         Numbering {
             nranks,
             node_owner,
             petsc_node,
+            node_body,
             rank_start,
         }
     }
@@ -50,15 +62,8 @@ impl Numbering {
         self.petsc_node[natural] as usize
     }
 
-    /// The piece of rank `rank`; see [`super::distribute`] for the arguments.
-    pub fn piece(
-        &self,
-        mesh: &Mesh,
-        partition: &[i32],
-        rank: usize,
-        extra_ghosts: &[usize],
-        owner_sets: &[String],
-    ) -> Piece {
+    /// The piece of rank `rank`; see [`super::distribute`] for `wanted`.
+    pub fn piece(&self, mesh: &Mesh, partition: &[i32], rank: usize, wanted: &Wanted) -> Piece {
         let n = self.node_owner.len();
         let local_cells: Vec<usize> = (0..mesh.num_cells())
             .filter(|&c| partition[c] as usize == rank)
@@ -69,25 +74,81 @@ impl Numbering {
         let mut ghosts: Vec<usize> = local_cells
             .iter()
             .flat_map(|&c| mesh.cell(c).iter().copied())
-            .chain(extra_ghosts.iter().copied())
+            .chain(wanted.extra_ghosts.iter().copied())
             .filter(|&v| !owned(v))
             .collect();
         ghosts.sort_unstable_by_key(|&v| self.petsc_node[v]);
         ghosts.dedup();
         local_natural.extend(ghosts);
         let local_petsc: Vec<u32> = local_natural.iter().map(|&v| self.petsc_node[v]).collect();
-        let cell_nodes = local_cell_nodes(mesh, &local_cells, &local_natural);
+        let by_natural = sorted_locals(&local_natural);
+        let local_of = |v: usize| {
+            let i = by_natural.partition_point(|&(nat, _)| nat < v);
+            by_natural[i].1
+        };
+        let cell_nodes: Vec<u32> = local_cells
+            .iter()
+            .flat_map(|&c| mesh.cell(c).iter())
+            .map(|&v| local_of(v))
+            .collect();
         let node_block = even_block(n, rank, self.nranks);
         let cell_block = even_block(mesh.num_cells(), rank, self.nranks);
-        let facet_owners = owner_sets
+        let is_local = |c: usize| partition[c] as usize == rank;
+        let facet_sets = mesh
+            .facet_sets
             .iter()
-            .map(|set| {
-                mesh.facet_sets
-                    .get(set)
-                    .map(|fs| fs.iter().map(|f| partition[f.cell]).collect())
-                    .unwrap_or_default()
+            .map(|(name, facets)| {
+                let set = local::local_facets(mesh, facets, is_local, local_of);
+                (name.clone(), set)
             })
             .collect();
+        let slaves = wanted
+            .slave_sets
+            .iter()
+            .map(|set| self.slave_piece(mesh, partition, rank, set))
+            .collect();
+        let mut shared = BTreeMap::new();
+        for (set, facets) in &mesh.facet_sets {
+            let nodes = facets
+                .iter()
+                .filter_map(|f| mesh.facet_nodes_iter(f).ok())
+                .flatten()
+                .collect();
+            let cells = facets.iter().map(|f| f.cell).collect();
+            let faces = facets.iter().map(|f| f.face).collect();
+            shared.insert(
+                set.clone(),
+                SharedSet {
+                    cells,
+                    faces,
+                    nodes,
+                },
+            );
+        }
+        let npc = mesh.cell_type.nodes();
+        let block = OutputBlock {
+            nodes: mesh.nodes[node_block.clone()].to_vec(),
+            cells: mesh.cells[cell_block.start * npc..cell_block.end * npc].to_vec(),
+            cell_body: mesh.cell_body[cell_block.clone()].to_vec(),
+        };
+        let mesh_piece = LocalMesh {
+            cell_type: mesh.cell_type,
+            bodies: mesh.bodies.clone(),
+            bounding_box: mesh.bounding_box(),
+            global_nodes: n,
+            global_cells: mesh.num_cells(),
+            nodes: local_natural.iter().map(|&v| mesh.nodes[v]).collect(),
+            cell_body: local_cells.iter().map(|&c| mesh.cell_body[c]).collect(),
+            owned_body: local_natural[..n_owned]
+                .iter()
+                .map(|&v| self.node_body[v])
+                .collect(),
+            facet_sets,
+            slaves,
+            shared,
+            node_sets: mesh.node_sets.clone(),
+            block,
+        };
         Piece {
             rank,
             nranks: self.nranks,
@@ -101,28 +162,57 @@ impl Numbering {
             cell_nodes,
             block_petsc: self.petsc_node[node_block].to_vec(),
             block_partition: partition[cell_block].to_vec(),
-            facet_owners,
+            mesh: mesh_piece,
+        }
+    }
+
+    /// Rank `rank`'s share of a contact slave set: every facet's owner, the
+    /// set's mean edge, and the other ranks' facets touching its owned nodes.
+    fn slave_piece(&self, mesh: &Mesh, partition: &[i32], rank: usize, set: &str) -> SlaveSetPiece {
+        let Some(facets) = mesh.facet_sets.get(set) else {
+            return SlaveSetPiece::default();
+        };
+        let owners: Vec<i32> = facets.iter().map(|f| partition[f.cell]).collect();
+        let mut ghosts = Vec::new();
+        for (set_index, f) in facets.iter().enumerate() {
+            if owners[set_index] as usize == rank {
+                continue;
+            }
+            let Ok(nodes) = mesh.facet_nodes(f) else {
+                continue;
+            };
+            if !nodes.iter().any(|&v| self.node_owner[v] as usize == rank) {
+                continue;
+            }
+            let mut g = GhostFacet {
+                set_index,
+                natural: [0; 4],
+                x_ref: [[0.0; 3]; 4],
+            };
+            for (a, &v) in nodes.iter().enumerate().take(4) {
+                g.natural[a] = v;
+                g.x_ref[a] = mesh.nodes[v];
+            }
+            ghosts.push(g);
+        }
+        SlaveSetPiece {
+            mean_edge: local::mean_shortest_edge(mesh, facets),
+            owners,
+            ghosts,
         }
     }
 }
 
-/// Local indices of the local cells' nodes, by binary search in a
-/// natural-sorted copy of the local nodes (local size, no O(N) lookup table).
-fn local_cell_nodes(mesh: &Mesh, local_cells: &[usize], local_natural: &[usize]) -> Vec<u32> {
+/// (natural id, local index) of the local nodes, sorted by natural id: the
+/// natural-to-local lookup without an O(N) table.
+fn sorted_locals(local_natural: &[usize]) -> Vec<(usize, u32)> {
     let mut by_natural: Vec<(usize, u32)> = local_natural
         .iter()
         .enumerate()
         .map(|(l, &v)| (v, l as u32))
         .collect();
     by_natural.sort_unstable();
-    local_cells
-        .iter()
-        .flat_map(|&c| mesh.cell(c).iter())
-        .map(|v| {
-            let i = by_natural.partition_point(|&(nat, _)| nat < *v);
-            by_natural[i].1
-        })
-        .collect()
+    by_natural
 }
 
 /// The owner of every node: the lowest rank among the cells containing it.

@@ -1,4 +1,4 @@
-use super::{wire, Numbering};
+use super::{wire, Numbering, Wanted};
 use crate::mesh::{graded_box, BoxSpec};
 
 fn small_box() -> crate::mesh::Mesh {
@@ -11,10 +11,16 @@ fn a_piece_survives_the_wire() {
     let part: Vec<i32> = (0..mesh.num_cells()).map(|c| (c % 3) as i32).collect();
     let sets: Vec<String> = mesh.facet_sets.keys().take(2).cloned().collect();
     let numbering = Numbering::new(&mesh, &part, 3);
+    let wanted = Wanted {
+        extra_ghosts: &[0, 1],
+        slave_sets: &sets,
+    };
     for r in 0..3 {
-        let piece = numbering.piece(&mesh, &part, r, &[0, 1], &sets);
+        let piece = numbering.piece(&mesh, &part, r, &wanted);
         assert_eq!(wire::decode(&wire::encode(&piece)).unwrap(), piece);
-        assert_eq!(piece.facet_owners.len(), 2);
+        assert_eq!(piece.mesh.slaves.len(), 2);
+        assert_eq!(piece.mesh.shared.len(), mesh.facet_sets.len());
+        assert_eq!(piece.mesh.node_sets, mesh.node_sets);
     }
 }
 
@@ -24,7 +30,7 @@ fn pieces_tile_the_nodes_and_cells() {
     let part: Vec<i32> = (0..mesh.num_cells()).map(|c| (c % 4) as i32).collect();
     let numbering = Numbering::new(&mesh, &part, 4);
     let pieces: Vec<_> = (0..4)
-        .map(|r| numbering.piece(&mesh, &part, r, &[], &[]))
+        .map(|r| numbering.piece(&mesh, &part, r, &Wanted::default()))
         .collect();
     let owned: usize = pieces.iter().map(|p| p.n_owned).sum();
     let cells: usize = pieces.iter().map(|p| p.local_cells.len()).sum();
@@ -39,6 +45,77 @@ fn pieces_tile_the_nodes_and_cells() {
             for (k, &l) in p.cell_nodes[i * npc..(i + 1) * npc].iter().enumerate() {
                 assert_eq!(p.local_natural[l as usize], mesh.cell(c)[k]);
             }
+            assert_eq!(p.mesh.cell_body[i], mesh.cell_body[c]);
         }
+        for (l, &nat) in p.local_natural.iter().enumerate() {
+            assert_eq!(p.mesh.nodes[l], mesh.nodes[nat]);
+        }
+    }
+}
+
+/// Every facet of every set lands on exactly one rank, with the local nodes
+/// of the global facet; the output blocks put the whole mesh back together.
+#[test]
+fn facet_sets_and_output_blocks_tile_the_mesh() {
+    let mesh = small_box();
+    let part: Vec<i32> = (0..mesh.num_cells()).map(|c| (c % 3) as i32).collect();
+    let numbering = Numbering::new(&mesh, &part, 3);
+    let pieces: Vec<_> = (0..3)
+        .map(|r| numbering.piece(&mesh, &part, r, &Wanted::default()))
+        .collect();
+    for (name, facets) in &mesh.facet_sets {
+        let mut seen = vec![0; facets.len()];
+        for p in &pieces {
+            let set = &p.mesh.facet_sets[name];
+            assert_eq!(set.global_len, facets.len());
+            for f in &set.facets {
+                seen[f.set_index] += 1;
+                let global = mesh.facet_nodes(&facets[f.set_index]).unwrap();
+                let local: Vec<usize> = f.nodes[..global.len()]
+                    .iter()
+                    .map(|&l| p.local_natural[l as usize])
+                    .collect();
+                assert_eq!(local, global, "{name}");
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1), "{name}: {seen:?}");
+    }
+    let nodes: Vec<[f64; 3]> = pieces
+        .iter()
+        .flat_map(|p| p.mesh.block.nodes.clone())
+        .collect();
+    let cells: Vec<usize> = pieces
+        .iter()
+        .flat_map(|p| p.mesh.block.cells.clone())
+        .collect();
+    assert_eq!(nodes, mesh.nodes);
+    assert_eq!(cells, mesh.cells);
+}
+
+/// A METIS partition over 4 ranks gives every rank a local mesh of about a
+/// quarter of the nodes plus one ghost layer: far below the whole mesh.
+#[test]
+fn a_local_mesh_is_a_fraction_of_the_whole() {
+    let mesh = graded_box(&BoxSpec {
+        divisions: [16, 16, 16],
+        ..BoxSpec::default()
+    })
+    .unwrap();
+    let n = mesh.num_nodes();
+    let part = crate::partition::partition_cells(&mesh, 4).unwrap();
+    let numbering = Numbering::new(&mesh, &part, 4);
+    for r in 0..4 {
+        let p = numbering.piece(&mesh, &part, r, &Wanted::default());
+        let local = p.mesh.num_nodes();
+        assert!(
+            local * 2 < n,
+            "rank {r} holds {local} of {n} nodes: more than half the mesh"
+        );
+        assert!(
+            p.n_owned * 3 < n,
+            "rank {r} owns {} of {n} nodes",
+            p.n_owned
+        );
+        assert!(p.mesh.block.nodes.len() <= n / 4 + 1);
     }
 }

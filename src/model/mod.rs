@@ -48,6 +48,13 @@ pub struct Model {
 }
 
 impl Model {
+    /// Moves the mesh out, leaving an empty mesh of the same cell type: a run
+    /// hands the mesh to the set-up, which frees it once the pieces are cut.
+    pub fn take_mesh(&mut self) -> Mesh {
+        let empty = Mesh::empty(self.mesh.cell_type);
+        std::mem::replace(&mut self.mesh, empty)
+    }
+
     /// Legal but risky choices, for the user to see before a long run.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();

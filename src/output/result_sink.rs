@@ -5,9 +5,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
+use crate::distribution::LocalMesh;
 use crate::dofs::even_block;
 use crate::error::Result;
-use crate::mesh::Mesh;
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::solve::{NaturalOrder, PairFields, Simulation, StepReport, StepSink};
@@ -59,7 +59,7 @@ impl Hdf5Sink {
             natural: NaturalOrder::nodal(dofs)?,
             natural_scalar: NaturalOrder::nodal_scalar(dofs)?,
             pairs,
-            nodes: sim.model().mesh.num_nodes(),
+            nodes: dofs.num_global_nodes(),
         })
     }
 
@@ -267,55 +267,45 @@ pub fn create_result_file(
     provenance: Option<&Provenance>,
 ) -> Result<ResultFile> {
     let model = sim.model();
-    let mesh = &model.mesh;
+    let local = sim.local_mesh();
     let (rank, size) = (rt.rank(), rt.size());
-    let node_block = even_block(mesh.num_nodes(), rank, size);
-    let cell_block = even_block(mesh.num_cells(), rank, size);
-    let nodes: Vec<f64> = mesh.nodes[node_block.clone()]
-        .iter()
-        .flatten()
-        .copied()
-        .collect();
-    let npc = mesh.cell_type.nodes();
-    let cells: Vec<i64> = cell_block
-        .clone()
-        .flat_map(|c| mesh.cell(c).iter().map(|&v| v as i64))
-        .collect();
+    let node_block = even_block(local.global_nodes, rank, size);
+    let cell_block = even_block(local.global_cells, rank, size);
+    let nodes: Vec<f64> = local.block.nodes.iter().flatten().copied().collect();
+    let npc = local.cell_type.nodes();
+    let cells: Vec<i64> = local.block.cells.iter().map(|&v| v as i64).collect();
     let partition: Vec<i32> = sim.partition_block().to_vec();
-    let cell_body: Vec<i32> = mesh.cell_body[cell_block.clone()]
-        .iter()
-        .map(|&b| b as i32)
-        .collect();
-    let facet_sets = facet_sets_out(mesh)?;
+    let cell_body: Vec<i32> = local.block.cell_body.iter().map(|&b| b as i32).collect();
+    let facet_sets = facet_sets_out(local);
     let header = MeshHeader {
-        cell_type: mesh.cell_type.name(),
-        facet_type: mesh.cell_type.facet_type().name(),
+        cell_type: local.cell_type.name(),
+        facet_type: local.cell_type.facet_type().name(),
         nodes: BlockRows {
-            global_rows: mesh.num_nodes(),
+            global_rows: local.global_nodes,
             start: node_block.start,
             cols: 3,
             data: &nodes,
         },
         cells: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: npc,
             data: &cells,
         },
         partition: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: 1,
             data: &partition,
         },
         cell_body: BlockRows {
-            global_rows: mesh.num_cells(),
+            global_rows: local.global_cells,
             start: cell_block.start,
             cols: 1,
             data: &cell_body,
         },
-        bodies: &mesh.bodies,
-        node_sets: &mesh.node_sets,
+        bodies: &local.bodies,
+        node_sets: &local.node_sets,
         facet_sets: &facet_sets,
     };
     let mut file = ResultFile::create(&rt.world(), path, &header)?;
@@ -369,23 +359,19 @@ fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
     Ok(())
 }
 
-fn facet_sets_out(mesh: &Mesh) -> Result<BTreeMap<String, FacetSetOut>> {
+/// Every facet set whole, as every rank received it with its piece.
+fn facet_sets_out(mesh: &LocalMesh) -> BTreeMap<String, FacetSetOut> {
     let k = mesh.cell_type.facet_type().nodes();
-    let mut out = BTreeMap::new();
-    for (name, facets) in &mesh.facet_sets {
-        let mut nodes = Vec::with_capacity(facets.len() * k);
-        for f in facets {
-            nodes.extend(mesh.facet_nodes(f)?.into_iter().map(|v| v as i64));
-        }
-        out.insert(
-            name.clone(),
-            FacetSetOut {
-                nodes,
+    mesh.shared
+        .iter()
+        .map(|(name, set)| {
+            let out = FacetSetOut {
+                nodes: set.nodes.iter().map(|&v| v as i64).collect(),
                 k,
-                cell: facets.iter().map(|f| f.cell as i64).collect(),
-                face: facets.iter().map(|f| f.face as i8).collect(),
-            },
-        );
-    }
-    Ok(out)
+                cell: set.cells.iter().map(|&c| c as i64).collect(),
+                face: set.faces.iter().map(|&f| f as i8).collect(),
+            };
+            (name.clone(), out)
+        })
+        .collect()
 }

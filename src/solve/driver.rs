@@ -28,14 +28,17 @@ use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::pair_state::{PairSnapshot, PointValues};
 use crate::contact::{ContactPair, PairForce, UzawaStats};
-use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::distribution::LocalMesh;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
+use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{self, LogStage, Matrix, Snes, SnesOutcome, Vector};
 use crate::runtime::Runtime;
 use mpi::topology::SimpleCommunicator;
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// A model set up on this rank: partition, numbering, element data, contact
@@ -44,6 +47,8 @@ pub struct Simulation<'m> {
     pub(super) model: &'m Model,
     /// Owning rank of each cell of this rank's output cell block.
     pub(super) partition_block: Vec<i32>,
+    /// This rank's mesh: local nodes and cells, facet-set pieces, output block.
+    pub(super) local: LocalMesh,
     pub(super) dofs: DofMap,
     pub(super) bulk: BulkAssembler,
     pub(super) loads: SurfaceLoads,
@@ -58,23 +63,28 @@ impl<'m> Simulation<'m> {
     /// Collective; fails on every rank if it fails on one.
     pub fn setup(rt: &Runtime, model: &'m Model) -> Result<Self> {
         let stage = LogStage::register("Setup")?;
-        let parts = stage.scope(|| setup::setup(rt, model))?;
+        let parts = stage.scope(|| setup::setup(rt, model, Cow::Borrowed(&model.mesh)))?;
         Ok(Self::from_parts(model, parts))
     }
 
-    fn from_parts(model: &'m Model, parts: setup::SetUp) -> Self {
-        let setup::SetUp {
-            partition_block,
-            dofs,
-            bulk,
-            loads,
-            dirichlet,
-            contact,
-            jac,
-        } = parts;
+    /// [`Simulation::setup`] with the mesh moved out of the model: it is
+    /// freed as soon as the pieces are cut, so no rank holds the global mesh
+    /// past the distribution (`model.mesh` is left as it was handed over,
+    /// normally empty, and nothing after set-up reads it).
+    pub fn setup_with_mesh(rt: &Runtime, model: &'m Model, mesh: Mesh) -> Result<Self> {
+        let stage = LogStage::register("Setup")?;
+        let parts = stage.scope(|| setup::setup(rt, model, Cow::Owned(mesh)))?;
+        Ok(Self::from_parts(model, parts))
+    }
+
+    fn from_parts(model: &'m Model, p: setup::SetUp) -> Self {
+        let (partition_block, local, dofs) = (p.partition_block, p.local, p.dofs);
+        let (bulk, loads, dirichlet, contact, jac) =
+            (p.bulk, p.loads, p.dirichlet, p.contact, p.jac);
         Simulation {
             model,
             partition_block,
+            local,
             dofs,
             bulk,
             loads,
@@ -92,6 +102,11 @@ impl<'m> Simulation<'m> {
 
     pub fn dofs(&self) -> &DofMap {
         &self.dofs
+    }
+
+    /// This rank's share of the mesh.
+    pub fn local_mesh(&self) -> &LocalMesh {
+        &self.local
     }
 
     pub fn model(&self) -> &Model {
@@ -120,6 +135,7 @@ impl<'m> Simulation<'m> {
         let tangent = setup::tangent_kind(&world, model, &self.loads, &self.contact);
         set_solver_defaults(&model.solver, tangent, DIM * self.dofs.num_global_nodes())?;
         let Simulation {
+            local,
             dofs,
             bulk,
             loads,
@@ -134,18 +150,19 @@ impl<'m> Simulation<'m> {
             loads,
             dirichlet,
         };
-        let mut mech = mechanics(model, tangent, parts, contact, jac)?;
-        let stepper = time_stepper(model, &mut mech)?;
+        let mut mech = mechanics(model, tangent, parts, contact, jac, local)?;
+        let stepper = time_stepper(model, &mut mech, local)?;
         let (x, first_step, done) = initial_state(&world, mech.dofs, restart, mech.contact)?;
         let r = x.duplicate()?;
         let x_prev = x.duplicate()?;
         let predictor = Predictor::new(&x, model.solver.extrapolate)?;
         let reaction = x.duplicate()?;
-        let (snes, tolerance) = newton_solver(model)?;
+        let (snes, tolerance) = newton_solver(model, local)?;
         let base = 1.0 / model.steps.max(1) as f64;
         let mut steps = LoadSteps {
             world,
             model,
+            local,
             mech,
             jac,
             stepper,
@@ -191,6 +208,7 @@ fn mechanics<'a>(
     parts: Parts<'a>,
     contact: &'a mut [ContactPair],
     jac: &Matrix,
+    local: &LocalMesh,
 ) -> Result<Mechanics<'a>> {
     let Parts {
         dofs,
@@ -226,12 +244,7 @@ fn mechanics<'a>(
     }
     if let Some(b) = &model.body_force_fn {
         let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
-        bulk.add_body_force_fn(
-            &model.mesh.nodes,
-            |l| dofs.natural(LocalNode(l as usize)).0,
-            b.as_ref(),
-            &mut f,
-        )?;
+        bulk.add_body_force_fn(&local.nodes, b.as_ref(), &mut f)?;
         mech.fixed_external = Some(f);
     }
     Ok(mech)
@@ -239,12 +252,15 @@ fn mechanics<'a>(
 
 /// Implicit dynamics: the time stepper, and the inertia term it hands to
 /// the callbacks (None: quasi-static load stepping).
-fn time_stepper(model: &Model, mech: &mut Mechanics) -> Result<Option<TimeStepper>> {
+fn time_stepper(
+    model: &Model,
+    mech: &mut Mechanics,
+    local: &LocalMesh,
+) -> Result<Option<TimeStepper>> {
     let Some(spec) = &model.dynamics else {
         return Ok(None);
     };
-    let (stepper, inertia) =
-        TimeStepper::new(spec, model.steps, &model.mesh, mech.dofs, mech.bulk)?;
+    let (stepper, inertia) = TimeStepper::new(spec, model.steps, local, mech.dofs, mech.bulk)?;
     mech.inertia = Some(inertia);
     Ok(Some(stepper))
 }
@@ -290,6 +306,7 @@ type Solved = (SnesOutcome, usize, Vec<UzawaStats>);
 struct LoadSteps<'a> {
     world: SimpleCommunicator,
     model: &'a Model,
+    local: &'a LocalMesh,
     mech: Mechanics<'a>,
     jac: &'a mut Matrix,
     stepper: Option<TimeStepper>,
@@ -386,7 +403,7 @@ impl LoadSteps<'_> {
             );
             let rebuild = !self.model.solver.reuse.pattern || self.pattern_builds == 0;
             if parallel::any_rank(&self.world, changed) || rebuild {
-                let (mech, mesh) = (&self.mech, &self.model.mesh);
+                let (mech, mesh) = (&self.mech, self.local);
                 // A new coupling pattern is contact assembly's cost.
                 *self.jac = self
                     .stages

@@ -10,9 +10,9 @@
 use super::newmark::Coefficients;
 use crate::assembly::BulkAssembler;
 use crate::contact::pair_state::SlipRateMap;
-use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::distribution::LocalMesh;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
 use crate::model::DynamicsSpec;
 use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
 use mpi::traits::*;
@@ -71,7 +71,7 @@ impl TimeStepper {
     pub fn new(
         spec: &DynamicsSpec,
         steps: usize,
-        mesh: &Mesh,
+        mesh: &LocalMesh,
         dofs: &DofMap,
         bulk: &BulkAssembler,
     ) -> Result<(Self, Inertia)> {
@@ -85,12 +85,10 @@ impl TimeStepper {
         u_n.set_all(0.0)?;
         let a_n = u_n.duplicate()?;
         let mut v_n = u_n.duplicate()?;
-        let body = node_bodies(mesh);
         v_n.with_array_mut(|v| {
-            for l in 0..dofs.num_owned_nodes() {
-                let nat = dofs.natural(LocalNode(l)).0;
-                if let Some(b) = body[nat] {
-                    v[DIM * l..DIM * l + DIM].copy_from_slice(&spec.initial_velocity[b]);
+            for (l, &b) in mesh.owned_body.iter().enumerate() {
+                if let Some(v0) = spec.initial_velocity.get(b as usize) {
+                    v[DIM * l..DIM * l + DIM].copy_from_slice(v0);
                 }
             }
         })?;
@@ -223,15 +221,4 @@ fn combine(out: &mut Vector, terms: [(f64, &Vector); 3]) -> Result<()> {
         out.axpy(c, v)?;
     }
     Ok(())
-}
-
-/// The body of every node (natural order); None for a node in no cell.
-fn node_bodies(mesh: &Mesh) -> Vec<Option<usize>> {
-    let mut body = vec![None; mesh.num_nodes()];
-    for c in 0..mesh.num_cells() {
-        for &v in mesh.cell(c) {
-            body[v] = Some(mesh.cell_body[c] as usize);
-        }
-    }
-    body
 }

@@ -9,7 +9,8 @@ use super::boundary::Dirichlet;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::distribution;
-use crate::dofs::{DofMap, LocalNode, DIM};
+use crate::distribution::LocalMesh;
+use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
@@ -19,6 +20,7 @@ use crate::parallel;
 use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
 use crate::runtime::Runtime;
 use mpi::traits::*;
+use std::borrow::Cow;
 
 /// What the default solver choice depends on.
 #[derive(Debug, Clone, Copy)]
@@ -134,6 +136,7 @@ pub(super) fn set_solver_defaults(
 /// What set-up hands the driver: every rank's share of the discrete problem.
 pub(super) struct SetUp {
     pub(super) partition_block: Vec<i32>,
+    pub(super) local: LocalMesh,
     pub(super) dofs: DofMap,
     pub(super) bulk: BulkAssembler,
     pub(super) loads: SurfaceLoads,
@@ -142,10 +145,11 @@ pub(super) struct SetUp {
     pub(super) jac: Matrix,
 }
 
-/// Partition, number, precompute element data, resolve contact, allocate the Jacobian.
-pub(super) fn setup(rt: &Runtime, model: &Model) -> Result<SetUp> {
+/// Partition, number, precompute element data, resolve contact, allocate the
+/// Jacobian. `mesh` is the model's mesh (borrowed, or moved out of the model
+/// so that it is freed once the pieces are cut).
+pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<SetUp> {
     let world = rt.world();
-    let mesh = &model.mesh;
     crate::footprint::checkpoint("model build");
     let mut master_nodes = Vec::new();
     // Mortar pairs see both their surfaces whole on every rank; a links
@@ -156,36 +160,47 @@ pub(super) fn setup(rt: &Runtime, model: &Model) -> Result<SetUp> {
         }
         if let MasterSpec::Surface { set } = &pair.master {
             master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-                mesh, set,
+                &mesh, set,
             )?);
         }
         master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-            mesh,
+            &mesh,
             &pair.slave,
         )?);
     }
     let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
-    let mut piece = distribution::distribute(&world, mesh, &master_nodes, &slave_sets)?;
+    let wanted = distribution::Wanted {
+        extra_ghosts: &master_nodes,
+        slave_sets: &slave_sets,
+    };
+    let mut piece = distribution::distribute(&world, &mesh, &wanted)?;
+    // From here on nothing reads the global mesh: an owned one (a scene's
+    // run) is freed before the element data and the Jacobian are allocated.
+    let owned = matches!(mesh, Cow::Owned(_));
+    drop(mesh);
+    drop(master_nodes);
+    if owned {
+        crate::footprint::checkpoint("pieces cut, global mesh freed");
+    }
     let partition_block = std::mem::take(&mut piece.block_partition);
-    let slave_owners = std::mem::take(&mut piece.facet_owners);
-    let dofs = DofMap::from_piece(piece);
+    let (dofs, mut local) = DofMap::from_piece(piece);
     crate::footprint::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
-        BulkAssembler::new(mesh, &dofs, model.materials.clone()),
+        BulkAssembler::new(&local, &dofs, model.materials.clone()),
     )?;
     crate::footprint::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();
     for (set, load, amplitude) in &model.facet_loads {
-        let facets = mesh.facet_sets.get(set).ok_or_else(|| {
+        let facets = local.facet_set(set).ok_or_else(|| {
             Error::scene(
                 "loads",
                 format!("facet set '{set}' does not exist in the mesh"),
             )
         })?;
-        facet_loads.push((facets.as_slice(), load.clone(), amplitude.clone()));
+        facet_loads.push((facets, load.clone(), amplitude.clone()));
     }
-    let loads = parallel::agree(&world, SurfaceLoads::new(mesh, &dofs, &facet_loads))?;
+    let loads = parallel::agree(&world, SurfaceLoads::new(&local, &dofs, &facet_loads))?;
     let dirichlet = parallel::agree(&world, Dirichlet::new(&dofs, &model.dirichlet))?;
     let softest = model
         .materials
@@ -197,12 +212,12 @@ pub(super) fn setup(rt: &Runtime, model: &Model) -> Result<SetUp> {
         model
             .contact
             .iter()
-            .zip(&slave_owners)
-            .map(|(p, owners)| {
+            .zip(&local.slaves)
+            .map(|(p, slave)| {
                 ContactPair::new(
-                    mesh,
+                    &local,
                     &dofs,
-                    owners,
+                    slave,
                     p,
                     softest,
                     &super::halo::PetscHalos,
@@ -212,11 +227,16 @@ pub(super) fn setup(rt: &Runtime, model: &Model) -> Result<SetUp> {
             .collect::<Result<Vec<_>>>(),
     )?;
     crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
-    let jac = build_jacobian(&dofs, &bulk, &loads, &[], mesh)?;
+    // The contact pairs hold what they need of the slave sets; the rest of
+    // the local mesh stays for the near-null space, the dynamics and the
+    // output.
+    local.slaves = Vec::new();
+    let jac = build_jacobian(&dofs, &bulk, &loads, &[], &local)?;
     crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
     Ok(SetUp {
         partition_block,
+        local,
         dofs,
         bulk,
         loads,
@@ -233,7 +253,7 @@ pub(super) fn build_jacobian(
     bulk: &BulkAssembler,
     loads: &SurfaceLoads,
     contact: &[ContactPair],
-    mesh: &Mesh,
+    mesh: &LocalMesh,
 ) -> Result<Matrix> {
     let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
     bulk.add_pattern(&mut pattern)?;
@@ -249,12 +269,12 @@ pub(super) fn build_jacobian(
 
 /// This rank's owned node coordinates, blocked like the displacement (for
 /// the rigid-body near-null space).
-fn owned_coordinates(mesh: &Mesh, dofs: &DofMap) -> Result<Vector> {
+fn owned_coordinates(mesh: &LocalMesh, dofs: &DofMap) -> Result<Vector> {
     let mut v = Vector::new_mpi(dofs.num_owned_dofs())?;
     v.set_block_size(DIM)?;
     v.with_array_mut(|a| {
         for l in 0..dofs.num_owned_nodes() {
-            let p = mesh.nodes[dofs.natural(LocalNode(l)).0];
+            let p = mesh.nodes[l];
             a[DIM * l..DIM * l + DIM].copy_from_slice(&p);
         }
     })?;
@@ -270,10 +290,10 @@ pub(super) struct StepTolerance {
 }
 
 /// Newton (SNES) with the settings' tolerances, the options applied.
-pub(super) fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
+pub(super) fn newton_solver(model: &Model, local: &LocalMesh) -> Result<(Snes, StepTolerance)> {
     let mut snes = Snes::new()?;
     let user_atol = petsc::options::has("-snes_atol")?;
-    let atol_floor = 1e-14 * force_scale(model);
+    let atol_floor = 1e-14 * force_scale(model, local);
     snes.set_tolerances(
         model.solver.atol.unwrap_or(atol_floor),
         model.solver.rtol,
@@ -292,15 +312,14 @@ pub(super) fn newton_solver(model: &Model) -> Result<(Snes, StepTolerance)> {
 
 /// A force scale for the default absolute tolerance: largest Young's modulus
 /// times the squared size of the model.
-pub(super) fn force_scale(model: &Model) -> f64 {
+pub(super) fn force_scale(model: &Model, local: &LocalMesh) -> f64 {
     let e = model
         .materials
         .iter()
         .map(Material::youngs)
         .fold(0.0, f64::max);
-    let l = model
-        .mesh
-        .bounding_box()
+    let l = local
+        .bounding_box
         .map_or(1.0, |b| b.size().into_iter().fold(0.0, f64::max));
     (e * l * l).max(f64::MIN_POSITIVE)
 }

@@ -20,10 +20,10 @@ use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::UzawaStats;
 use crate::contact::surfaces::SharedSurface;
+use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
-use crate::mesh::Mesh;
 use crate::model::{FrictionSpec, PairSpec, RigidSurface};
 
 /// The nodal fields the output writes, one entry per owned mesh node of
@@ -118,7 +118,7 @@ impl MortarPair {
     /// pair's εN for a node of element size `h`; `friction`: the pair's
     /// Coulomb friction, if it computes any (μ > 0).
     pub fn new(
-        mesh: &Mesh,
+        mesh: &LocalMesh,
         dofs: &DofMap,
         spec: &PairSpec,
         master: MortarMaster,
@@ -141,12 +141,9 @@ impl MortarPair {
             .flat_map(|m| &m.facets)
             .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
             .collect();
-        let refs = mesh
-            .facet_sets
-            .get(&spec.slave)
-            .map(Vec::as_slice)
-            .unwrap_or(&[]);
-        let assembled: Vec<bool> = refs.iter().map(|f| dofs.is_local_cell(f.cell)).collect();
+        let assembled: Vec<bool> = mesh.shared.get(&spec.slave).map_or(Vec::new(), |s| {
+            s.cells.iter().map(|&c| dofs.is_local_cell(c)).collect()
+        });
         let mut mine = vec![false; n_slave];
         for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
             for &n in &f[..nf] {

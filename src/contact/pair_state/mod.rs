@@ -29,9 +29,9 @@ use super::mortar::pair::{MortarMaster, MortarPair};
 use super::multipliers::Multipliers;
 use super::surfaces::SlaveSurface;
 use crate::assembly::{HaloFactory, RankExchange};
+use crate::distribution::{LocalMesh, SlaveSetPiece};
 use crate::dofs::DofMap;
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
 use crate::model::{Formulation, MasterSpec, PairSpec, RigidSurface};
 
 /// The master side at run time.
@@ -86,20 +86,20 @@ pub struct ContactPair {
 }
 
 impl ContactPair {
-    /// Resolves a pair on this rank. `slave_owner` is the owning rank of each
-    /// facet of the slave set, in set order; `softest_youngs` sets the
-    /// default penalty.
+    /// Resolves a pair on this rank. `slave_piece` is what the rank holds of
+    /// the slave set beyond its own facets (every facet's owner, the mean
+    /// edge, ghost facets); `softest_youngs` sets the default penalty.
     pub fn new(
-        mesh: &Mesh,
+        mesh: &LocalMesh,
         dofs: &DofMap,
-        slave_owner: &[i32],
+        slave_piece: &SlaveSetPiece,
         spec: &PairSpec,
         softest_youngs: f64,
         halos: &dyn HaloFactory,
         ranks: &dyn RankExchange,
     ) -> Result<Self> {
         let rule = spec.quadrature.rule(mesh.cell_type.facet_type());
-        let slave = SlaveSurface::new(mesh, dofs, &spec.slave, &rule)?;
+        let slave = SlaveSurface::new(mesh, dofs, &spec.slave, slave_piece, &rule)?;
         let master = match &spec.master {
             // A mortar pair searches its own replicated surfaces; it holds
             // no exchanged facets, only the set-wide sizes from here.
@@ -110,9 +110,8 @@ impl ContactPair {
         };
         let friction_spec = spec.active_friction();
         let multipliers = Multipliers::new(
-            mesh,
             dofs,
-            slave_owner,
+            slave_piece,
             &slave,
             &rule,
             friction_spec.is_some(),
@@ -224,10 +223,10 @@ impl ContactPair {
 
 /// Default search distance: generous enough that bodies approaching within a
 /// load step are linked (an open link costs only its evaluation).
-fn default_search_distance(mesh: &Mesh, master: &MasterSide, h: f64) -> f64 {
+fn default_search_distance(mesh: &LocalMesh, master: &MasterSide, h: f64) -> f64 {
     let diag = match master {
         MasterSide::Deformable(m) => m.reference_box.map_or(0.0, |(lo, hi)| norm(&sub(&hi, &lo))),
-        MasterSide::Rigid(_) => mesh.bounding_box().map_or(0.0, |b| b.diagonal()),
+        MasterSide::Rigid(_) => mesh.bounding_box.map_or(0.0, |b| b.diagonal()),
     };
     (10.0 * h).max(0.1 * diag)
 }
