@@ -25,6 +25,7 @@ mod reactions;
 mod report;
 mod restart_state;
 mod setup;
+mod start;
 pub mod stiffness;
 pub mod tolerance;
 mod uzawa;
