@@ -16,8 +16,8 @@
 //! - `system`: nodal weighted gaps and pressures, residual and consistent
 //!   tangent of a set of segments;
 //! - `rigid`, `rigid_friction`: the same against a rigid analytic master
-//!   (integrals over the slave facets alone), `rigid_pair` their run-time
-//!   side;
+//!   (integrals over the slave facets alone), `rigid_master` the surface
+//!   and its motion, `rigid_pair` their run-time side;
 //! - `pair_output`: the pair's nodal fields, force and point values;
 //!   `pair_restart`: taking them over from a result file.
 pub mod friction;
@@ -27,6 +27,7 @@ mod pair_output;
 pub mod pair_restart;
 pub mod rigid;
 pub mod rigid_friction;
+mod rigid_master;
 mod rigid_pair;
 mod rows;
 pub mod segment;

@@ -11,7 +11,7 @@
 //! the same update of `λ_j` bit for bit; the owner of the node is the one
 //! that counts it in the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
-use super::rigid_pair::RigidMaster;
+use super::rigid_master::RigidMaster;
 use super::rows::{signature, Rows};
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeState, Segment};

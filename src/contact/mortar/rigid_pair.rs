@@ -12,68 +12,12 @@ use super::pair::MortarPair;
 use super::pair_output::OutputRows;
 use super::rigid::{self, RigidFacet, RigidInterface, RD};
 use super::rigid_friction::{self, RigidSlip};
+use super::rigid_master::RigidMaster;
 use super::rows::Rows;
 use super::system::{self, NodeState, Seed};
-use crate::amplitude::Amplitude;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
-use crate::model::{PairSpec, RigidSurface};
-
-/// The rigid master of a mortar pair.
-#[derive(Debug, Clone)]
-pub struct RigidMaster {
-    /// As given (at load factor 0) ...
-    surface: RigidSurface,
-    /// ... translated by `amplitude(factor) · motion`.
-    motion: [f64; 3],
-    amplitude: Amplitude,
-    /// Per slot: how many facets this rank evaluates hold the node (all of
-    /// them must be integrated for its weighted gap to be whole).
-    expected: Vec<u32>,
-    /// The step's candidate facets: every evaluated facet with a node within
-    /// the search distance of the surface at the search (ascending).
-    candidates: Vec<u32>,
-    /// Load factor of the last converged step and of the last Uzawa update:
-    /// the quasi-static slip measures the master's translation from the first.
-    pub(super) start_factor: f64,
-    pub(super) last_factor: f64,
-}
-
-impl RigidMaster {
-    /// `slots`: the pair's slave node per slot; `facet_count`: per slave
-    /// node, the evaluated facets that hold it.
-    pub(super) fn new(
-        surface: RigidSurface,
-        spec: &PairSpec,
-        slots: &[u32],
-        facet_count: &[usize],
-    ) -> Self {
-        RigidMaster {
-            surface,
-            motion: spec.motion,
-            amplitude: spec.motion_amplitude.clone(),
-            expected: slots
-                .iter()
-                .map(|&n| facet_count[n as usize] as u32)
-                .collect(),
-            candidates: Vec::new(),
-            start_factor: 0.0,
-            last_factor: 0.0,
-        }
-    }
-
-    /// The surface's translation at load factor `factor`.
-    pub fn shift(&self, factor: f64) -> [f64; 3] {
-        let a = self.amplitude.at(factor);
-        self.motion.map(|c| c * a)
-    }
-
-    /// The surface placed at load factor `factor` (unit normal / axis).
-    pub fn placed(&self, factor: f64) -> RigidSurface {
-        self.surface.moved(self.motion, self.amplitude.at(factor))
-    }
-}
 
 /// One evaluation against the rigid master.
 struct RigidEvaluation<T> {
