@@ -132,7 +132,7 @@ memory: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/memory.py --mpirun "$(MPIRUN)"
 
-# Hertz verification under refinement (figures in the README).
+# Hertz verification under refinement (figures in docs/verification.md).
 hertz-study: build
 	@for args in "--set mesh.fine_size=0.2" "" "--set mesh.level=1 --set solver.direct_max_dofs=200000"; do \
 	  echo "== hertz-cylinder $$args"; \
@@ -158,12 +158,12 @@ ironing-compare: build
 	$(PYTHON) scripts/ironing_ratio.py out/ironing.csv out/ironing-mortar.csv
 
 # Mortar against links on the same scenes, alternated, median of REPEATS
-# runs each, 1 rank (the README's mortar cost table).
+# runs each, 1 rank (the mortar cost table of docs/performance.md).
 mortar-cost: build
 	@mkdir -p out
 	$(PYTHON) scripts/mortar_cost.py target/release/contactlink $(or $(REPEATS),3)
 
-# The friction and dynamics figures of the README (block-slide, ironing, impact).
+# The friction and dynamics figures of docs/verification.md (block-slide, ironing, impact).
 friction-figures: ironing
 	$(MPIRUN) -n $(NP) target/release/contactlink run block-slide -q -o out/block-slide.h5
 	$(PYTHON) scripts/plot_history.py out/block-slide.csv out/block-slide.png --pair floor --mu 0.3 --title "block-slide (μ = 0.3)"

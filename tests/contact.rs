@@ -147,8 +147,8 @@ fn patch_test_pressure_is_uniform_up_to_the_measured_deviation() {
     );
     // The Gauss-point formulation does not pass the patch test on
     // non-matching meshes: slave points carry the load to master nodes with
-    // the slave's quadrature, not the master's. See the README for the
-    // measured deviation; this bound guards against regressions.
+    // the slave's quadrature, not the master's. See docs/verification.md for
+    // the measured deviation; this bound guards against regressions.
     assert!(
         (mean - 10.0).abs() < 1e-2 * 10.0,
         "mean contact pressure {mean} is not E·strain = 10"
@@ -302,7 +302,7 @@ fn contact_scenes_same_on_1_3_4_ranks() {
 fn hertz_sphere_on_a_coarse_mesh_is_close_to_closed_form() {
     // Two elements per contact radius (fine_size 0.5): a smoke test of point
     // contact in 3D, with tolerances for that resolution; the default mesh's
-    // figures are in the README.
+    // figures are in docs/verification.md.
     let dir = scratch("contact-hertz-sphere");
     let out = dir.join("out.h5");
     run_scene(
