@@ -235,11 +235,11 @@ fn still_inside(
     xi: [f64; 2],
 ) -> Option<Projection> {
     const STICKY: f64 = 1e-3;
-    let ids = surface.facets.get(facet as usize)?;
+    let ids = surface.facet(facet)?;
     let n = surface.facet_type.nodes();
     let mut xm = [[0.0; 3]; 4];
     for (slot, &id) in xm.iter_mut().zip(&ids[..n]) {
-        *slot = *surface.positions.get(id as usize)?;
+        *slot = surface.position(id)?;
     }
     let p = projection::project(surface.facet_type, &xm[..n], x, Some(xi));
     (p.converged && p.outside <= STICKY).then_some(p)
