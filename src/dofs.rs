@@ -22,6 +22,43 @@ pub struct LocalNode(pub usize);
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GlobalDof(pub PetscInt);
 
+impl LocalNode {
+    /// The node a compact local-node array entry (`u32`) names: element
+    /// connectivity, facet nodes and surface node lists store local nodes so.
+    pub fn from_u32(l: u32) -> Self {
+        LocalNode(l as usize)
+    }
+
+    /// Position in the rank's local node arrays (owned then ghosts).
+    pub fn index(self) -> usize {
+        self.0
+    }
+
+    /// The compact form stored in local-node arrays. Local node counts fit
+    /// in `u32`: the numbering stores them so.
+    pub fn to_u32(self) -> u32 {
+        self.0 as u32
+    }
+
+    /// Index of component `c` of this node in a local-form (ghosted) array,
+    /// node-major with [`DIM`] entries per node.
+    pub fn vec_index(self, c: usize) -> usize {
+        DIM * self.0 + c
+    }
+
+    /// This node's [`DIM`] entries of a local-form array.
+    pub fn value(self, local: &[f64]) -> [f64; 3] {
+        let b = self.vec_index(0);
+        [local[b], local[b + 1], local[b + 2]]
+    }
+}
+
+impl From<u32> for LocalNode {
+    fn from(l: u32) -> Self {
+        LocalNode::from_u32(l)
+    }
+}
+
 /// This rank's view of the node and DOF numbering. Every array is of local
 /// size (local nodes, local cells, this rank's output block): the global
 /// numbering exists only on the rank that cut the pieces
@@ -131,13 +168,13 @@ impl DofMap {
     }
 
     pub fn natural(&self, l: LocalNode) -> NaturalNode {
-        NaturalNode(self.local_natural[l.0])
+        NaturalNode(self.local_natural[l.index()])
     }
 
     pub fn local(&self, nat: NaturalNode) -> Option<LocalNode> {
         self.local_of_natural
             .get(&nat.0)
-            .map(|&l| LocalNode(l as usize))
+            .map(|&l| LocalNode::from_u32(l))
     }
 
     /// Whether this rank assembles natural cell `c` (binary search: the
@@ -147,11 +184,16 @@ impl DofMap {
     }
 
     pub fn is_owned(&self, l: LocalNode) -> bool {
-        l.0 < self.n_owned
+        l.index() < self.n_owned
     }
 
     pub fn dof(&self, l: LocalNode, c: usize) -> GlobalDof {
-        GlobalDof((DIM * self.local_petsc[l.0] as usize + c) as PetscInt)
+        GlobalDof(petsc_dof(self.local_petsc[l.index()], c))
+    }
+
+    /// The [`DIM`] global DOFs of local node `l`, by component.
+    pub fn node_dofs(&self, l: LocalNode) -> [GlobalDof; DIM] {
+        std::array::from_fn(|c| self.dof(l, c))
     }
 
     /// Local nodes of the i-th local cell.
@@ -163,7 +205,7 @@ impl DofMap {
     pub fn ghost_dofs(&self) -> Vec<PetscInt> {
         self.local_petsc[self.n_owned..]
             .iter()
-            .flat_map(|&p| (0..DIM).map(move |c| (DIM * p as usize + c) as PetscInt))
+            .flat_map(|&p| (0..DIM).map(move |c| petsc_dof(p, c)))
             .collect()
     }
 
@@ -178,4 +220,9 @@ impl DofMap {
     pub fn output_node_block(&self) -> std::ops::Range<usize> {
         even_block(self.global_nodes, self.rank, self.nranks)
     }
+}
+
+/// PETSc DOF of component `c` of PETSc node `p`.
+fn petsc_dof(p: u32, c: usize) -> PetscInt {
+    (DIM * p as usize + c) as PetscInt
 }

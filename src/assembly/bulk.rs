@@ -3,7 +3,7 @@
 use super::{element_dofs, gather_nodal, scatter_add};
 use super::{MatrixSink, PatternSink};
 use crate::distribution::LocalMesh;
-use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
 
@@ -37,7 +37,10 @@ impl BulkAssembler {
         let mut scratch = Vec::new();
         for (i, &c) in dofs.local_cells.iter().enumerate() {
             let nodes = dofs.cell_local_nodes(i, npc);
-            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| mesh.nodes[l as usize]).collect();
+            let x_ref: Vec<[f64; 3]> = nodes
+                .iter()
+                .map(|&l| mesh.nodes[LocalNode::from_u32(l).index()])
+                .collect();
             let geom = ElementGeometry::new(cell_type, &x_ref, &rule).map_err(|e| match e {
                 FemError::InvertedElement { qp, det_j } => {
                     Error::InvertedCell { cell: c, qp, det_j }
@@ -84,6 +87,11 @@ impl BulkAssembler {
         &self.cell_dofs[i * n..(i + 1) * n]
     }
 
+    /// Body (index into `materials`) of the i-th local cell.
+    fn body(&self, i: usize) -> usize {
+        self.cell_material[i] as usize
+    }
+
     fn cell_error(&self, i: usize, e: FemError) -> Error {
         Error::Element {
             cell: self.natural_cell[i],
@@ -99,7 +107,7 @@ impl BulkAssembler {
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
             gather_nodal(u_local, nodes, &mut u[..n]);
-            let mat = &self.materials[self.cell_material[i] as usize];
+            let mat = &self.materials[self.body(i)];
             fem::internal_force(mat, geom, &u[..n], &mut r[..3 * n])
                 .map_err(|e| self.cell_error(i, e))?;
             scatter_add(r_local, nodes, &r[..3 * n], 1.0);
@@ -116,7 +124,7 @@ impl BulkAssembler {
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
             gather_nodal(u_local, nodes, &mut u[..n]);
-            let mat = &self.materials[self.cell_material[i] as usize];
+            let mat = &self.materials[self.body(i)];
             fem::internal_force_and_tangent(
                 mat,
                 geom,
@@ -153,7 +161,7 @@ impl BulkAssembler {
         let n = self.npc();
         let mut me = [0.0; 24 * 24];
         for (i, geom) in self.geometry.iter().enumerate() {
-            let body = self.cell_material[i] as usize;
+            let body = self.body(i);
             let rho = *density.get(body).ok_or_else(|| {
                 self.cell_error(
                     i,
@@ -209,7 +217,7 @@ impl BulkAssembler {
             let nodes = self.nodes(i);
             self.check_local_len(i, u_local)?;
             gather_nodal(u_local, nodes, &mut u[..n]);
-            let body = self.cell_material[i] as usize;
+            let body = self.body(i);
             let mat = self.materials.get(body).ok_or_else(|| {
                 self.cell_error(
                     i,
@@ -228,7 +236,11 @@ impl BulkAssembler {
     /// A local-form array too short for a cell's nodes is an error, not an
     /// out-of-bounds panic in `gather_nodal`.
     fn check_local_len(&self, i: usize, local: &[f64]) -> Result<()> {
-        let needed = self.nodes(i).iter().map(|&l| DIM * (l as usize + 1)).max();
+        let needed = self
+            .nodes(i)
+            .iter()
+            .map(|&l| LocalNode::from_u32(l).vec_index(DIM))
+            .max();
         match needed {
             Some(needed) if needed > local.len() => Err(self.cell_error(
                 i,
@@ -256,7 +268,7 @@ impl BulkAssembler {
         let n = self.npc();
         let mut fe = [0.0; 24];
         for (i, geom) in self.geometry.iter().enumerate() {
-            let bb = b[self.cell_material[i] as usize];
+            let bb = b[self.body(i)];
             if bb == [0.0; 3] {
                 continue;
             }
@@ -279,7 +291,10 @@ impl BulkAssembler {
         let mut fe = [0.0; 24];
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
-            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| local_nodes[l as usize]).collect();
+            let x_ref: Vec<[f64; 3]> = nodes
+                .iter()
+                .map(|&l| local_nodes[LocalNode::from_u32(l).index()])
+                .collect();
             fem::body_force_fn(geom, &x_ref, b, &mut fe[..3 * n])
                 .map_err(|e| self.cell_error(i, e))?;
             scatter_add(f_local, nodes, &fe[..3 * n], 1.0);

@@ -21,17 +21,16 @@ use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 /// The displacement of `nodes` (local indices) read out of a local-form array.
 pub(crate) fn gather_nodal(local: &[f64], nodes: &[u32], out: &mut [[f64; 3]]) {
     for (o, &l) in out.iter_mut().zip(nodes) {
-        let base = DIM * l as usize;
-        *o = [local[base], local[base + 1], local[base + 2]];
+        *o = LocalNode::from_u32(l).value(local);
     }
 }
 
 /// Adds an element vector (node-major, 3 per node) into a local-form array.
 pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign: f64) {
     for (a, &l) in nodes.iter().enumerate() {
-        let base = DIM * l as usize;
+        let l = LocalNode::from_u32(l);
         for c in 0..DIM {
-            local[base + c] += sign * values[DIM * a + c];
+            local[l.vec_index(c)] += sign * values[DIM * a + c];
         }
     }
 }
@@ -40,8 +39,6 @@ pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign
 pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[u32], out: &mut Vec<GlobalDof>) {
     out.clear();
     for &l in nodes {
-        for c in 0..DIM {
-            out.push(dofs.dof(LocalNode(l as usize), c));
-        }
+        out.extend(dofs.node_dofs(LocalNode::from_u32(l)));
     }
 }

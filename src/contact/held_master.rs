@@ -95,13 +95,11 @@ impl HeldMaster {
             };
             let mut local = [0u32; 4];
             for (a, &l) in f.nodes.iter().enumerate().take(n) {
-                let l = LocalNode(l as usize);
-                local[a] = l.0 as u32;
+                let l = LocalNode::from_u32(l);
+                local[a] = l.to_u32();
                 facet.natural[a] = dofs.natural(l).0 as u64;
-                facet.x_ref[a] = mesh.nodes[l.0];
-                for c in 0..DIM {
-                    facet.dofs[DIM * a + c] = dofs.dof(l, c);
-                }
+                facet.x_ref[a] = mesh.nodes[l.index()];
+                facet.dofs[DIM * a..DIM * (a + 1)].copy_from_slice(&dofs.node_dofs(l));
             }
             own.push(facet);
             own_local.push(local);
@@ -254,7 +252,7 @@ impl HeldMaster {
         self.node_local = nodes
             .iter()
             .map(|v| match dofs.local(NaturalNode(v.0 as usize)) {
-                Some(l) => l.0 as u32,
+                Some(l) => l.to_u32(),
                 None => {
                     let slot = n_local + tail_base + self.tail_dofs.len() / DIM;
                     self.tail_dofs.extend(v.1);
@@ -307,8 +305,24 @@ impl HeldMaster {
 
     pub fn facet_dofs(&self, facet: u32, out: &mut Vec<GlobalDof>) {
         for &m in self.facet_nodes(facet) {
-            out.extend_from_slice(&self.node_dofs[m as usize]);
+            out.extend_from_slice(self.held_node_dofs(m));
         }
+    }
+
+    /// Slot of held node `m` in the extended local array (a local node, or
+    /// past them, a tail slot).
+    pub fn extended_slot(&self, m: u32) -> u32 {
+        self.node_local[m as usize]
+    }
+
+    /// Global DOFs of held node `m`.
+    pub fn held_node_dofs(&self, m: u32) -> &[GlobalDof; DIM] {
+        &self.node_dofs[m as usize]
+    }
+
+    /// Position of held facet `facet` in the whole facet set.
+    pub fn set_index_of(&self, facet: u32) -> u32 {
+        self.set_index[facet as usize]
     }
 }
 
@@ -324,8 +338,8 @@ pub fn select_in_box(boxes: &[Aabb], target: Aabb) -> Vec<usize> {
 
 fn current_box(x_ref: &[[f64; 3]], local: &[u32], u_local: &[f64]) -> Aabb {
     x_ref.iter().zip(local).fold(EMPTY_BOX, |b, (x, &l)| {
-        let d = DIM * l as usize;
-        grow(b, [0, 1, 2].map(|c| x[c] + u_local[d + c]))
+        let u = LocalNode::from_u32(l).value(u_local);
+        grow(b, [0, 1, 2].map(|c| x[c] + u[c]))
     })
 }
 

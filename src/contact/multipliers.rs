@@ -37,6 +37,23 @@ struct NodalWeight {
     weight: f64,
 }
 
+impl NodalWeight {
+    /// The owned slave node the weight goes to.
+    fn owned_node(&self) -> LocalNode {
+        LocalNode::from_u32(self.owned_node)
+    }
+
+    /// Position of the node in `owned_nodes`.
+    fn owned_slot(&self) -> usize {
+        self.owned_slot as usize
+    }
+
+    /// The slave point (halo slot) the weight comes from.
+    fn slot(&self) -> usize {
+        self.slot as usize
+    }
+}
+
 /// Contact state of a slave point, as written to the output (`state`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum PointState {
@@ -214,13 +231,13 @@ impl Multipliers {
             for (q, (zeta, w)) in points.iter().enumerate() {
                 let s = facet_shape(slave.facet_type, *zeta);
                 for (a, &v) in natural.iter().enumerate() {
-                    if let Some(LocalNode(l)) = owned_node(v) {
-                        let owned_slot = *slot_of.entry(l as u32).or_insert_with(|| {
-                            owned_nodes.push((l as u32, x_ref[a]));
+                    if let Some(l) = owned_node(v).map(LocalNode::to_u32) {
+                        let owned_slot = *slot_of.entry(l).or_insert_with(|| {
+                            owned_nodes.push((l, x_ref[a]));
                             (owned_nodes.len() - 1) as u32
                         });
                         nodal.push(NodalWeight {
-                            owned_node: l as u32,
+                            owned_node: l,
                             owned_slot,
                             slot: (first_slot + q) as u32,
                             weight: s.n[a] * w,
@@ -233,7 +250,7 @@ impl Multipliers {
             let natural: Vec<usize> = f
                 .nodes
                 .iter()
-                .map(|&l| dofs.natural(LocalNode(l as usize)).0)
+                .map(|&l| dofs.natural(LocalNode::from_u32(l)).0)
                 .collect();
             add_facet(&natural, &f.x_ref, k * nqp);
         }
@@ -308,8 +325,8 @@ impl Multipliers {
         if let Some(t) = &self.tangential {
             let all = t.halo.local();
             for w in &self.nodal {
-                let base = FRICTION_WIDTH * w.slot as usize;
-                let f = &mut forces[w.owned_slot as usize];
+                let base = FRICTION_WIDTH * w.slot();
+                let f = &mut forces[w.owned_slot()];
                 for (fi, ti) in f.iter_mut().zip(&all[base..base + 3]) {
                     *fi += w.weight * ti;
                 }
@@ -326,7 +343,7 @@ impl Multipliers {
         let mut forces = vec![0.0; self.owned_nodes.len()];
         let all = self.halo.local();
         for w in &self.nodal {
-            forces[w.owned_slot as usize] += w.weight * all[w.slot as usize];
+            forces[w.owned_slot()] += w.weight * all[w.slot()];
         }
         Ok(forces)
     }
@@ -338,7 +355,7 @@ impl Multipliers {
         let forces = self.nodal_forces()?;
         let mut area = vec![0.0; forces.len()];
         for w in &self.nodal {
-            area[w.owned_slot as usize] += w.weight;
+            area[w.owned_slot()] += w.weight;
         }
         Ok(forces
             .iter()
@@ -360,8 +377,9 @@ impl Multipliers {
         let all = self.halo.local();
         debug_assert_eq!(all.len(), self.n_owned + self.n_ghost);
         for w in &self.nodal {
-            numerator[w.owned_node as usize] += w.weight * all[w.slot as usize];
-            denominator[w.owned_node as usize] += w.weight;
+            let l = w.owned_node().index();
+            numerator[l] += w.weight * all[w.slot()];
+            denominator[l] += w.weight;
         }
         Ok(())
     }

@@ -80,8 +80,7 @@ impl SlaveSurface {
             let nodes: Vec<u32> = f.nodes[..facet_type.nodes()].to_vec();
             let facet_dofs = nodes
                 .iter()
-                .flat_map(|&l| (0..DIM).map(move |c| (l, c)))
-                .map(|(l, c)| dofs.dof(LocalNode(l as usize), c))
+                .flat_map(|&l| dofs.node_dofs(LocalNode::from_u32(l)))
                 .collect();
             facets.push(SlaveFacet {
                 set_index,
@@ -115,7 +114,7 @@ impl SlaveSurface {
         let mut x = [0.0; 3];
         for (a, (&l, xr)) in facet.nodes.iter().zip(&facet.x_ref).enumerate() {
             for c in 0..DIM {
-                x[c] += s.n[a] * (xr[c] + u_local[DIM * l as usize + c]);
+                x[c] += s.n[a] * (xr[c] + u_local[LocalNode::from_u32(l).vec_index(c)]);
             }
         }
         x
@@ -178,7 +177,10 @@ impl SharedSurface {
             .iter()
             .map(|&v| local_node(dofs, v))
             .collect::<Result<Vec<_>>>()?;
-        let x_ref = node_local.iter().map(|&l| mesh.nodes[l as usize]).collect();
+        let x_ref = node_local
+            .iter()
+            .map(|&l| mesh.nodes[LocalNode::from_u32(l).index()])
+            .collect();
         let mut facets = Vec::new();
         for facet in shared.nodes.chunks_exact(nf) {
             let mut ids = [0u32; 4];
@@ -206,16 +208,18 @@ impl SharedSurface {
         out
     }
 
+    /// Local node of surface node `m` (an index into `node_local`).
+    pub fn local_node(&self, m: u32) -> LocalNode {
+        LocalNode::from_u32(self.node_local[m as usize])
+    }
+
     pub fn facet_nodes(&self, facet: u32) -> &[u32] {
         &self.facets[facet as usize][..self.facet_type.nodes()]
     }
 
     pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<GlobalDof>) {
         for &m in self.facet_nodes(facet) {
-            let l = LocalNode(self.node_local[m as usize] as usize);
-            for c in 0..DIM {
-                out.push(dofs.dof(l, c));
-            }
+            out.extend(dofs.node_dofs(self.local_node(m)));
         }
     }
 }
@@ -231,12 +235,8 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
 
 fn current_positions(nodes: &[u32], x_ref: &[[f64; 3]], u_local: &[f64], out: &mut [[f64; 3]]) {
     for ((o, &l), xr) in out.iter_mut().zip(nodes).zip(x_ref) {
-        let b = DIM * l as usize;
-        *o = [
-            xr[0] + u_local[b],
-            xr[1] + u_local[b + 1],
-            xr[2] + u_local[b + 2],
-        ];
+        let u = LocalNode::from_u32(l).value(u_local);
+        *o = [xr[0] + u[0], xr[1] + u[1], xr[2] + u[2]];
     }
 }
 
@@ -257,7 +257,7 @@ fn unknown_set(set: &str, known: Vec<&str>) -> Error {
 
 fn local_node(dofs: &DofMap, natural: usize) -> Result<u32> {
     dofs.local(NaturalNode(natural))
-        .map(|l| l.0 as u32)
+        .map(LocalNode::to_u32)
         .ok_or_else(|| {
             Error::Partition(format!(
                 "node {natural} is not visible on rank {}",

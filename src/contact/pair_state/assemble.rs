@@ -29,7 +29,7 @@ impl ContactPair {
         let mut by_facet: std::collections::BTreeMap<usize, Vec<u32>> =
             std::collections::BTreeMap::new();
         for l in &self.links {
-            let entry = by_facet.entry(l.qp as usize / self.slave.nqp).or_default();
+            let entry = by_facet.entry(l.qp_index() / self.slave.nqp).or_default();
             if let MasterSide::Deformable(m) = &self.master {
                 for &f in &l.patch {
                     entry.extend_from_slice(m.facet_nodes(f));
@@ -44,7 +44,7 @@ impl ContactPair {
                 master_nodes.sort_unstable();
                 master_nodes.dedup();
                 for &n in &master_nodes {
-                    d.extend_from_slice(&m.node_dofs[n as usize]);
+                    d.extend_from_slice(m.held_node_dofs(n));
                 }
             }
             pattern.add_square(&d)?;
@@ -70,14 +70,14 @@ impl ContactPair {
         let mut link_dofs: Vec<GlobalDof> = Vec::with_capacity(MAX_LINK_DOFS);
         for li in 0..self.links.len() {
             let link = &self.links[li];
-            let sf = link.qp as usize / self.slave.nqp;
+            let sf = link.qp_index() / self.slave.nqp;
             nodes.clear();
             link_dofs.clear();
             nodes.extend_from_slice(&self.slave.facets[sf].nodes);
             link_dofs.extend_from_slice(&self.slave.facets[sf].dofs);
             if let MasterSide::Deformable(m) = &self.master {
                 let fnodes = m.facet_nodes(link.facet);
-                nodes.extend(fnodes.iter().map(|&n| m.node_local[n as usize]));
+                nodes.extend(fnodes.iter().map(|&n| m.extended_slot(n)));
                 m.facet_dofs(link.facet, &mut link_dofs);
             }
             let input = self.link_input(link, u_local, factor, &mut buf);
@@ -111,7 +111,7 @@ impl ContactPair {
         buf: &'b mut LinkBuffers,
     ) -> LinkInput<'b> {
         let LinkBuffers { xs, xm, vs, vm } = buf;
-        let qp = link.qp as usize;
+        let qp = link.qp_index();
         let sf = qp / self.slave.nqp;
         let ns = self.slave.facet_type.nodes();
         self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
@@ -149,7 +149,7 @@ impl ContactPair {
                     let nm = match &self.master {
                         MasterSide::Deformable(m) => {
                             for (v, &n) in vm.iter_mut().zip(master_nodes) {
-                                *v = velocity(m.node_local[n as usize]);
+                                *v = velocity(m.extended_slot(n));
                             }
                             master_nodes.len()
                         }

@@ -21,6 +21,13 @@ pub struct Link {
     pub patch: Vec<u32>,
 }
 
+impl Link {
+    /// The slave quadrature point, as an index into the slave point arrays.
+    pub fn qp_index(&self) -> usize {
+        self.qp as usize
+    }
+}
+
 impl ContactPair {
     /// Before the step's search: the box exchange that decides which master
     /// facets this rank holds (`contact::held_master`), at the same state the
@@ -47,11 +54,7 @@ impl ContactPair {
             .map(|q| self.slave.qp_position(q, u_local))
             .collect();
         // Last step's partners, by set index, across the renumbering.
-        let previous: Vec<u32> = self
-            .links
-            .iter()
-            .map(|l| m.set_index[l.facet as usize])
-            .collect();
+        let previous: Vec<u32> = self.links.iter().map(|l| m.set_index_of(l.facet)).collect();
         let margin = self.search_distance + m.max_facet_size;
         m.exchange(&points, margin, u_local, dofs, tail_base, ranks);
         let mut kept = Vec::with_capacity(self.links.len());
@@ -108,7 +111,7 @@ impl ContactPair {
         let previous: Vec<Option<(u32, [f64; 2])>> = {
             let mut p = vec![None; nq];
             for l in &self.links {
-                p[l.qp as usize] = Some((l.facet, l.xi));
+                p[l.qp_index()] = Some((l.facet, l.xi));
             }
             p
         };
@@ -177,7 +180,7 @@ impl ContactPair {
         let mut h = DefaultHasher::new();
         // Patches by set index: the held numbering changes between steps.
         let global = |f: &u32| match &self.master {
-            MasterSide::Deformable(m) => m.set_index[*f as usize],
+            MasterSide::Deformable(m) => m.set_index_of(*f),
             MasterSide::Rigid(_) => *f,
         };
         for l in &self.links {
@@ -204,7 +207,7 @@ impl ContactPair {
             facets: &m.facets,
         };
         for l in &mut self.links {
-            let x = self.slave.qp_position(l.qp as usize, u_local);
+            let x = self.slave.qp_position(l.qp_index(), u_local);
             // A link stays on its facet while it still projects inside it:
             // where a point lies over a master node or edge, two facets are
             // equally near, and switching between them from one Newton
@@ -232,11 +235,11 @@ fn still_inside(
     xi: [f64; 2],
 ) -> Option<Projection> {
     const STICKY: f64 = 1e-3;
-    let ids = surface.facets.get(facet as usize)?;
+    let ids = surface.facet(facet)?;
     let n = surface.facet_type.nodes();
     let mut xm = [[0.0; 3]; 4];
     for (slot, &id) in xm.iter_mut().zip(&ids[..n]) {
-        *slot = *surface.positions.get(id as usize)?;
+        *slot = surface.position(id)?;
     }
     let p = projection::project(surface.facet_type, &xm[..n], x, Some(xi));
     (p.converged && p.outside <= STICKY).then_some(p)

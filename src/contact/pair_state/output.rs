@@ -102,7 +102,7 @@ impl ContactPair {
         }
         let mut force = PairForce::default();
         for (l, s) in self.links.iter().zip(&states) {
-            let q = l.qp as usize;
+            let q = l.qp_index();
             // The updated multiplier ⟨λN − εN gN⟩ is exactly the pressure the
             // last Newton solve balanced, so forces computed from it are in
             // equilibrium with the reactions to the Newton tolerance.

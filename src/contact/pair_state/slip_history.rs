@@ -28,7 +28,7 @@ impl ContactPair {
                 // step's held numbering). A facet no longer held (the point
                 // slid beyond the search margin within one step) starts
                 // from the link's own point and keeps λT's components.
-                let here = m.set_index[link.facet as usize];
+                let here = m.set_index_of(link.facet);
                 let xi_n = match p.origin {
                     Some((o, f)) if f == here => [o[0], o[1]],
                     Some((o, f)) => match m.held_facet(f) {
@@ -58,7 +58,7 @@ impl ContactPair {
                     // link): no slip yet.
                     None => spec
                         .moved(self.spec.motion, factor)
-                        .closest_point(self.slave.qp_position(link.qp as usize, u_local)),
+                        .closest_point(self.slave.qp_position(link.qp_index(), u_local)),
                 };
                 SlipHistory::Spatial {
                     point_n,
@@ -76,18 +76,16 @@ impl ContactPair {
             return;
         };
         for l in &self.links {
-            let p = &mut t.points[l.qp as usize];
+            let p = &mut t.points[l.qp_index()];
             if p.origin.is_some() {
                 continue;
             }
             p.origin = Some(match &self.master {
-                MasterSide::Deformable(m) => {
-                    ([l.xi[0], l.xi[1], 0.0], m.set_index[l.facet as usize])
-                }
+                MasterSide::Deformable(m) => ([l.xi[0], l.xi[1], 0.0], m.set_index_of(l.facet)),
                 MasterSide::Rigid(spec) => {
                     let foot = spec
                         .moved(self.spec.motion, factor)
-                        .closest_point(points[l.qp as usize]);
+                        .closest_point(points[l.qp_index()]);
                     (
                         [foot[0] - shift[0], foot[1] - shift[1], foot[2] - shift[2]],
                         0,
@@ -115,7 +113,7 @@ impl ContactPair {
         }
         let mut sliding = 0;
         for (l, s) in self.links.iter().zip(states) {
-            let p = &mut fresh[l.qp as usize];
+            let p = &mut fresh[l.qp_index()];
             let Some(f) = s.friction.filter(|_| s.closed) else {
                 continue;
             };
@@ -155,7 +153,7 @@ impl ContactPair {
 /// The set index of held facet `facet` (0 for a rigid master).
 fn global_facet(master: &MasterSide, facet: u32) -> u32 {
     match master {
-        MasterSide::Deformable(m) => m.set_index[facet as usize],
+        MasterSide::Deformable(m) => m.set_index_of(facet),
         MasterSide::Rigid(_) => 0,
     }
 }

@@ -28,7 +28,7 @@ impl ContactPair {
         let mut new_lambda = vec![0.0; self.slave.num_qps()];
         let mut stats = UzawaStats::default();
         for (l, s) in self.links.iter().zip(&states) {
-            let q = l.qp as usize;
+            let q = l.qp_index();
             let facet = q / self.slave.nqp;
             new_lambda[q] =
                 updated_multiplier(self.multipliers.lambda[q], self.facet_penalty[facet], s.gap);

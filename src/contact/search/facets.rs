@@ -15,10 +15,10 @@ pub(super) struct UsableFacet {
 
 pub(super) fn facet_nodes(surface: &SearchSurface, f: u32) -> Option<UsableFacet> {
     let k = surface.facet_type.nodes();
-    let ids = *surface.facets.get(f as usize)?;
+    let ids = *surface.facet(f)?;
     let mut nodes = [[0.0; 3]; 4];
     for (slot, &n) in nodes.iter_mut().zip(&ids[..k]) {
-        let p = *surface.positions.get(n as usize)?;
+        let p = surface.position(n)?;
         if !is_finite3(p) {
             return None;
         }
@@ -64,12 +64,12 @@ pub(super) fn facet_neighbours(surface: &SearchSurface, node_facets: &Rows) -> R
     start.push(0);
     for (f, conn) in surface.facets.iter().enumerate() {
         // Usable facets are exactly those listed at their nodes.
-        let usable = u32::try_from(f)
-            .is_ok_and(|id| node_facets.row(conn[0] as usize).binary_search(&id).is_ok());
+        let usable =
+            u32::try_from(f).is_ok_and(|id| node_facets.row_of(conn[0]).binary_search(&id).is_ok());
         if usable {
             let mut rows: [&[u32]; 4] = [&[]; 4];
             for (row, &n) in rows.iter_mut().zip(&conn[..k]) {
-                *row = node_facets.row(n as usize);
+                *row = node_facets.row_of(n);
             }
             merge_sorted_unique(&mut rows[..k], &mut items);
         }

@@ -252,6 +252,11 @@ impl Rows {
     pub(super) fn row(&self, r: usize) -> &[u32] {
         &self.items[self.range(r)]
     }
+
+    /// The row of node or facet `id` (rows keyed by surface ids).
+    pub(super) fn row_of(&self, id: u32) -> &[u32] {
+        self.row(id as usize)
+    }
 }
 
 /// Running nearest node: smaller squared distance wins, equal distance goes

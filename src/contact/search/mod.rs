@@ -125,6 +125,24 @@ pub struct SearchSurface<'a> {
     pub facets: &'a [[u32; 4]],
 }
 
+impl SearchSurface<'_> {
+    /// Position of node `n`; None past the end.
+    pub fn position(&self, n: u32) -> Option<[f64; 3]> {
+        self.positions.get(n as usize).copied()
+    }
+
+    /// Position of node `n`, which must be in range (a node of a usable
+    /// facet).
+    fn node(&self, n: u32) -> [f64; 3] {
+        self.positions[n as usize]
+    }
+
+    /// Node ids of facet `f`; None past the end.
+    pub fn facet(&self, f: u32) -> Option<&[u32; 4]> {
+        self.facets.get(f as usize)
+    }
+}
+
 /// The result of [`SearchIndex::find`] for one slave point.
 pub struct Found {
     /// The chosen master facet.
@@ -194,8 +212,8 @@ impl SearchIndex {
     pub fn build(surface: &SearchSurface) -> Self {
         let facets = usable_facets(surface);
         let used = used_nodes(surface, &facets);
-        let bbox = points_bounding_box_of(used.iter().map(|&n| surface.positions[n as usize]))
-            .unwrap_or(EMPTY_BOX);
+        let bbox =
+            points_bounding_box_of(used.iter().map(|&n| surface.node(n))).unwrap_or(EMPTY_BOX);
         let grid = if used.is_empty() {
             Grid::single_cell()
         } else {
@@ -208,14 +226,10 @@ impl SearchIndex {
 
         let node_pairs: Vec<(usize, u32)> = used
             .iter()
-            .map(|&n| (grid.index(grid.cell_of(surface.positions[n as usize])), n))
+            .map(|&n| (grid.index(grid.cell_of(surface.node(n))), n))
             .collect();
         let cell_nodes = Rows::build(n_cells, &node_pairs);
-        let cell_node_pos = cell_nodes
-            .items
-            .iter()
-            .map(|&n| surface.positions[n as usize])
-            .collect();
+        let cell_node_pos = cell_nodes.items.iter().map(|&n| surface.node(n)).collect();
 
         let mut facet_box = vec![EMPTY_BOX; surface.facets.len()];
         let mut facet_pairs = Vec::new();
@@ -422,7 +436,7 @@ impl SearchIndex {
     /// box first: on a smooth mesh the first one holds the point and its
     /// distance lets the others be skipped without projecting.
     fn search_ring(&self, surface: &SearchSurface, node: u32, x: [f64; 3], sel: &mut Selection) {
-        let ring = self.node_facets.row(node as usize);
+        let ring = self.node_facets.row_of(node);
         let mut order = [(0.0, 0u32); RING_BUF];
         let n = ring.len().min(RING_BUF);
         for (slot, &f) in order.iter_mut().zip(ring) {
@@ -483,14 +497,14 @@ impl SearchIndex {
     /// The facets around `node` and `chosen`, and every facet sharing a node
     /// with one of them: the union of their neighbour rows.
     fn patch(&self, node: u32, chosen: u32) -> Vec<u32> {
-        let ring = self.node_facets.row(node as usize);
+        let ring = self.node_facets.row_of(node);
         let extra = (!ring.contains(&chosen)).then_some(&chosen);
         let seeds = ring.iter().chain(extra);
         let mut rows: [&[u32]; RING_BUF + 1] = [&[]; RING_BUF + 1];
         if ring.len() + 1 > rows.len() {
             // A huge ring: sort the lot instead.
             let mut patch: Vec<u32> = seeds
-                .flat_map(|&f| self.facet_neighbours.row(f as usize))
+                .flat_map(|&f| self.facet_neighbours.row_of(f))
                 .copied()
                 .collect();
             patch.sort_unstable();
@@ -499,7 +513,7 @@ impl SearchIndex {
         }
         let mut n = 0;
         for &f in seeds {
-            rows[n] = self.facet_neighbours.row(f as usize);
+            rows[n] = self.facet_neighbours.row_of(f);
             n += 1;
         }
         let mut patch = Vec::with_capacity(rows[..n].iter().map(|r| r.len()).sum());
