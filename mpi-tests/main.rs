@@ -207,7 +207,7 @@ fn halo_exchange_refreshes_ghosts(rt: &Runtime) -> Result<(), String> {
         a.fill(-1.0);
         for l in 0..dofs.num_owned_nodes() {
             for c in 0..DIM {
-                a[DIM * l + c] = (DIM * dofs.natural(LocalNode(l)).0 + c) as f64;
+                a[DIM * l + c] = (DIM * dofs.natural(LocalNode::from_index(l)).0 + c) as f64;
             }
         }
     })
@@ -217,7 +217,9 @@ fn halo_exchange_refreshes_ghosts(rt: &Runtime) -> Result<(), String> {
         .with_local(|a| {
             (0..dofs.num_local_nodes())
                 .flat_map(|l| (0..DIM).map(move |c| (l, c)))
-                .filter(|&(l, c)| a[DIM * l + c] != (DIM * dofs.natural(LocalNode(l)).0 + c) as f64)
+                .filter(|&(l, c)| {
+                    a[DIM * l + c] != (DIM * dofs.natural(LocalNode::from_index(l)).0 + c) as f64
+                })
                 .count()
         })
         .map_err(|e| e.to_string())?;

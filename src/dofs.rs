@@ -16,8 +16,11 @@ pub const DIM: usize = 3;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct NaturalNode(pub usize);
 
+/// Stored as `u32` (local node counts fit: the numbering stores them so),
+/// `repr(transparent)` so that connectivity arrays of it are plain `u32`s.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct LocalNode(pub usize);
+#[repr(transparent)]
+pub struct LocalNode(pub u32);
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct GlobalDof(pub PetscInt);
@@ -26,24 +29,28 @@ impl LocalNode {
     /// The node a compact local-node array entry (`u32`) names: element
     /// connectivity, facet nodes and surface node lists store local nodes so.
     pub fn from_u32(l: u32) -> Self {
-        LocalNode(l as usize)
+        LocalNode(l)
+    }
+
+    /// The node at position `i` of the rank's local node arrays.
+    pub fn from_index(i: usize) -> Self {
+        LocalNode(i as u32)
     }
 
     /// Position in the rank's local node arrays (owned then ghosts).
     pub fn index(self) -> usize {
-        self.0
+        self.0 as usize
     }
 
-    /// The compact form stored in local-node arrays. Local node counts fit
-    /// in `u32`: the numbering stores them so.
+    /// The compact form stored in local-node arrays.
     pub fn to_u32(self) -> u32 {
-        self.0 as u32
+        self.0
     }
 
     /// Index of component `c` of this node in a local-form (ghosted) array,
     /// node-major with [`DIM`] entries per node.
     pub fn vec_index(self, c: usize) -> usize {
-        DIM * self.0 + c
+        DIM * self.index() + c
     }
 
     /// This node's [`DIM`] entries of a local-form array.
@@ -77,7 +84,7 @@ pub struct DofMap {
     /// Local index of every local node, keyed by natural id.
     local_of_natural: HashMap<usize, u32>,
     /// Local node indices of the local cells, flat, cell_type.nodes() per cell.
-    cell_nodes: Vec<u32>,
+    cell_nodes: Vec<LocalNode>,
     owned_node_start: usize,
     global_nodes: usize,
     /// PETSc node number of each natural node of this rank's output block.
@@ -138,7 +145,7 @@ impl DofMap {
             local_petsc: piece.local_petsc,
             n_owned: piece.n_owned,
             local_of_natural,
-            cell_nodes: piece.cell_nodes,
+            cell_nodes: piece.cell_nodes.into_iter().map(LocalNode).collect(),
             owned_node_start: piece.owned_node_start,
             global_nodes: piece.global_nodes,
             block_petsc: piece.block_petsc,
@@ -197,7 +204,7 @@ impl DofMap {
     }
 
     /// Local nodes of the i-th local cell.
-    pub fn cell_local_nodes(&self, i: usize, nodes_per_cell: usize) -> &[u32] {
+    pub fn cell_local_nodes(&self, i: usize, nodes_per_cell: usize) -> &[LocalNode] {
         &self.cell_nodes[i * nodes_per_cell..(i + 1) * nodes_per_cell]
     }
 

@@ -16,7 +16,7 @@ pub struct BulkAssembler {
     cell_material: Vec<u32>,
     materials: Vec<Material>,
     /// Local node indices per local cell, flat.
-    cell_nodes: Vec<u32>,
+    cell_nodes: Vec<LocalNode>,
     /// Global DOFs per local cell, flat (3 per node).
     cell_dofs: Vec<GlobalDof>,
     /// Natural cell ids, for error messages.
@@ -37,10 +37,7 @@ impl BulkAssembler {
         let mut scratch = Vec::new();
         for (i, &c) in dofs.local_cells.iter().enumerate() {
             let nodes = dofs.cell_local_nodes(i, npc);
-            let x_ref: Vec<[f64; 3]> = nodes
-                .iter()
-                .map(|&l| mesh.nodes[LocalNode::from_u32(l).index()])
-                .collect();
+            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| mesh.nodes[l.index()]).collect();
             let geom = ElementGeometry::new(cell_type, &x_ref, &rule).map_err(|e| match e {
                 FemError::InvertedElement { qp, det_j } => {
                     Error::InvertedCell { cell: c, qp, det_j }
@@ -77,7 +74,7 @@ impl BulkAssembler {
         self.cell_type.nodes()
     }
 
-    fn nodes(&self, i: usize) -> &[u32] {
+    fn nodes(&self, i: usize) -> &[LocalNode] {
         let n = self.npc();
         &self.cell_nodes[i * n..(i + 1) * n]
     }
@@ -236,11 +233,7 @@ impl BulkAssembler {
     /// A local-form array too short for a cell's nodes is an error, not an
     /// out-of-bounds panic in `gather_nodal`.
     fn check_local_len(&self, i: usize, local: &[f64]) -> Result<()> {
-        let needed = self
-            .nodes(i)
-            .iter()
-            .map(|&l| LocalNode::from_u32(l).vec_index(DIM))
-            .max();
+        let needed = self.nodes(i).iter().map(|&l| l.vec_index(DIM)).max();
         match needed {
             Some(needed) if needed > local.len() => Err(self.cell_error(
                 i,
@@ -291,10 +284,7 @@ impl BulkAssembler {
         let mut fe = [0.0; 24];
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
-            let x_ref: Vec<[f64; 3]> = nodes
-                .iter()
-                .map(|&l| local_nodes[LocalNode::from_u32(l).index()])
-                .collect();
+            let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| local_nodes[l.index()]).collect();
             fem::body_force_fn(geom, &x_ref, b, &mut fe[..3 * n])
                 .map_err(|e| self.cell_error(i, e))?;
             scatter_add(f_local, nodes, &fe[..3 * n], 1.0);
@@ -307,7 +297,7 @@ impl BulkAssembler {
         &self.geometry
     }
 
-    pub fn cell_nodes_of(&self, i: usize) -> &[u32] {
+    pub fn cell_nodes_of(&self, i: usize) -> &[LocalNode] {
         self.nodes(i)
     }
 }
@@ -446,7 +436,7 @@ mod tests {
     /// Local-form displacement u = g(X) on one pretend rank.
     fn local_field(mesh: &Mesh, dofs: &DofMap, g: impl Fn([f64; 3]) -> [f64; 3]) -> Vec<f64> {
         (0..dofs.num_local_nodes())
-            .flat_map(|l| g(mesh.nodes[dofs.natural(LocalNode(l)).0]))
+            .flat_map(|l| g(mesh.nodes[dofs.natural(LocalNode::from_index(l)).0]))
             .collect()
     }
 

@@ -2,7 +2,7 @@
 use super::{element_dofs, gather_nodal, scatter_add, MatrixSink, PatternSink};
 use crate::amplitude::Amplitude;
 use crate::distribution::{LocalFacetSet, LocalMesh};
-use crate::dofs::{DofMap, GlobalDof};
+use crate::dofs::{DofMap, GlobalDof, LocalNode};
 use crate::error::{Error, Result};
 use crate::fem::{self, FacetType};
 use crate::model::FacetLoad;
@@ -10,7 +10,7 @@ use crate::model::FacetLoad;
 struct LocalFacet {
     /// Natural id of the cell the facet belongs to (for error messages).
     cell: usize,
-    nodes: Vec<u32>,
+    nodes: Vec<LocalNode>,
     x_ref: Vec<[f64; 3]>,
     dofs: Vec<GlobalDof>,
     load: FacetLoad,
@@ -45,7 +45,10 @@ impl SurfaceLoads {
         let mut facets = Vec::new();
         for (set, load, amplitude) in loads {
             for f in &set.facets {
-                let nodes: Vec<u32> = f.nodes[..facet_type.nodes()].to_vec();
+                let nodes: Vec<LocalNode> = f.nodes[..facet_type.nodes()]
+                    .iter()
+                    .map(|&l| LocalNode::from_u32(l))
+                    .collect();
                 let x_ref = mesh.facet_x_ref(f);
                 let mut d = Vec::new();
                 element_dofs(dofs, &nodes, &mut d);

@@ -19,16 +19,15 @@ pub use sink::{MatrixSink, PatternSink};
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 
 /// The displacement of `nodes` (local indices) read out of a local-form array.
-pub(crate) fn gather_nodal(local: &[f64], nodes: &[u32], out: &mut [[f64; 3]]) {
+pub(crate) fn gather_nodal(local: &[f64], nodes: &[LocalNode], out: &mut [[f64; 3]]) {
     for (o, &l) in out.iter_mut().zip(nodes) {
-        *o = LocalNode::from_u32(l).value(local);
+        *o = l.value(local);
     }
 }
 
 /// Adds an element vector (node-major, 3 per node) into a local-form array.
-pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign: f64) {
+pub(crate) fn scatter_add(local: &mut [f64], nodes: &[LocalNode], values: &[f64], sign: f64) {
     for (a, &l) in nodes.iter().enumerate() {
-        let l = LocalNode::from_u32(l);
         for c in 0..DIM {
             local[l.vec_index(c)] += sign * values[DIM * a + c];
         }
@@ -36,9 +35,9 @@ pub(crate) fn scatter_add(local: &mut [f64], nodes: &[u32], values: &[f64], sign
 }
 
 /// Global DOFs of `nodes` (local indices), node-major.
-pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[u32], out: &mut Vec<GlobalDof>) {
+pub(crate) fn element_dofs(dofs: &DofMap, nodes: &[LocalNode], out: &mut Vec<GlobalDof>) {
     out.clear();
     for &l in nodes {
-        out.extend(dofs.node_dofs(LocalNode::from_u32(l)));
+        out.extend(dofs.node_dofs(l));
     }
 }

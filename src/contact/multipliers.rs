@@ -247,11 +247,7 @@ impl Multipliers {
             }
         };
         for (k, f) in slave.facets.iter().enumerate() {
-            let natural: Vec<usize> = f
-                .nodes
-                .iter()
-                .map(|&l| dofs.natural(LocalNode::from_u32(l)).0)
-                .collect();
+            let natural: Vec<usize> = f.nodes.iter().map(|&l| dofs.natural(l).0).collect();
             add_facet(&natural, &f.x_ref, k * nqp);
         }
         for (k, g) in ghost_facets.iter().enumerate() {

@@ -16,7 +16,7 @@ use crate::mesh::Mesh;
 pub struct SlaveFacet {
     /// Position in the slave facet set: output rows are ordered by it.
     pub set_index: usize,
-    pub nodes: Vec<u32>,
+    pub nodes: Vec<LocalNode>,
     pub x_ref: Vec<[f64; 3]>,
     pub dofs: Vec<GlobalDof>,
     /// Shortest edge: the local element size for the penalty and tolerance.
@@ -77,11 +77,11 @@ impl SlaveSurface {
                 qp_zeta.push(*zeta);
                 qp_weight.push(*w);
             }
-            let nodes: Vec<u32> = f.nodes[..facet_type.nodes()].to_vec();
-            let facet_dofs = nodes
+            let nodes: Vec<LocalNode> = f.nodes[..facet_type.nodes()]
                 .iter()
-                .flat_map(|&l| dofs.node_dofs(LocalNode::from_u32(l)))
+                .map(|&l| LocalNode::from_u32(l))
                 .collect();
+            let facet_dofs = nodes.iter().flat_map(|&l| dofs.node_dofs(l)).collect();
             facets.push(SlaveFacet {
                 set_index,
                 nodes,
@@ -114,7 +114,7 @@ impl SlaveSurface {
         let mut x = [0.0; 3];
         for (a, (&l, xr)) in facet.nodes.iter().zip(&facet.x_ref).enumerate() {
             for c in 0..DIM {
-                x[c] += s.n[a] * (xr[c] + u_local[LocalNode::from_u32(l).vec_index(c)]);
+                x[c] += s.n[a] * (xr[c] + u_local[l.vec_index(c)]);
             }
         }
         x
@@ -233,9 +233,15 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn current_positions(nodes: &[u32], x_ref: &[[f64; 3]], u_local: &[f64], out: &mut [[f64; 3]]) {
+/// `nodes`: local nodes, stored as such or in the compact `u32` form.
+fn current_positions<N: Copy + Into<LocalNode>>(
+    nodes: &[N],
+    x_ref: &[[f64; 3]],
+    u_local: &[f64],
+    out: &mut [[f64; 3]],
+) {
     for ((o, &l), xr) in out.iter_mut().zip(nodes).zip(x_ref) {
-        let u = LocalNode::from_u32(l).value(u_local);
+        let u = l.into().value(u_local);
         *o = [xr[0] + u[0], xr[1] + u[1], xr[2] + u[2]];
     }
 }

@@ -32,7 +32,7 @@ impl RestartState {
     ) -> Result<()> {
         let start = dofs.owned_dof_start();
         x.with_array_mut(|xa| {
-            for l in (0..dofs.num_local_nodes()).map(LocalNode) {
+            for l in (0..dofs.num_local_nodes()).map(LocalNode::from_index) {
                 if !dofs.is_owned(l) {
                     continue;
                 }

@@ -193,7 +193,7 @@ impl MortarPair {
         let owned = slots
             .iter()
             .map(|&n| {
-                mine[n as usize] && dofs.is_owned(LocalNode(slave.node_local[n as usize] as usize))
+                mine[n as usize] && dofs.is_owned(LocalNode::from_u32(slave.node_local[n as usize]))
             })
             .collect();
         let nodal = NodalData::new(
@@ -220,7 +220,7 @@ impl MortarPair {
         }
         let natural = node_local
             .iter()
-            .map(|&l| dofs.natural(LocalNode(l as usize)).0)
+            .map(|&l| dofs.natural(LocalNode::from_u32(l)).0)
             .collect();
         let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
@@ -323,7 +323,7 @@ impl MortarPair {
     }
 
     pub(super) fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
-        dofs.dof(LocalNode(self.node_local[id as usize] as usize), c)
+        dofs.dof(LocalNode::from_u32(self.node_local[id as usize]), c)
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple

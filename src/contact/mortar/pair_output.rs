@@ -146,7 +146,7 @@ impl MortarPair {
             let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
             let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
             for (n, na) in slave.facets[q / slave.nqp].nodes.iter().zip(s.n) {
-                if let Some(&j) = by_node.get(n) {
+                if let Some(&j) = by_node.get(&n.to_u32()) {
                     for c in 0..3 {
                         t[c] -= na * f.nodal.lambda[j][c];
                         slip[c] += na * f.slip[j][c];

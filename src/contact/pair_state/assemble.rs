@@ -73,7 +73,7 @@ impl ContactPair {
             let sf = link.qp_index() / self.slave.nqp;
             nodes.clear();
             link_dofs.clear();
-            nodes.extend_from_slice(&self.slave.facets[sf].nodes);
+            nodes.extend(self.slave.facets[sf].nodes.iter().map(|l| l.to_u32()));
             link_dofs.extend_from_slice(&self.slave.facets[sf].dofs);
             if let MasterSide::Deformable(m) = &self.master {
                 let fnodes = m.facet_nodes(link.facet);
@@ -144,7 +144,7 @@ impl ContactPair {
                         [0, 1, 2].map(|c| rate.dv_du * u_local[d + c] + rate.offset[d + c])
                     };
                     for (v, &n) in vs.iter_mut().zip(&self.slave.facets[sf].nodes) {
-                        *v = velocity(n);
+                        *v = velocity(n.to_u32());
                     }
                     let nm = match &self.master {
                         MasterSide::Deformable(m) => {

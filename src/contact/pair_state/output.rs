@@ -143,7 +143,7 @@ impl ContactPair {
                 .nodes
                 .iter()
                 .zip(s.n)
-                .map(|(n, na)| na * lambda.get(n).copied().unwrap_or(0.0))
+                .map(|(n, na)| na * lambda.get(&n.to_u32()).copied().unwrap_or(0.0))
                 .sum();
         }
         let (fields, force) = m.output(u_local, self.mortar_rate().as_ref(), factor);
