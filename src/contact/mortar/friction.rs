@@ -337,6 +337,19 @@ pub fn tangent(
         }
     }
     // c ⊗ ∂tT_j/∂x.
+    emit_outer(coef, grad, emit);
+}
+
+/// Emits, per active node j, the outer product of its assembled
+/// coefficients (`coef[j]`, by row node) with the gradient of its
+/// tangential traction (`grad[j]`, per component): the chain-rule part of
+/// the tangential tangent, the same for deformable and rigid masters.
+pub(super) fn emit_outer(
+    mut coef: Vec<Vec<(NodeDof, f64)>>,
+    mut grad: Vec<[Vec<(NodeDof, f64)>; 3]>,
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    let nn = coef.len();
     for j in 0..nn {
         if coef[j].is_empty() {
             continue;

@@ -34,20 +34,6 @@ use crate::model::RigidSurface;
 pub const RIGID_DOFS: usize = 3 * MAX_FACET_NODES;
 pub(super) type RD = Dual<RIGID_DOFS>;
 
-impl Seed for RD {
-    fn seed(v: f64, i: usize) -> Self {
-        Dual::variable(v, i)
-    }
-
-    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self {
-        let mut d = Dual::constant(v);
-        if let Some(e) = d.eps.get_mut(i) {
-            *e = slope;
-        }
-        d
-    }
-}
-
 /// A slave surface against a rigid master, as node ids into `positions`.
 #[derive(Debug, Clone, Copy)]
 pub struct RigidInterface<'a> {

@@ -14,9 +14,9 @@
 //!   reaction). `D` is constant, so the tangent is `D_jk ⊗ ∂tT_j/∂x` alone,
 //!   through the aggregates' derivatives (slip branch, coupling to `p_j`
 //!   and, in dynamics, the damping `Δt ∂v/∂x`).
-use super::friction::{node_law, Increment, NodalFriction, NodeFriction};
+use super::friction::{emit_outer, node_law, Increment, NodalFriction, NodeFriction};
 use super::rigid::{for_each_node, RigidFacet, RigidInterface, RD};
-use super::system::{merged, NodalData, NodeDof, NodeState, Seed};
+use super::system::{NodalData, NodeDof, NodeState, Seed};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::MAX_FACET_NODES;
 
@@ -110,7 +110,7 @@ pub fn tangent(
     facets: &[RigidFacet<RD>],
     slips: &[RigidSlip<RD>],
     frictions: &[NodeFriction],
-    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+    emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
     let ns = interface.facet_type.nodes();
     let nn = nodal.nodes.len();
@@ -152,21 +152,5 @@ pub fn tangent(
         }
     }
     // D ⊗ ∂tT_j/∂x.
-    for j in 0..nn {
-        if coef[j].is_empty() {
-            continue;
-        }
-        let rows = merged(std::mem::take(&mut coef[j]));
-        for (i, g) in std::mem::take(&mut grad[j]).into_iter().enumerate() {
-            let g = merged(g);
-            for ((id, _), c) in &rows {
-                for (col, dt) in &g {
-                    let v = c * dt;
-                    if v != 0.0 {
-                        emit((*id, i), *col, v);
-                    }
-                }
-            }
-        }
-    }
+    emit_outer(coef, grad, emit);
 }

@@ -95,7 +95,9 @@ impl Seed for f64 {
     }
 }
 
-impl Seed for D {
+// One impl for every size: the segment variables (`D`) and a rigid
+// master's slave-facet variables alike.
+impl<const N: usize> Seed for Dual<N> {
     fn seed(v: f64, i: usize) -> Self {
         Dual::variable(v, i)
     }
