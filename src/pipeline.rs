@@ -114,12 +114,13 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
     )
 }
 
-/// The state to continue from, read before anything is solved or written.
+/// The file to continue from, checked before set-up (what needs no mesh);
+/// its rows are read after set-up, by each rank for its piece.
 fn read_restart(
     from: &Path,
     output: Option<&Path>,
     model: &Model,
-) -> Result<crate::solve::RestartState> {
+) -> Result<crate::restart::RestartFile> {
     let same = |out: &Path| match (out.canonicalize(), from.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => out == from,
@@ -134,7 +135,7 @@ fn read_restart(
     // error, a file system hiccup) is every rank's, named by that rank.
     let world = mpi::topology::SimpleCommunicator::world();
     let read = crate::parallel::fault::check(crate::parallel::fault::FaultPhase::RestartRead)
-        .and_then(|()| crate::restart::read(from, model));
+        .and_then(|()| crate::restart::open(from, model));
     crate::parallel::agree(&world, read)
 }
 
@@ -161,7 +162,7 @@ fn run_model_with(
     output: Option<&Path>,
     printing: Printing,
     provenance: Option<&Provenance>,
-    restart: Option<&crate::solve::RestartState>,
+    restart: Option<&crate::restart::RestartFile>,
 ) -> Result<RunSummary> {
     let echo = printing.steps;
     if rt.rank() == 0 {
@@ -178,6 +179,12 @@ fn run_model_with(
         Some(mesh) => Simulation::setup_with_mesh(rt, model, mesh)?,
         None => Simulation::setup(rt, model)?,
     };
+    // Each rank reads its rows of the file, now that it has its piece
+    // (before the result file exists: a mismatch leaves nothing behind).
+    let restart = restart
+        .map(|file| crate::restart::read(file, &sim))
+        .transpose()?;
+    let restart = restart.as_ref();
     if printing.header && rt.rank() == 0 {
         println!(
             "{}: {} cells, {} nodes, {} DOFs, {} rank(s), {} load step(s)",

@@ -2,65 +2,97 @@
 //! (displacement, every pair's λN and friction history) so that a run
 //! continues from it and ends where an uninterrupted run ends.
 //!
-//! Every rank reads the file on its own (serial HDF5, read-only): the arrays
-//! are in natural order, and each rank picks its own rows. The file must come
-//! from the same scene: same mesh (node count and coordinates, cell count),
-//! same contact pairs; anything else is an error naming the file and what
-//! differs, raised before any solve.
+//! Two stages. [`open`], before set-up: the file is a result file with a
+//! step, and the scene can be continued at all (no mesh is needed). [`read`],
+//! after set-up, collectively, from the distributed data alone (no rank holds
+//! the global mesh then): each rank reads one contiguous block of every
+//! natural-order array it needs (serial HDF5, read-only, one hyperslab) and a
+//! scatter brings each row to the rank that uses it ([`fetch`]). So per rank
+//! the restart holds O(N / ranks) of the file plus its own rows:
+//! - the mesh check: the rank's output block of `/mesh/nodes` against the
+//!   coordinates it has of that block; node and cell counts from the
+//!   datasets' shapes. Any rank's mismatch is every rank's error, naming the
+//!   first node that moved;
+//! - the displacement of its owned nodes;
+//! - a links pair's λN and friction history of its own slave points;
+//! - a mortar pair's nodal λ, λT and slip origins of the pair nodes it
+//!   holds.
+//!
+//! The file must come from the same scene: same mesh (node count and
+//! coordinates, cell count), same contact pairs; anything else is an error
+//! naming the file and what differs, raised before any solve.
+mod fetch;
+
 use crate::contact::multipliers::FrictionRecord;
 use crate::contact::pair_state::{FrictionRows, MortarRows, RestartRows};
+use crate::contact::ContactPair;
+use crate::distribution::LocalMesh;
+use crate::dofs::{even_block, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::output::{layout, read_dataset, read_nodal, read_step_attrs, OutputError};
-use crate::solve::RestartState;
-use std::path::Path;
+use crate::output::{
+    dataset_shape, layout, read_nodal, read_rows, read_step_attrs, OutputError, StepInfo,
+};
+use crate::parallel;
+use crate::solve::{RestartState, Simulation};
+use fetch::Fetch;
+use mpi::topology::SimpleCommunicator;
+use std::path::{Path, PathBuf};
 
-/// Reads the last step of `path` for `model`.
-pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
-    let fail = |message: String| Error::Restart(format!("{}: {message}", path.display()));
-    let h5 = |e: OutputError| fail(e.to_string());
+/// A result file that passed the checks needing no mesh: what [`read`]
+/// continues from once the ranks have their pieces.
+#[derive(Debug, Clone)]
+pub struct RestartFile {
+    path: PathBuf,
+    /// The file's steps, ascending (never empty).
+    steps: Vec<usize>,
+}
+
+impl RestartFile {
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Before set-up (any rank, on its own): `path` is a result file with a
+/// step, and `model` is one a restart can continue. Reads no array.
+pub fn open(path: &Path, model: &Model) -> Result<RestartFile> {
     if model.dynamics.is_some() {
-        return Err(fail(
-            "continuing a dynamic scene is not supported (the file holds no accelerations)".into(),
-        ));
+        return Err(Error::Restart(format!(
+            "{}: continuing a dynamic scene is not supported (the file holds no accelerations)",
+            path.display()
+        )));
     }
     // The same checks as `summary`: a missing file, not a result file, or
     // one without a converged step each get one plain sentence.
     let steps = crate::results::open_steps(path).map_err(|e| Error::Restart(e.to_string()))?;
-    check_mesh(path, model).map_err(fail)?;
-    let step = *steps
-        .last()
-        .ok_or_else(|| fail("the file holds no converged step to continue from".into()))?;
-    let info = read_step_attrs(path, step).map_err(h5)?;
-    if info.load_factor >= 1.0 - 1e-12 {
-        return Err(fail(format!(
-            "step {step} already reached the full load (load factor {}); nothing to continue",
-            info.load_factor
-        )));
-    }
-    let n = model.mesh.num_nodes();
-    let displacement = read_columns(path, step, layout::DISPLACEMENT, n, 3)?;
-    let pairs = model
-        .contact
+    Ok(RestartFile {
+        path: path.to_path_buf(),
+        steps,
+    })
+}
+
+/// After set-up, collective: this rank's share of the last step of `file`
+/// for `sim`. Fails on every rank with the same error if it fails on one.
+pub fn read(file: &RestartFile, sim: &Simulation) -> Result<RestartState> {
+    let world = SimpleCommunicator::world();
+    let reader = Reader {
+        world: &world,
+        path: &file.path,
+        rank: sim.dofs().rank,
+        nranks: sim.dofs().nranks,
+        nodes: sim.dofs().num_global_nodes(),
+    };
+    let local = sim.local_mesh();
+    let (step, info) = parallel::agree(&world, reader.check(file, local))?;
+    let displacement = reader.displacement(step, sim)?;
+    let pairs = sim
+        .contact()
         .iter()
-        .map(|p| {
-            let mut rows = read_pair(path, step, &p.name, p.active_friction().is_some())?;
-            if p.formulation == crate::model::Formulation::Mortar {
-                let friction = p.active_friction().is_some();
-                rows.mortar = Some(read_mortar(
-                    path,
-                    step,
-                    &p.name,
-                    n,
-                    friction,
-                    info.load_factor,
-                )?);
-            }
-            Ok(rows)
-        })
+        .map(|p| reader.pair(step, p, info.load_factor))
         .collect::<Result<Vec<_>>>()?;
     Ok(RestartState {
-        path: path.to_path_buf(),
+        path: file.path.clone(),
         step,
         load_factor: info.load_factor,
         displacement,
@@ -68,151 +100,237 @@ pub fn read(path: &Path, model: &Model) -> Result<RestartState> {
     })
 }
 
-/// The file's mesh must be the model's: same cells and nodes, same places.
-fn check_mesh(path: &Path, model: &Model) -> std::result::Result<(), String> {
-    let mesh = &model.mesh;
-    let (nodes, shape) =
-        read_dataset::<f64>(path, layout::MESH_NODES).map_err(|e| e.to_string())?;
-    if shape != [mesh.num_nodes(), 3] {
-        return Err(format!(
-            "written for another mesh: {} nodes, this scene has {}",
-            shape.first().copied().unwrap_or(0),
-            mesh.num_nodes()
-        ));
-    }
-    let (_, cells) = read_dataset::<i64>(path, layout::MESH_CELLS).map_err(|e| e.to_string())?;
-    if cells.first() != Some(&mesh.num_cells()) {
-        return Err(format!(
-            "written for another mesh: {} cells, this scene has {}",
-            cells.first().copied().unwrap_or(0),
-            mesh.num_cells()
-        ));
-    }
-    let scale = mesh
-        .bounding_box()
-        .map_or(1.0, |b| b.diagonal())
-        .max(f64::MIN_POSITIVE);
-    let moved = mesh
-        .nodes
-        .iter()
-        .flatten()
-        .zip(&nodes)
-        .position(|(a, b)| (a - b).abs() > 1e-12 * scale);
-    match moved {
-        Some(i) => Err(format!(
-            "written for another mesh: node {} is elsewhere (another scene, or other --set mesh values?)",
-            i / 3
-        )),
-        None => Ok(()),
-    }
-}
-
-fn read_pair(path: &Path, step: usize, name: &str, friction: bool) -> Result<RestartRows> {
-    let field = |f: &str| layout::pair_dataset(name, f);
-    let lambda = read_any_rows(path, step, &field(layout::PAIR_LAMBDA_N), 1)?;
-    let friction = if friction {
-        let rows = lambda.len();
-        let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
-            let v = read_columns(path, step, &field(f), rows, 3)?;
-            Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
-        };
-        let (lambda_t, origin, ids) = (
-            triples(layout::PAIR_LAMBDA_T)?,
-            triples(layout::PAIR_SLIP_ORIGIN)?,
-            triples(layout::PAIR_HISTORY_IDS)?,
-        );
-        let records = lambda_t
-            .into_iter()
-            .zip(origin)
-            .zip(ids)
-            .map(|((lambda, origin), ids)| FrictionRecord {
-                lambda,
-                origin,
-                ids,
-            })
-            .collect();
-        Some(FrictionRows {
-            records,
-            state: read_columns(path, step, &field(layout::PAIR_STATE), rows, 1)?,
-            traction: triples(layout::PAIR_TRACTION_T)?,
-        })
-    } else {
-        None
-    };
-    // Files from before penalties were written have none: keep the scene's.
-    let penalty = read_nodal(path, step, &field(layout::PAIR_PENALTY))
-        .ok()
-        .and_then(|(v, _, _)| v.first().copied());
-    Ok(RestartRows {
-        penalty,
-        lambda,
-        friction,
-        mortar: None,
-    })
-}
-
-/// A mortar pair's nodal datasets (`nodes` rows each).
-fn read_mortar(
-    path: &Path,
-    step: usize,
-    name: &str,
+/// The collective reading context.
+struct Reader<'a> {
+    world: &'a SimpleCommunicator,
+    path: &'a Path,
+    rank: usize,
+    nranks: usize,
+    /// Mesh nodes (the rows of every nodal dataset).
     nodes: usize,
-    friction: bool,
-    load_factor: f64,
-) -> Result<MortarRows> {
-    let field = |f: &str| layout::pair_dataset(name, f);
-    let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
-        let v = read_columns(path, step, &field(f), nodes, 3)?;
-        Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
-    };
-    let (lambda_t, slip_origin) = if friction {
-        (
-            Some(triples(layout::PAIR_NODE_LAMBDA_T)?),
-            Some(triples(layout::PAIR_NODE_SLIP_ORIGIN)?),
-        )
-    } else {
-        (None, None)
-    };
-    Ok(MortarRows {
-        lambda: read_columns(path, step, &field(layout::PAIR_NODE_LAMBDA), nodes, 1)?,
-        lambda_t,
-        slip_origin,
-        load_factor,
-    })
 }
 
-/// `/steps/<step>/<name>` with `cols` columns, any number of rows.
-fn read_any_rows(path: &Path, step: usize, name: &str, cols: usize) -> Result<Vec<f64>> {
-    let (data, _, c) = read_nodal(path, step, name).map_err(|e| {
-        Error::Restart(format!(
-            "{}: {e} (a file written before restarts existed, or by another scene?)",
-            path.display()
-        ))
-    })?;
-    if c != cols {
-        return Err(Error::Restart(format!(
-            "{}: step {step} {name} has {c} columns, expected {cols}",
-            path.display()
-        )));
+impl Reader<'_> {
+    fn fail(&self, message: impl std::fmt::Display) -> Error {
+        Error::Restart(format!("{}: {message}", self.path.display()))
     }
-    Ok(data)
+
+    /// Rank-local: the mesh check of this rank's block, then the step to
+    /// continue from (the same on every rank).
+    fn check(&self, file: &RestartFile, local: &LocalMesh) -> Result<(usize, StepInfo)> {
+        self.check_mesh(local).map_err(|m| self.fail(m))?;
+        let step = *file
+            .steps
+            .last()
+            .ok_or_else(|| self.fail("the file holds no converged step to continue from"))?;
+        let info = read_step_attrs(self.path, step).map_err(|e| self.fail(e))?;
+        if info.load_factor >= 1.0 - 1e-12 {
+            return Err(self.fail(format!(
+                "step {step} already reached the full load (load factor {}); nothing to continue",
+                info.load_factor
+            )));
+        }
+        Ok((step, info))
+    }
+
+    /// The file's mesh must be the scene's: same cell and node counts (the
+    /// datasets' shapes) and, in this rank's output block of nodes, the same
+    /// coordinates. The blocks tile the nodes in rank order, so the lowest
+    /// rank that finds a moved node names the first one of the mesh.
+    fn check_mesh(&self, local: &LocalMesh) -> std::result::Result<(), String> {
+        let shape = dataset_shape(self.path, layout::MESH_NODES).map_err(|e| e.to_string())?;
+        if shape != [local.global_nodes, 3] {
+            return Err(format!(
+                "written for another mesh: {} nodes, this scene has {}",
+                shape.first().copied().unwrap_or(0),
+                local.global_nodes
+            ));
+        }
+        let cells = dataset_shape(self.path, layout::MESH_CELLS).map_err(|e| e.to_string())?;
+        if cells.first() != Some(&local.global_cells) {
+            return Err(format!(
+                "written for another mesh: {} cells, this scene has {}",
+                cells.first().copied().unwrap_or(0),
+                local.global_cells
+            ));
+        }
+        let block = even_block(local.global_nodes, self.rank, self.nranks);
+        let nodes =
+            read_rows(self.path, layout::MESH_NODES, block.clone()).map_err(|e| e.to_string())?;
+        let scale = local
+            .bounding_box
+            .map_or(1.0, |b| b.diagonal())
+            .max(f64::MIN_POSITIVE);
+        let moved = local
+            .block
+            .nodes
+            .iter()
+            .flatten()
+            .zip(&nodes)
+            .position(|(a, b)| (a - b).abs() > 1e-12 * scale);
+        match moved {
+            Some(i) => Err(format!(
+                "written for another mesh: node {} is elsewhere (another scene, or other --set mesh values?)",
+                block.start + i / 3
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// Rank-local: the row count of `/steps/<step>/<name>` (checked against
+    /// `rows` when given, and its column count against `cols`) and this
+    /// rank's block of it.
+    fn read_block(
+        &self,
+        step: usize,
+        name: &str,
+        rows: Option<usize>,
+        cols: usize,
+    ) -> Result<(usize, Vec<f64>)> {
+        let object = layout::step_dataset(step, name);
+        let missing = |e: OutputError| {
+            self.fail(format!(
+                "{e} (a file written before restarts existed, or by another scene?)"
+            ))
+        };
+        let shape = dataset_shape(self.path, &object).map_err(missing)?;
+        let (have, c) = match shape[..] {
+            [r] => (r, 1),
+            [r, c] => (r, c),
+            _ => return Err(self.fail(format!("{object} has shape {shape:?}"))),
+        };
+        if c != cols {
+            return Err(self.fail(format!(
+                "step {step} {name} has {c} columns, expected {cols}"
+            )));
+        }
+        if let Some(rows) = rows.filter(|&r| r != have) {
+            return Err(self.fail(format!(
+                "step {step} {name} has {have} rows, expected {rows}"
+            )));
+        }
+        let block = even_block(have, self.rank, self.nranks);
+        let data = read_rows(self.path, &object, block).map_err(|e| self.fail(e))?;
+        Ok((have, data))
+    }
+
+    /// Collective: the rows `wanted` of `/steps/<step>/<name>` (`cols` values
+    /// each), every rank reading its block; and the dataset's row count.
+    /// Rows the file lacks come back as NaN.
+    fn fetch(
+        &self,
+        step: usize,
+        name: &str,
+        rows: Option<usize>,
+        cols: usize,
+        wanted: &[usize],
+    ) -> Result<(usize, Vec<f64>)> {
+        let (have, block) = parallel::agree(self.world, self.read_block(step, name, rows, cols))?;
+        let mut fetch = Fetch::new(have, cols, wanted, self.rank, self.nranks)?;
+        Ok((have, fetch.fetch(&block)?))
+    }
+
+    /// Collective: the displacement of this rank's owned DOFs, PETSc order.
+    fn displacement(&self, step: usize, sim: &Simulation) -> Result<Vec<f64>> {
+        let dofs = sim.dofs();
+        let owned: Vec<LocalNode> = (0..dofs.num_local_nodes())
+            .map(LocalNode::from_index)
+            .filter(|&l| dofs.is_owned(l))
+            .collect();
+        let natural: Vec<usize> = owned.iter().map(|&l| dofs.natural(l).0).collect();
+        let (_, values) =
+            self.fetch(step, layout::DISPLACEMENT, Some(self.nodes), DIM, &natural)?;
+        let start = dofs.owned_dof_start();
+        let mut x = vec![0.0; dofs.num_owned_dofs()];
+        for (k, &l) in owned.iter().enumerate() {
+            for c in 0..DIM {
+                x[dofs.dof(l, c).0 as usize - start] = values[DIM * k + c];
+            }
+        }
+        Ok(x)
+    }
+
+    /// Collective: this rank's rows of one pair.
+    fn pair(&self, step: usize, pair: &ContactPair, load_factor: f64) -> Result<RestartRows> {
+        let name = &pair.spec.name;
+        let field = |f: &str| layout::pair_dataset(name, f);
+        let friction = pair.restarts_friction();
+        // Files from before penalties were written have none: keep the
+        // scene's. One value, the same file: the same answer on every rank.
+        let penalty = read_nodal(self.path, step, &field(layout::PAIR_PENALTY))
+            .ok()
+            .and_then(|(v, _, _)| v.first().copied());
+        if let Some(m) = &pair.mortar {
+            let nodes = m.restart_nodes();
+            // One row per mesh node (zero off the pair).
+            let n = Some(self.nodes);
+            let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
+                Ok(triples(&self.fetch(step, &field(f), n, 3, nodes)?.1))
+            };
+            let (lambda_t, slip_origin) = if friction {
+                (
+                    Some(triples(layout::PAIR_NODE_LAMBDA_T)?),
+                    Some(triples(layout::PAIR_NODE_SLIP_ORIGIN)?),
+                )
+            } else {
+                (None, None)
+            };
+            let lambda = self
+                .fetch(step, &field(layout::PAIR_NODE_LAMBDA), n, 1, nodes)?
+                .1;
+            return Ok(RestartRows {
+                penalty,
+                lambda: Vec::new(),
+                friction: None,
+                mortar: Some(MortarRows {
+                    lambda,
+                    lambda_t,
+                    slip_origin,
+                    load_factor,
+                }),
+            });
+        }
+        let points = pair.restart_points();
+        let (rows, lambda) = self.fetch(step, &field(layout::PAIR_LAMBDA_N), None, 1, &points)?;
+        let friction = if friction {
+            let rows = Some(rows);
+            let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
+                Ok(triples(&self.fetch(step, &field(f), rows, 3, &points)?.1))
+            };
+            let (lambda_t, origin, ids) = (
+                triples(layout::PAIR_LAMBDA_T)?,
+                triples(layout::PAIR_SLIP_ORIGIN)?,
+                triples(layout::PAIR_HISTORY_IDS)?,
+            );
+            let records = lambda_t
+                .into_iter()
+                .zip(origin)
+                .zip(ids)
+                .map(|((lambda, origin), ids)| FrictionRecord {
+                    lambda,
+                    origin,
+                    ids,
+                })
+                .collect();
+            Some(FrictionRows {
+                records,
+                state: self
+                    .fetch(step, &field(layout::PAIR_STATE), rows, 1, &points)?
+                    .1,
+                traction: triples(layout::PAIR_TRACTION_T)?,
+            })
+        } else {
+            None
+        };
+        Ok(RestartRows {
+            penalty,
+            lambda,
+            friction,
+            mortar: None,
+        })
+    }
 }
 
-/// As [`read_any_rows`], with the row count checked too.
-fn read_columns(
-    path: &Path,
-    step: usize,
-    name: &str,
-    rows: usize,
-    cols: usize,
-) -> Result<Vec<f64>> {
-    let data = read_any_rows(path, step, name, cols)?;
-    if data.len() != rows * cols {
-        return Err(Error::Restart(format!(
-            "{}: step {step} {name} has {} rows, expected {rows}",
-            path.display(),
-            data.len() / cols
-        )));
-    }
-    Ok(data)
+fn triples(flat: &[f64]) -> Vec<[f64; 3]> {
+    flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
 }

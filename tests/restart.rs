@@ -6,6 +6,8 @@ mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_nodal};
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 fn run_ok(ranks: usize, args: &[&str]) -> String {
     let o = mpirun(ranks, args);
@@ -78,14 +80,103 @@ fn continued_run_matches(scene: &str, extra: &[&str], keep: usize, ranks: usize,
 #[test]
 fn frictional_block_slide_continues_exactly() {
     // Cut in the sliding phase: λT and the slip origins must carry over.
-    continued_run_matches("block-slide", &[], 14, 1, "floor");
-    continued_run_matches("block-slide", &[], 14, 2, "floor");
+    // Each rank reads its blocks of the file and receives its own rows: 1,
+    // 2 and 3 ranks all end where the uninterrupted 1-rank run ends.
+    for ranks in [1, 2, 3] {
+        continued_run_matches("block-slide", &[], 14, ranks, "floor");
+    }
 }
 
 #[test]
 fn hertz_cylinder_continues_exactly() {
     let extra = ["--set", "mesh.fine_size=0.4", "--set", "steps.count=4"];
     continued_run_matches("hertz-cylinder", &extra, 2, 2, "hertz");
+    continued_run_matches("hertz-cylinder", &extra, 2, 3, "hertz");
+}
+
+/// `mpirun -n N contactlink ARGS`, killed after `limit` (a rank that fails
+/// alone must not leave the others waiting).
+fn bounded_mpirun(n: usize, args: &[&str], limit: Duration) -> Output {
+    let mut child = mpi_env(&mut Command::new("mpirun"))
+        .args([
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-n",
+            &n.to_string(),
+            binary(),
+        ])
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn mpirun");
+    let started = Instant::now();
+    while child.try_wait().expect("wait for mpirun").is_none() {
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let o = child.wait_with_output().expect("collect mpirun");
+            panic!("{args:?} on {n} ranks hung past {limit:?}:\n{}", text(&o));
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.wait_with_output().expect("collect mpirun")
+}
+
+#[test]
+fn a_node_moved_in_the_last_ranks_block_is_one_error_on_every_rank() {
+    // Each rank checks only its own block of the file's nodes: a node near
+    // the end of the list moved is seen by the last rank alone, and must
+    // still stop every rank with the same single error, before any solve.
+    let dir = scratch("restart-moved-node");
+    let full = dir.join("full.h5");
+    let extra = ["--set", "mesh.fine_size=0.4", "--set", "steps.count=2"];
+    let mut args = vec!["run", "hertz-cylinder", "-q", "-o", full.to_str().unwrap()];
+    args.extend_from_slice(&extra);
+    run_ok(1, &args);
+    let moved = cut_after(&full, 1, "moved.h5");
+    let node = {
+        let file = hdf5::File::open_rw(&moved).expect("open copy");
+        let ds = file.dataset(layout::MESH_NODES).expect("/mesh/nodes");
+        let mut nodes = ds.read_raw::<f64>().expect("read nodes");
+        let n = nodes.len() / 3;
+        nodes[3 * (n - 2)] += 1e-3;
+        ds.write_raw(&nodes).expect("write nodes");
+        n - 2
+    };
+    for ranks in [2, 3] {
+        let out = dir.join(format!("continued-{ranks}.h5"));
+        let mut args = vec!["run", "hertz-cylinder", "-q", "-o", out.to_str().unwrap()];
+        args.extend_from_slice(&extra);
+        args.extend_from_slice(&["--restart", moved.to_str().unwrap()]);
+        let o = bounded_mpirun(ranks, &args, Duration::from_secs(300));
+        let t = text(&o);
+        assert!(!o.status.success(), "{ranks} ranks: should fail:\n{t}");
+        let errors: Vec<&str> = t
+            .lines()
+            .filter(|l| l.starts_with("contactlink:") && !l.starts_with("contactlink: warning"))
+            .collect();
+        assert_eq!(
+            errors.len(),
+            1,
+            "{ranks} ranks: one error line expected:\n{t}"
+        );
+        for needle in [
+            format!("rank {}", ranks - 1),
+            moved.display().to_string(),
+            format!("written for another mesh: node {node} is elsewhere"),
+        ] {
+            assert!(
+                errors[0].contains(&needle),
+                "no {needle:?} in {}",
+                errors[0]
+            );
+        }
+        assert!(!t.contains("panicked"), "{t}");
+        assert!(
+            !out.exists(),
+            "{ranks} ranks: a refused restart wrote {out:?}"
+        );
+    }
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `run --restart` of mortar pairs: a frictional mortar run cut short and
 //! continued from its last converged step (nodal λ, λT and slip origins read
 //! back) gives the uninterrupted run's steps, against a rigid plane and
-//! against a deformable block, on 1 and 2 ranks, and with a penalty the
+//! against a deformable block, on 1, 2 and 3 ranks, and with a penalty the
 //! first run raised; without λT, the slip origins or the raised penalty it
 //! would not.
 mod common;
@@ -170,6 +170,7 @@ fn frictional_mortar_between_blocks_continues_exactly() {
     for (ranks, history) in [
         (1, layout::PAIR_NODE_SLIP_ORIGIN),
         (2, layout::PAIR_NODE_LAMBDA_T),
+        (3, layout::PAIR_NODE_SLIP_ORIGIN),
     ] {
         continued_run_matches(scene, &extra, 6, ranks, "interface", history);
     }

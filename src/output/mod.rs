@@ -75,7 +75,8 @@ use std::path::{Path, PathBuf};
 
 pub use history_csv::HistoryCsv;
 pub use reader::{
-    list_steps, read_dataset, read_f64_attr, read_nodal, read_step_attrs, read_string_attr,
+    dataset_shape, list_steps, read_dataset, read_f64_attr, read_nodal, read_rows, read_step_attrs,
+    read_string_attr,
 };
 pub use result_sink::{create_result_file, Hdf5Sink, Provenance};
 pub use tee::Tee;

@@ -50,6 +50,48 @@ pub fn read_nodal(
     }
 }
 
+/// The shape of a dataset, read from its header alone (no values).
+pub fn dataset_shape(path: &Path, dataset: &str) -> Result<Vec<usize>, OutputError> {
+    let file = open(path)?;
+    let ds = file
+        .dataset(dataset)
+        .map_err(|e| OutputError::hdf5(path, dataset, "open", e))?;
+    Ok(ds.shape())
+}
+
+/// Rows `rows` of a 1- or 2-D f64 dataset, flat row-major: one hyperslab
+/// read, so a rank reading its block holds only that block (the rest of
+/// the dataset is never read). An empty range reads nothing.
+pub fn read_rows(
+    path: &Path,
+    dataset: &str,
+    rows: std::ops::Range<usize>,
+) -> Result<Vec<f64>, OutputError> {
+    let file = open(path)?;
+    let ds = file
+        .dataset(dataset)
+        .map_err(|e| OutputError::hdf5(path, dataset, "open", e))?;
+    let shape = ds.shape();
+    if shape.first().is_none_or(|&n| rows.end > n) || shape.len() > 2 {
+        return Err(OutputError::invalid(
+            path,
+            dataset,
+            format!("has shape {shape:?}, rows {rows:?} asked for"),
+        ));
+    }
+    if rows.is_empty() {
+        return Ok(Vec::new());
+    }
+    let read = |e| OutputError::hdf5(path, dataset, "read rows of", e);
+    if shape.len() == 1 {
+        let v = ds.read_slice_1d::<f64, _>(rows).map_err(read)?;
+        Ok(v.iter().copied().collect())
+    } else {
+        let v = ds.read_slice_2d::<f64, _>((rows, ..)).map_err(read)?;
+        Ok(v.iter().copied().collect())
+    }
+}
+
 /// The step indices in the file, ascending.
 pub fn list_steps(path: &Path) -> Result<Vec<usize>, OutputError> {
     let file = open(path)?;

@@ -3,21 +3,23 @@
 //! solver, so the solver never depends on the file format.
 use crate::contact::pair_state::RestartRows;
 use crate::contact::ContactPair;
-use crate::dofs::{DofMap, LocalNode, DIM};
-use crate::error::Result;
+use crate::dofs::DofMap;
+use crate::error::{Error, Result};
 use crate::petsc::Vector;
 use std::path::PathBuf;
 
-/// What a run continues from.
+/// What a run continues from: this rank's share of it only (read after
+/// set-up, for the rank's own DOFs and contact points).
 #[derive(Debug, Clone)]
 pub struct RestartState {
     pub path: PathBuf,
     /// Index of the step continued from; the next one written is `step + 1`.
     pub step: usize,
     pub load_factor: f64,
-    /// Natural node order, 3 per node.
+    /// The displacement of this rank's owned DOFs, in PETSc order (the
+    /// owned rows of the solution vector).
     pub displacement: Vec<f64>,
-    /// Per contact pair of the model, in the model's order.
+    /// Per contact pair of the model, in the model's order: this rank's rows.
     pub pairs: Vec<RestartRows>,
 }
 
@@ -30,19 +32,14 @@ impl RestartState {
         x: &mut Vector,
         pairs: &mut [ContactPair],
     ) -> Result<()> {
-        let start = dofs.owned_dof_start();
-        x.with_array_mut(|xa| {
-            for l in (0..dofs.num_local_nodes()).map(LocalNode::from_index) {
-                if !dofs.is_owned(l) {
-                    continue;
-                }
-                let n = dofs.natural(l).0;
-                for c in 0..DIM {
-                    let row = dofs.dof(l, c).0 as usize - start;
-                    xa[row] = self.displacement[DIM * n + c];
-                }
-            }
-        })?;
+        if self.displacement.len() != dofs.num_owned_dofs() {
+            return Err(Error::Internal(format!(
+                "restart state holds {} displacement rows for {} owned DOFs",
+                self.displacement.len(),
+                dofs.num_owned_dofs()
+            )));
+        }
+        x.with_array_mut(|xa| xa.copy_from_slice(&self.displacement))?;
         for (pair, rows) in pairs.iter_mut().zip(&self.pairs) {
             pair.restart_from(rows)?;
         }

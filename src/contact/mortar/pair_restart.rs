@@ -4,8 +4,8 @@
 //! natural node).
 use super::pair::MortarPair;
 
-/// What a result file holds of a mortar pair at one step, rows by natural
-/// node (every mesh node; zero off the pair).
+/// What a result file holds of a mortar pair at one step, the rows of this
+/// pair's nodes only, in the order of [`MortarPair::restart_nodes`].
 #[derive(Debug, Clone, Default)]
 pub struct MortarRows {
     pub lambda: Vec<f64>,
@@ -17,17 +17,23 @@ pub struct MortarRows {
 }
 
 impl MortarPair {
+    /// The natural (file) rows a restart reads: every node of the pair this
+    /// rank holds, in pair node order.
+    pub fn restart_nodes(&self) -> &[usize] {
+        &self.natural
+    }
+
+    /// Whether a restart reads λT and the slip origins.
+    pub fn restarts_friction(&self) -> bool {
+        self.friction.is_some()
+    }
+
     /// Takes over `rows` as the end of a converged step (then committed, as
     /// the step end did). On a mismatch, says which dataset does not fit.
     pub fn restart(&mut self, rows: &MortarRows) -> Result<(), &'static str> {
-        let natural = &self.natural;
-        let slot_rows: Vec<usize> = self
-            .nodal
-            .nodes
-            .iter()
-            .map(|&id| natural[id as usize])
-            .collect();
-        let lambda = slot_rows
+        let nodes = self.natural.len();
+        let slots: Vec<usize> = self.nodal.nodes.iter().map(|&id| id as usize).collect();
+        let lambda = slots
             .iter()
             .map(|&r| rows.lambda.get(r).copied())
             .collect::<Option<Vec<f64>>>()
@@ -36,18 +42,17 @@ impl MortarPair {
         if let Some(f) = &mut self.friction {
             let lambda_t = rows.lambda_t.as_ref().ok_or("node_lambda_t")?;
             let origin = rows.slip_origin.as_ref().ok_or("node_slip_origin")?;
-            let take = |v: &[[f64; 3]], at: &[usize], what| {
-                at.iter()
-                    .map(|&r| {
-                        v.get(r)
-                            .copied()
-                            .filter(|x| x.iter().all(|c| c.is_finite()))
-                    })
-                    .collect::<Option<Vec<[f64; 3]>>>()
-                    .ok_or(what)
+            let take = |v: &[[f64; 3]], at: &mut dyn Iterator<Item = usize>, what| {
+                at.map(|r| {
+                    v.get(r)
+                        .copied()
+                        .filter(|x| x.iter().all(|c| c.is_finite()))
+                })
+                .collect::<Option<Vec<[f64; 3]>>>()
+                .ok_or(what)
             };
-            f.nodal.lambda = take(lambda_t, &slot_rows, "node_lambda_t")?;
-            f.last = take(origin, natural, "node_slip_origin")?;
+            f.nodal.lambda = take(lambda_t, &mut slots.iter().copied(), "node_lambda_t")?;
+            f.last = take(origin, &mut (0..nodes), "node_slip_origin")?;
         }
         self.nodal.lambda = lambda;
         if let Some(r) = &mut self.rigid {

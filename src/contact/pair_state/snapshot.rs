@@ -6,15 +6,18 @@ pub use crate::contact::mortar::pair_restart::MortarRows;
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::error::{Error, Result};
 
-/// One pair's state as a result file stores it, whole-pair arrays in output
-/// row order: what [`ContactPair::restart_from`] takes over.
+/// What [`ContactPair::restart_from`] takes over: the rows of a result file
+/// this rank's share of the pair needs, and nothing more. A links pair's
+/// arrays hold one row per slave point of this rank, in the pair's point
+/// order (the file rows [`ContactPair::restart_points`] names); a mortar
+/// pair's, one per pair node ([`MortarPair::restart_nodes`]).
 #[derive(Debug, Clone, Default)]
 pub struct RestartRows {
     /// The pair's penalty at that step (None in files that lack it).
     pub penalty: Option<f64>,
     pub lambda: Vec<f64>,
     pub friction: Option<FrictionRows>,
-    /// A mortar pair's nodal state (rows by natural node).
+    /// A mortar pair's nodal state.
     pub mortar: Option<MortarRows>,
 }
 
@@ -48,18 +51,39 @@ impl ContactPair {
         Ok(())
     }
 
+    /// The rows of the per-point datasets (set facet × quadrature point)
+    /// that hold this rank's slave points, in the pair's point order; none
+    /// for a mortar pair (it restarts from its nodal datasets).
+    pub fn restart_points(&self) -> Vec<usize> {
+        if self.mortar.is_some() {
+            return Vec::new();
+        }
+        let nqp = self.slave.nqp;
+        (0..self.slave.num_qps())
+            .map(|i| self.slave.facets[i / nqp].set_index * nqp + i % nqp)
+            .collect()
+    }
+
+    /// Whether a restart reads a friction history (links: per point; mortar:
+    /// nodal λT and slip origins).
+    pub fn restarts_friction(&self) -> bool {
+        match &self.mortar {
+            Some(m) => m.restarts_friction(),
+            None => self.multipliers.tangential.is_some(),
+        }
+    }
+
     /// Takes over a converged step's multipliers and friction history from a
-    /// result file, given as whole-pair arrays in output row order (set
-    /// facet × quadrature point), then commits them as the step end did.
+    /// result file, given as this rank's rows (see [`RestartRows`]), then
+    /// commits them as the step end did. A row the file lacks arrives as
+    /// NaN and is refused here.
     pub fn restart_from(&mut self, rows: &RestartRows) -> Result<()> {
         if self.mortar.is_some() {
             return self.restart_mortar(rows);
         }
-        let nqp = self.slave.nqp;
-        let row_of = |i: usize| self.slave.facets[i / nqp].set_index * nqp + i % nqp;
         let n = self.slave.num_qps();
         let lambda = (0..n)
-            .map(|i| rows.lambda.get(row_of(i)).copied())
+            .map(|i| rows.lambda.get(i).copied())
             .collect::<Option<Vec<f64>>>()
             .filter(|l| l.iter().all(|v| v.is_finite() && *v >= 0.0))
             .ok_or_else(|| self.restart_error("lambda_n"))?;
@@ -69,11 +93,10 @@ impl ContactPair {
             (Some(_), Some(f)) => Some(
                 (0..n)
                     .map(|i| {
-                        let r = row_of(i);
                         PointFriction::from_record(
-                            f.records.get(r)?,
-                            *f.state.get(r)?,
-                            *f.traction.get(r)?,
+                            f.records.get(i)?,
+                            *f.state.get(i)?,
+                            *f.traction.get(i)?,
                         )
                     })
                     .collect::<Option<Vec<_>>>()
@@ -93,7 +116,7 @@ impl ContactPair {
     }
 
     /// A mortar pair's [`ContactPair::restart_from`]: the nodal multipliers,
-    /// λT and slip origins by natural node.
+    /// λT and slip origins of the pair's nodes.
     fn restart_mortar(&mut self, rows: &RestartRows) -> Result<()> {
         let name = self.spec.name.clone();
         let misfit = |what: &str| {
