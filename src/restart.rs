@@ -256,10 +256,14 @@ impl Reader<'_> {
         let field = |f: &str| layout::pair_dataset(name, f);
         let friction = pair.restarts_friction();
         // Files from before penalties were written have none: keep the
-        // scene's. One value, the same file: the same answer on every rank.
+        // scene's. Agreed (a rank whose read failed alone takes the others'
+        // value), since every rank must go on with the same penalty.
         let penalty = read_nodal(self.path, step, &field(layout::PAIR_PENALTY))
             .ok()
-            .and_then(|(v, _, _)| v.first().copied());
+            .and_then(|(v, _, _)| v.first().copied())
+            .filter(|p| p.is_finite() && *p > 0.0);
+        let [agreed] = parallel::max(self.world, [penalty.unwrap_or(-1.0)]);
+        let penalty = (agreed > 0.0).then_some(agreed);
         if let Some(m) = &pair.mortar {
             let nodes = m.restart_nodes();
             // One row per mesh node (zero off the pair).
