@@ -16,6 +16,8 @@ use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use std::process::ExitCode;
 
+mod rank0;
+
 type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
 
 const CASES: &[Case] = &[
@@ -56,6 +58,14 @@ const CASES: &[Case] = &[
     (
         "a_rank_holds_a_share_of_the_mesh_after_set_up",
         a_rank_holds_a_share_of_the_mesh,
+    ),
+    (
+        "only_rank_0_holds_the_mesh",
+        rank0::only_rank_0_holds_the_mesh,
+    ),
+    (
+        "a_scene_error_on_rank_0_is_every_ranks",
+        rank0::a_scene_error_on_rank_0_is_every_ranks,
     ),
 ];
 

@@ -45,6 +45,11 @@ impl Amplitude {
         })
     }
 
+    /// The points `(f_i, a_i)`, in increasing `f_i`.
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+
     /// The value at load factor `f`.
     pub fn at(&self, f: f64) -> f64 {
         let pts = &self.points;

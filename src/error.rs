@@ -45,6 +45,10 @@ pub enum Error {
     /// with the lowest failing rank's message.
     #[error("rank {rank}: {message}")]
     OnRank { rank: usize, message: String },
+    /// A failure of work only rank 0 does (reading the mesh, resolving the
+    /// scene against it), as every other rank holds it: rank 0's text.
+    #[error("{0}")]
+    Relayed(String),
     /// NaN or infinite values where a finite result was expected.
     #[error("non-finite values in the {0}")]
     NonFinite(String),

@@ -1,5 +1,8 @@
 //! One run end to end: scene → model → set-up (partition, DOFs) → output file
 //! created (so an unwritable path fails before any solve) → load steps → summary.
+//! A run of a scene reads the mesh on rank 0 only (`load`).
+pub mod load;
+
 use crate::error::Result;
 use crate::model::Model;
 use crate::output::paths::{check_not_input, Input};
@@ -78,13 +81,19 @@ fn build_model(
 /// Runs a scene on all ranks of the runtime.
 pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<RunSummary> {
     crate::parallel::fault::arm(rt.rank())?;
-    let src = SceneSource::resolve(name_or_path)?;
-    let (mut model, scene_out, mut inputs) = build_model(&src, &opts.overrides)?;
-    let output = opts.output.clone().or(scene_out.map(PathBuf::from));
-    let restart = match &opts.restart {
-        Some(from) => Some(read_restart(from, output.as_deref(), &model)?),
-        None => None,
-    };
+    // Rank 0 alone builds the mesh; a restart needs none of it (the file is
+    // checked against each rank's piece after set-up).
+    let mut loaded = load::on_root(&rt.world(), name_or_path, &opts.overrides)?;
+    let output = opts
+        .output
+        .clone()
+        .or(loaded.output.take().map(PathBuf::from));
+    let restart = opts
+        .restart
+        .as_ref()
+        .map(|from| read_restart(from, output.as_deref(), &loaded.model))
+        .transpose()?;
+    let mut inputs = std::mem::take(&mut loaded.inputs);
     if let Some(out) = &output {
         // Every rank sees the same paths and files: the same answer.
         inputs.extend(opts.restart.clone().map(|path| Input {
@@ -94,7 +103,7 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
         check_not_input(out, &inputs).map_err(std::io::Error::other)?;
     }
     let provenance = Provenance {
-        scene: src.text,
+        scene: std::mem::take(&mut loaded.scene_text),
         overrides: opts.overrides.clone(),
     };
     let printing = Printing {
@@ -102,10 +111,10 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
         steps: opts.echo && !opts.quiet,
     };
     // The set-up frees the mesh once each rank has its piece.
-    let mesh = model.take_mesh();
+    let mesh = loaded.take_mesh();
     run_model_with(
         rt,
-        &model,
+        &loaded.model,
         Some(mesh),
         output.as_deref(),
         printing,

@@ -3,7 +3,7 @@
 //! the Jacobian allocated with its pattern filled in), then stop. What the
 //! set-up costs in memory and time, without the solve's share.
 use crate::error::Result;
-use crate::pipeline::load_model;
+use crate::pipeline::load;
 use crate::runtime::Runtime;
 use crate::solve::Simulation;
 
@@ -15,11 +15,14 @@ pub struct SetupSummary {
     pub global_dofs: usize,
 }
 
-/// Collective: builds the model and the set-up of a run on every rank.
+/// Collective: builds the model (its mesh on rank 0) and the set-up of a
+/// run on every rank.
 pub fn setup_only(rt: &Runtime, scene: &str, overrides: &[String]) -> Result<SetupSummary> {
     crate::parallel::fault::arm(rt.rank())?;
-    let (mut model, _) = load_model(scene, overrides)?;
-    let mesh = model.take_mesh();
+    // The mesh is built on rank 0 only, as in a run.
+    let mut loaded = load::on_root(&rt.world(), scene, overrides)?;
+    let mesh = loaded.take_mesh();
+    let model = loaded.model;
     let sim = Simulation::setup_with_mesh(rt, &model, mesh)?;
     Ok(SetupSummary {
         model_name: model.name.clone(),

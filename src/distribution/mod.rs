@@ -77,8 +77,8 @@ pub fn even_block(n: usize, rank: usize, nranks: usize) -> std::ops::Range<usize
 
 /// Collective: partitions `mesh` on rank 0 and returns this rank's piece.
 ///
-/// Only rank 0 reads `mesh` and `wanted` (the other ranks may pass what
-/// they like; today every rank still holds the same mesh).
+/// Only rank 0 reads `mesh` and `wanted`: the other ranks pass an empty
+/// mesh in a scene's run (`pipeline::load`), or their own copy.
 pub fn distribute(world: &impl Communicator, mesh: &Mesh, wanted: &Wanted) -> Result<Piece> {
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let part = if rank == 0 {

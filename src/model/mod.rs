@@ -6,11 +6,13 @@
 //! - `conditions`: Dirichlet conditions and facet loads;
 //! - `contact`: what a pair states (surfaces, rigid masters, friction, tolerances);
 //! - `dynamics`: implicit dynamics and the Newmark parameters;
-//! - `solver`: Newton, load-stepping and reuse settings.
+//! - `solver`: Newton, load-stepping and reuse settings;
+//! - `wire`: a model without its mesh as words for one broadcast.
 pub mod conditions;
 pub mod contact;
 pub mod dynamics;
 pub mod solver;
+pub mod wire;
 
 pub use conditions::{DirichletSpec, FacetLoad};
 pub use contact::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
@@ -28,6 +30,9 @@ pub type VectorField = Box<dyn Fn([f64; 3]) -> [f64; 3]>;
 /// A fully resolved problem: mesh, materials per body, conditions, contact, steps.
 pub struct Model {
     pub name: String,
+    /// The global mesh. A scene's run holds it on rank 0 only, and only
+    /// until the set-up has cut it into pieces: on the other ranks, and
+    /// after [`Model::take_mesh`], it is empty (its cell type kept).
     pub mesh: Mesh,
     /// Material of each body, indexed like `mesh.bodies`.
     pub materials: Vec<Material>,

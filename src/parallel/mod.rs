@@ -9,11 +9,14 @@
 //! [`any_rank`], [`all_ranks`], [`sum`] and [`max`] are the reductions the
 //! run loop steers by; [`gather_all`] concatenates every rank's slice on
 //! every rank ([`gather_equal`] when all slices have one length), and
-//! [`all_to_all`] sends each rank its own array. [`fault`] makes one rank fail on purpose (tests only).
+//! [`all_to_all`] sends each rank its own array; [`from_root`] hands the
+//! outcome of work only one rank does (success or error) to every rank.
+//! [`fault`] makes one rank fail on purpose (tests only).
 pub mod agree;
 mod exchange;
 pub mod fault;
 mod gather;
+mod relay;
 
 pub use agree::{
     agree, agree_failure, all_ranks, any_rank, broadcast_text, lowest_rank, max, sum, sum_usize,
@@ -21,3 +24,4 @@ pub use agree::{
 };
 pub use exchange::all_to_all;
 pub use gather::{gather_all, gather_equal};
+pub use relay::from_root;

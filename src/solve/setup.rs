@@ -151,23 +151,15 @@ pub(super) struct SetUp {
 pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<SetUp> {
     let world = rt.world();
     crate::footprint::checkpoint("model build");
-    let mut master_nodes = Vec::new();
     // Mortar pairs see both their surfaces whole on every rank; a links
     // pair's master is exchanged at each search (`contact::held_master`).
-    for pair in &model.contact {
-        if pair.formulation != crate::model::Formulation::Mortar {
-            continue;
-        }
-        if let MasterSpec::Surface { set } = &pair.master {
-            master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-                &mesh, set,
-            )?);
-        }
-        master_nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-            &mesh,
-            &pair.slave,
-        )?);
-    }
+    // Their nodes are only read where the mesh is, on rank 0 (`distribute`
+    // reads `wanted` there only): the other ranks may hold no mesh at all.
+    let master_nodes = match world.rank() {
+        0 => mortar_nodes(model, &mesh),
+        _ => Ok(Vec::new()),
+    };
+    let master_nodes = parallel::agree(&world, master_nodes)?;
     let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
     let wanted = distribution::Wanted {
         extra_ghosts: &master_nodes,
@@ -244,6 +236,27 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
         contact,
         jac,
     })
+}
+
+/// The natural nodes of every mortar pair's surfaces, which every rank must
+/// see (read from the global mesh).
+fn mortar_nodes(model: &Model, mesh: &Mesh) -> Result<Vec<usize>> {
+    let mut nodes = Vec::new();
+    for pair in &model.contact {
+        if pair.formulation != crate::model::Formulation::Mortar {
+            continue;
+        }
+        if let MasterSpec::Surface { set } = &pair.master {
+            nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
+                mesh, set,
+            )?);
+        }
+        nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
+            mesh,
+            &pair.slave,
+        )?);
+    }
+    Ok(nodes)
 }
 
 /// The Jacobian's storage for the current contact couplings: bulk cells,
