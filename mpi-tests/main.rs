@@ -16,6 +16,8 @@ use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use std::process::ExitCode;
 
+mod lagging;
+
 type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
 
 const CASES: &[Case] = &[
@@ -56,6 +58,10 @@ const CASES: &[Case] = &[
     (
         "a_rank_holds_a_share_of_the_mesh_after_set_up",
         a_rank_holds_a_share_of_the_mesh,
+    ),
+    (
+        "the_watch_rebuilds_factors_on_a_change_and_amg_once_worn",
+        lagging::the_watch_rebuilds_factors_on_a_change_and_amg_once_worn,
     ),
 ];
 
