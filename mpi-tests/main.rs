@@ -16,6 +16,7 @@ use mpi::collective::SystemOperation;
 use mpi::traits::*;
 use std::process::ExitCode;
 
+mod lagging;
 mod rank0;
 
 type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
@@ -66,6 +67,10 @@ const CASES: &[Case] = &[
     (
         "a_scene_error_on_rank_0_is_every_ranks",
         rank0::a_scene_error_on_rank_0_is_every_ranks,
+    ),
+    (
+        "the_watch_rebuilds_factors_on_a_change_and_amg_once_worn",
+        lagging::the_watch_rebuilds_factors_on_a_change_and_amg_once_worn,
     ),
 ];
 

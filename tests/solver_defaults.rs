@@ -55,3 +55,18 @@ fn runs_whose_matrix_changes_keep_the_galerkin_intermediates() {
         assert!(!t.contains("-mat_product_clear"), "{args:?}: {t}");
     }
 }
+
+#[test]
+fn an_iterative_contact_run_caps_the_eisenstat_walker_forcing() {
+    // GMRES + GAMG with contact: Eisenstat–Walker, never looser than 0.1.
+    let t = option_table(&[
+        "scenes/block-on-plane.toml",
+        "--set",
+        "solver.direct_max_dofs=0",
+    ]);
+    assert!(t.contains("-snes_ksp_ew true"), "{t}");
+    assert!(t.contains("-snes_ksp_ew_rtolmax 0.1"), "{t}");
+    // The direct path solves each Newton step to 1e-10 around the factors.
+    let t = option_table(&["scenes/block-on-plane.toml"]);
+    assert!(!t.contains("-snes_ksp_ew"), "{t}");
+}

@@ -68,7 +68,13 @@ pub(super) fn mechanics<'a>(
         && model.solver.reuse.preconditioner
         && model.solver.reuse.active_set
     {
-        mech.lag = Some(PreconditionerLag::default());
+        // Above the direct limit the preconditioner is GMRES + AMG.
+        let iterative = DIM * dofs.num_global_nodes() > model.solver.direct_max_dofs;
+        mech.lag = Some(if iterative {
+            PreconditionerLag::iterative()
+        } else {
+            PreconditionerLag::default()
+        });
     }
     if let Some(b) = &model.body_force_fn {
         let mut f = vec![0.0; DIM * dofs.num_local_nodes()];
