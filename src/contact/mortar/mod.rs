@@ -9,6 +9,8 @@
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//! - `main_part`: the tangent without the derivatives of `D`, `M`, `ν`
+//!   (the first Uzawa iteration from no contact);
 //! - `rows`: the tangent as the solver gets it (entries merged into matrix
 //!   rows, active-set signature);
 //! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
@@ -22,6 +24,7 @@
 //!   `pair_restart`: taking them over from a result file.
 pub mod friction;
 pub mod geometry;
+mod main_part;
 pub mod pair;
 mod pair_output;
 pub mod pair_restart;

@@ -474,19 +474,24 @@ impl MortarPair {
     /// Adds the tangent; returns its active-set signature: equal values mean
     /// the same segments, the same closed nodes and the same sliding nodes
     /// on this rank (what the tangent's structure depends on, so the
-    /// solver may keep the preconditioner of an earlier one).
+    /// solver may keep the preconditioner of an earlier one). With
+    /// `main_part` a frictionless pair adds only the main part (see
+    /// `main_part`).
     pub fn add_tangent(
         &self,
         dofs: &DofMap,
         u_local: &[f64],
         rate: Option<&Rate>,
-        factor: f64,
+        (factor, main_part): (f64, bool),
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
         if self.rigid.is_some() {
             return self.rigid_tangent(dofs, u_local, rate, factor, k);
         }
         let x = self.positions(u_local);
+        if main_part && self.friction.is_none() {
+            return self.add_main_part(dofs, &x, u_local, k);
+        }
         let e = self.evaluate_tangent(&x, u_local, rate);
         let interface = self.interface(&x);
         let mut rows = Rows::new(self.node_local.len());
@@ -502,6 +507,29 @@ impl MortarPair {
                 &mut add,
             );
         }
+        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
+        Ok(signature(
+            &e.segments,
+            &e.states,
+            &e.frictions,
+            &self.slave_facets,
+            self.facet_type.nodes(),
+            &self.nodal,
+        ))
+    }
+
+    fn add_main_part(
+        &self,
+        dofs: &DofMap,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        k: &mut dyn MatrixSink,
+    ) -> Result<u64> {
+        let e = self.evaluate::<f64>(x, u_local, None);
+        let interface = self.interface(x);
+        let mut rows = Rows::new(self.node_local.len());
+        let add = |r, c, v| rows.add(r, c, v);
+        super::main_part::tangent(&interface, &self.nodal, &e.segments, &e.states, add);
         rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
         Ok(signature(
             &e.segments,

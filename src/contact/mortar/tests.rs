@@ -460,3 +460,45 @@ fn segment_triangle_rule_is_exact_to_degree_six() {
         }
     }
 }
+
+/// On a flat slave, moving a master node along the slave's normal moves
+/// neither the overlaps nor `D`, `M`, `ν`: there the consistent tangent is
+/// its main part, `(ε_j/A_j) f_j ⊗ f_j`. The main part is symmetric.
+#[test]
+fn main_part_is_the_tangent_along_the_normal_of_master_nodes() {
+    for (seed, s, m) in [(21, Quad4, Quad4), (22, Tri3, Quad4), (23, Quad4, Tri3)] {
+        let mut case = random_case(seed, s, m);
+        let n_slave = case.nodal.nodes.len();
+        for p in &mut case.positions[..n_slave] {
+            p[2] = 0.0;
+        }
+        let (k, closed) = case.tangent();
+        assert!(closed >= 4, "seed {seed}: only {closed} closed nodes");
+        let interface = case.interface(&case.positions);
+        let rules = MortarRules::default();
+        let segs: Vec<Segment<f64>> = segments(&interface, &rules);
+        let (gap, covered) = weighted_gaps(&interface, &case.nodal, &segs);
+        let states = node_states(&case.nodal, &gap, &covered);
+        let n = 3 * case.positions.len();
+        let mut main = vec![0.0; n * n];
+        super::main_part::tangent(&interface, &case.nodal, &segs, &states, |r, c, v| {
+            main[(3 * r.0 as usize + r.1) * n + 3 * c.0 as usize + c.1] += v;
+        });
+        let scale = main.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(scale > 1.0, "seed {seed}: main part vanishes");
+        for row in 0..n {
+            for col in 0..n {
+                let (a, b) = (main[row * n + col], main[col * n + row]);
+                assert!((a - b).abs() < 1e-12 * scale, "seed {seed}: not symmetric");
+            }
+            for node in n_slave..case.positions.len() {
+                let col = 3 * node + 2;
+                let (a, b) = (main[row * n + col], k[row * n + col]);
+                assert!(
+                    (a - b).abs() < 1e-9 * scale,
+                    "seed {seed} row {row} col {col}: {a:e} vs {b:e}"
+                );
+            }
+        }
+    }
+}

@@ -226,7 +226,13 @@ impl ContactPair {
     ) -> Result<()> {
         if let Some(m) = &self.mortar {
             let rate = self.mortar_rate();
-            self.tangent_signature = m.add_tangent(dofs, u_local, rate.as_ref(), factor, k)?;
+            self.tangent_signature = m.add_tangent(
+                dofs,
+                u_local,
+                rate.as_ref(),
+                (factor, self.main_part_tangent),
+                k,
+            )?;
             return Ok(());
         }
         // Which links are closed, on which master facets, sticking or

@@ -201,7 +201,8 @@ impl ContactPair {
 
     /// Whether the frictionless links' tangent keeps only its main part
     /// (see `kernel::LinkInput::main_part_tangent`; the residual is the
-    /// same either way). A mortar pair and friction ignore it.
+    /// same either way; the mortar pair's analogue is
+    /// `mortar::main_part`). Friction and a rigid mortar master ignore it.
     pub fn set_main_part_tangent(&mut self, on: bool) {
         self.main_part_tangent = on;
     }
