@@ -253,6 +253,18 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         r.preconditioner_reuses
                     );
                 }
+                if let Some(s) = &r.schur {
+                    let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
+                    println!(
+                        "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s)",
+                        r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
+                        linear,
+                        s.dofs,
+                        s.bulk_factorisations,
+                        s.growths,
+                        s.schur_factorisations
+                    );
+                }
                 if rt.size() > 1 {
                     println!(
                         "  halo (all ranks): {} ghost displacement values per residual, {} ghost multiplier values per Uzawa update",

@@ -21,6 +21,8 @@ struct Counts {
     /// Preconditioner builds decided by the active-set watch.
     builds: usize,
     reuses: usize,
+    /// The contact Schur path: (bulk, dense Schur) factorisations.
+    schur: Option<(usize, usize)>,
 }
 
 fn counts(args: &[&str]) -> Counts {
@@ -47,6 +49,19 @@ fn counts(args: &[&str]) -> Counts {
         if line.trim_start().starts_with("cutback:") {
             c.cutbacks += 1;
         }
+        if let (Some(bulk), Some(dense)) = (
+            line.split("bulk stiffness factored ").nth(1),
+            line.split("Schur complement factored ").nth(1),
+        ) {
+            let first = |s: &str| {
+                s.split_whitespace()
+                    .next()
+                    .unwrap()
+                    .parse::<usize>()
+                    .unwrap()
+            };
+            c.schur = Some((first(bulk), first(dense)));
+        }
         if let Some(rest) = line.split("preconditioner built ").nth(1) {
             let n: Vec<usize> = rest
                 .split_whitespace()
@@ -72,13 +87,47 @@ fn within(what: &str, scene: &str, value: usize, band: (usize, usize)) {
     );
 }
 
+/// The contact Schur path (the default for these small linear scenes on
+/// one rank): the same Newton and Uzawa counts as the factor-per-rebuild
+/// path, one exact solve per Newton iteration, the bulk factored once and
+/// the dense Schur complement once per Newton iteration.
+fn schur_path(scene: &str, args: &[&str], newton: (usize, usize), uzawa: (usize, usize)) {
+    let c = counts(args);
+    within("Newton iterations", scene, c.newton, newton);
+    within("Uzawa iterations", scene, c.uzawa, uzawa);
+    assert_eq!(
+        c.ksp, c.newton,
+        "{scene}: not one exact solve per Newton iteration: {c:?}"
+    );
+    assert_eq!(c.schur, Some((1, c.newton)), "{scene}: {c:?}");
+}
+
+/// The factor-per-rebuild path these pins were set on.
+const NO_SCHUR: [&str; 2] = ["--set", "solver.contact_schur=false"];
+
+#[test]
+fn hertz_cylinder_schur() {
+    // Measured: 14 Newton, 11 Uzawa, 14 exact solves; bulk factored once.
+    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.4"];
+    schur_path("hertz-cylinder h = 0.4, Schur", &args, (12, 16), (9, 13));
+    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.2"];
+    schur_path("hertz-cylinder h = 0.2, Schur", &args, (6, 9), (3, 6));
+    schur_path("patch-test, Schur", &["patch-test"], (5, 8), (3, 6));
+}
+
 #[test]
 fn hertz_cylinder_coarse() {
     // Measured: 14 Newton, 11 Uzawa, 55 GMRES iterations around 4 LDLᵀ
     // factorisations (before the coupled Uzawa tolerance and the
     // active-set lag: 23 Newton, 10 Uzawa, 84 GMRES).
     let scene = "hertz-cylinder h = 0.4";
-    let c = counts(&["hertz-cylinder", "--set", "mesh.fine_size=0.4"]);
+    let c = counts(
+        &[
+            &["hertz-cylinder", "--set", "mesh.fine_size=0.4"][..],
+            &NO_SCHUR,
+        ]
+        .concat(),
+    );
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (12, 16));
     within("Uzawa iterations", scene, c.uzawa, (9, 13));
@@ -92,7 +141,13 @@ fn hertz_cylinder_medium() {
     // main-part tangent of the first Uzawa iteration: 9, 4, 20, 6; before
     // the coupled Uzawa tolerance: 11, 3, 25).
     let scene = "hertz-cylinder h = 0.2";
-    let c = counts(&["hertz-cylinder", "--set", "mesh.fine_size=0.2"]);
+    let c = counts(
+        &[
+            &["hertz-cylinder", "--set", "mesh.fine_size=0.2"][..],
+            &NO_SCHUR,
+        ]
+        .concat(),
+    );
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (6, 9));
     within("Uzawa iterations", scene, c.uzawa, (3, 6));
@@ -143,7 +198,7 @@ fn patch_test() {
     // Measured: 6 Newton, 5 Uzawa, 32 GMRES, one factorisation kept for the
     // whole step (before: 9, 4, 29).
     let scene = "patch-test";
-    let c = counts(&["patch-test"]);
+    let c = counts(&[&["patch-test"][..], &NO_SCHUR].concat());
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (5, 8));
     within("Uzawa iterations", scene, c.uzawa, (3, 6));

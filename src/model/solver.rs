@@ -42,6 +42,10 @@ pub struct SolverSettings {
     /// assembles the frictionless links' tangent without its terms in the
     /// pressure times the derivatives of the normal (see `solve::uzawa`).
     pub first_contact_main_tangent: bool,
+    /// On the direct path with linear bodies on one rank, factor the bulk
+    /// stiffness once with a Schur complement on the contact DOFs and solve
+    /// each contact Jacobian through it (see `solve::schur`).
+    pub contact_schur: bool,
 }
 
 /// Work a run reuses instead of redoing.
@@ -85,6 +89,7 @@ impl Default for SolverSettings {
             uzawa_forcing: DEFAULT_FORCING,
             first_contact_softening: 1.0,
             first_contact_main_tangent: true,
+            contact_schur: true,
         }
     }
 }

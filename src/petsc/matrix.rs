@@ -228,6 +228,11 @@ impl Matrix {
         })
     }
 
+    /// Whether both handles name the same PETSc matrix.
+    pub fn same_as(&self, other: &Matrix) -> bool {
+        self.raw == other.raw
+    }
+
     pub fn duplicate(&self) -> Result<Matrix> {
         let mut raw: sys::Mat = std::ptr::null_mut();
         // SAFETY: valid mat and out-pointer.

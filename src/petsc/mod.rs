@@ -6,6 +6,7 @@ pub mod matrix;
 pub mod options;
 pub mod reason;
 pub mod scatter;
+pub mod schur;
 pub mod snes;
 pub mod sys;
 pub mod vector;

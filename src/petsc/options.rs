@@ -68,6 +68,16 @@ pub fn set(name: &str, value: &str) -> Result<()> {
     }
 }
 
+/// True when the option is in the database and the program did not set it
+/// as its default (the command line, PETSC_OPTIONS or a scene's
+/// `petsc_options` did).
+pub fn user_set(name: &str) -> Result<bool> {
+    let ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
+    let by_program = ours.iter().any(|(n, s)| n == name && *s == Source::Program);
+    drop(ours);
+    Ok(!by_program && has(name)?)
+}
+
 /// True when the option is present in the database.
 pub fn has(name: &str) -> Result<bool> {
     let n = c_string(name)?;

@@ -1,6 +1,7 @@
 //! Newton's method through PETSc SNES, with residual and Jacobian computed by
 //! Rust code behind the [`NonlinearProblem`] trait.
 use super::reason::{KspReason, SnesReason};
+use super::schur::SchurPreconditioner;
 use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -64,6 +65,10 @@ struct Context<'a> {
 
 pub struct Snes {
     raw: sys::SNES,
+    /// The shell preconditioner's state, when there is one: boxed so that
+    /// its address, which the PC holds, stays fixed; dropped after the SNES
+    /// (fields go after `Drop::drop`).
+    schur: Option<Box<SchurPreconditioner>>,
 }
 
 impl Snes {
@@ -73,7 +78,7 @@ impl Snes {
         let mut raw: sys::SNES = std::ptr::null_mut();
         // SAFETY: PETSc is initialised; out-pointer valid.
         unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
-        let snes = Snes { raw };
+        let snes = Snes { raw, schur: None };
         Ok(snes)
     }
 
@@ -136,6 +141,40 @@ impl Snes {
             petsc_call!(KSPGetPC(ksp, &mut pc))?;
             petsc_call!(PCReset(pc))
         }
+    }
+
+    /// Makes the linear solver's preconditioner the Schur-complement shell
+    /// (after [`Self::set_from_options`], which would reset it).
+    pub fn install_schur(&mut self, state: SchurPreconditioner) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut pc: sys::PC = std::ptr::null_mut();
+        let mut boxed = Box::new(state);
+        let ptr: *mut SchurPreconditioner = &mut *boxed;
+        self.schur = Some(boxed);
+        // SAFETY: valid snes; the KSP and PC are borrowed from it; the box
+        // is kept in `self` until after the SNES (and so the PC) is destroyed,
+        // and never moved out while the SNES lives.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetPC(ksp, &mut pc))?;
+            super::schur::install(pc, ptr)?;
+            // A fresh exact solve needs no Krylov iterations around it
+            // (GMRES took one each, at twice the solves); a user's
+            // -ksp_type stands.
+            if !super::options::user_set("-ksp_type")? {
+                petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
+            }
+            Ok(())
+        }
+    }
+
+    /// The Schur preconditioner's state, if installed.
+    pub fn schur(&self) -> Option<&SchurPreconditioner> {
+        self.schur.as_deref()
+    }
+
+    pub fn schur_mut(&mut self) -> Option<&mut SchurPreconditioner> {
+        self.schur.as_deref_mut()
     }
 
     /// Applies the options database (after the program's defaults are set).

@@ -168,6 +168,7 @@ impl Scene {
             first_contact_main_tangent: s
                 .first_contact_main_tangent
                 .unwrap_or(d.first_contact_main_tangent),
+            contact_schur: s.contact_schur.unwrap_or(d.contact_schur),
         })
     }
 }

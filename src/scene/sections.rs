@@ -318,6 +318,8 @@ pub struct SolverSection {
     /// Main-part contact tangent in the first Uzawa iteration of a step
     /// without contact (default true).
     pub first_contact_main_tangent: Option<bool>,
+    /// Bulk factored once, contact solved on its Schur complement (default true).
+    pub contact_schur: Option<bool>,
 }
 
 #[derive(Debug, Deserialize, Default)]

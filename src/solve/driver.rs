@@ -18,6 +18,7 @@ use super::reactions::{reaction_totals, zero_unconstrained};
 use super::report::{
     contact_reports, nodal_pressure, print_step, PairFields, RunReport, StepReport, StepSink,
 };
+use super::schur;
 use super::setup::{self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance};
 use super::start::{initial_state, mechanics, prepare_time_step, time_stepper, Parts};
 use super::uzawa::{uzawa_loop, StepContext, StepResult};
@@ -154,7 +155,14 @@ impl<'m> Simulation<'m> {
         let x_prev = x.duplicate()?;
         let predictor = Predictor::new(&x, model.solver.extrapolate)?;
         let reaction = x.duplicate()?;
-        let (snes, tolerance) = newton_solver(model, local)?;
+        let (mut snes, tolerance) = newton_solver(model, local)?;
+        let global_dofs = DIM * mech.dofs.num_global_nodes();
+        if schur::applies(model, tangent, mech.loads, rt.size(), global_dofs) {
+            if let Some(k) = mech.separate_stiffness() {
+                schur::install(&mut snes, k, mech.dirichlet, tangent)?;
+                mech.always_rebuild = true;
+            }
+        }
         let base = 1.0 / model.steps.max(1) as f64;
         let mut steps = LoadSteps {
             world,
@@ -313,6 +321,7 @@ impl LoadSteps<'_> {
                         build_jacobian(mech.dofs, mech.bulk, mech.loads, mech.contact, mesh)
                     })?;
                 self.pattern_builds += 1;
+                schur::want(&mut self.snes, self.mech.contact, self.mech.dofs)?;
             }
         }
         Ok(())
@@ -566,6 +575,7 @@ impl LoadSteps<'_> {
             times,
             pattern_builds,
             x,
+            snes,
             ..
         } = self;
         let dofs = mech.dofs;
@@ -580,6 +590,7 @@ impl LoadSteps<'_> {
             pattern_builds,
             preconditioner_builds: mech.lag.as_ref().map_or(0, |l| l.rebuilds),
             preconditioner_reuses: mech.lag.as_ref().map_or(0, |l| l.reuses),
+            schur: schur::summary(&snes),
             phases: times.plus(&mech.times).max_over_ranks(&world),
             halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
             halo_multipliers: parallel::sum_usize(

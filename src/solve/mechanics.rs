@@ -38,6 +38,10 @@ pub struct Mechanics<'a> {
     /// Rebuild the preconditioner only on active-set changes (None: SNES's
     /// own lag setting decides).
     pub lag: Option<PreconditionerLag>,
+    /// Rebuild the preconditioner at every Jacobian (the contact Schur
+    /// path, where a rebuild is a small dense factorisation): each linear
+    /// solve is then exact.
+    pub always_rebuild: bool,
     stages: Stages,
     /// The callbacks agree their outcome over these ranks (PETSc's world).
     world: SimpleCommunicator,
@@ -45,6 +49,8 @@ pub struct Mechanics<'a> {
     r: GhostedVector,
     /// Bulk stiffness when every body is linear: assembled once, reused.
     linear_k: Option<LinearStiffness>,
+    /// With a separate K: the Jacobian matrix last seen and K on its pattern.
+    k_on_pattern: Option<(Matrix, Matrix)>,
     work: Vector,
     /// Held master nodes this rank does not see, and their displacements at
     /// the last loaded state.
@@ -82,11 +88,13 @@ impl<'a> Mechanics<'a> {
             inertia: None,
             times: PhaseTimes::default(),
             lag: None,
+            always_rebuild: false,
             stages: Stages::register()?,
             world: SimpleCommunicator::world(),
             u,
             r,
             linear_k: None,
+            k_on_pattern: None,
             work,
             tail: MasterTail::new(dofs.num_owned_dofs()),
             u_tail: Vec::new(),
@@ -108,6 +116,14 @@ impl<'a> Mechanics<'a> {
             };
         }
         Ok(me)
+    }
+
+    /// The linear bulk stiffness K when it is kept in a matrix of its own.
+    pub fn separate_stiffness(&self) -> Option<&Matrix> {
+        match &self.linear_k {
+            Some(LinearStiffness::Separate(k)) => Some(k),
+            _ => None,
+        }
     }
 
     fn load_state(&mut self, x: &Vector) -> Result<()> {
@@ -330,19 +346,25 @@ impl<'a> Mechanics<'a> {
             return self.shared_jacobian(j);
         }
         self.load_state(x)?;
+        self.stages.time(Phase::BulkAssembly, &mut self.times, || {
+            stiffness_on_pattern(&self.linear_k, &mut self.k_on_pattern, j)
+        })?;
         let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
         let (stages, times) = (self.stages, &mut self.times);
         let (u, inertia, linear_k) = (&self.u, &self.inertia, &self.linear_k);
+        let k_on_pattern = &self.k_on_pattern;
         let u_tail = &self.u_tail;
         let bulk_part = stages.time(Phase::BulkAssembly, times, || -> Result<Result<bool>> {
-            j.zero_entries()?;
+            // K copied in on the Jacobian's own pattern (a copy of values,
+            // where adding K of a smaller pattern went entry by entry).
+            match k_on_pattern {
+                Some((_, kj)) => j.copy_from(kj)?,
+                None => j.zero_entries()?,
+            }
             // Whole-matrix additions (MatAXPY, collective) need the assembled
-            // (zeroed) matrix, so they come before any element values are set.
+            // matrix, so they come before any element values are set.
             if let Some(inertia) = inertia {
                 j.add_scaled_subset(inertia.a_u, &inertia.mass)?;
-            }
-            if let Some(LinearStiffness::Separate(k)) = linear_k {
-                j.add_scaled_subset(1.0, k)?;
             }
             // From here on only this rank's values: a failure is kept for the end.
             let mut local = || -> Result<bool> {
@@ -442,6 +464,29 @@ impl<'a> Mechanics<'a> {
     }
 }
 
+/// Collective: K on the pattern of the Jacobian `j` (kept with a handle on
+/// `j`, so a new Jacobian matrix is told apart from the old one), formed
+/// again when `j` is a new matrix; None without a separate K.
+fn stiffness_on_pattern(
+    linear_k: &Option<LinearStiffness>,
+    slot: &mut Option<(Matrix, Matrix)>,
+    j: &Matrix,
+) -> Result<()> {
+    let Some(LinearStiffness::Separate(k)) = linear_k else {
+        *slot = None;
+        return Ok(());
+    };
+    if slot.as_ref().is_some_and(|(for_j, _)| for_j.same_as(j)) {
+        return Ok(());
+    }
+    *slot = None;
+    let mut kj = j.duplicate()?;
+    kj.zero_entries()?;
+    kj.add_scaled_subset(1.0, k)?;
+    *slot = Some((j.share()?, kj));
+    Ok(())
+}
+
 /// Adds NaN to the diagonal of this rank's first unconstrained row.
 fn poison_diagonal(dofs: &DofMap, dirichlet: &Dirichlet, j: &mut Matrix) -> Result<()> {
     let constrained: std::collections::HashSet<usize> =
@@ -481,6 +526,9 @@ impl NonlinearProblem for Mechanics<'_> {
     }
 
     fn rebuild_preconditioner(&mut self, last_linear_iterations: usize) -> Option<bool> {
+        if self.always_rebuild {
+            return Some(true);
+        }
         let lag = self.lag.as_mut()?;
         let signatures: Vec<u64> = self
             .contact

@@ -66,6 +66,8 @@ pub struct RunReport {
     /// (`lagging`; both 0 when it is off).
     pub preconditioner_builds: usize,
     pub preconditioner_reuses: usize,
+    /// The contact Schur path's figures (None: not taken).
+    pub schur: Option<super::schur::SchurSummary>,
     /// Seconds per phase over the run, the largest over the ranks.
     pub phases: PhaseTimes,
     /// Halo volume, summed over ranks: ghost displacement values refreshed
