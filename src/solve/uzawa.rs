@@ -1,8 +1,11 @@
 //! The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with
 //! the multipliers λ fixed, then λ ← ⟨λ − εN gN⟩ at every link, until every
 //! pair's penetration and multiplier change are within its tolerances on
-//! every rank. A pair that converges too slowly has its penalty raised (at
-//! most `PENALTY_RAISES` times a step) before the step counts as failed.
+//! every rank. A frictionless pair whose multiplier change stalls far above
+//! its tolerance has its penalty raised once (the rate rule,
+//! `penalty::RATE_LIMIT`); a pair still unconverged after `max_uzawa` has
+//! it raised (at most `PENALTY_RAISES` times a step) before the step counts
+//! as failed.
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
 use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
