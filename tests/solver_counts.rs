@@ -117,8 +117,11 @@ fn hertz_cylinder_schur() {
 
 #[test]
 fn hertz_cylinder_coarse() {
-    // Measured: 14 Newton, 11 Uzawa, 55 GMRES iterations around 4 LDLᵀ
-    // factorisations (before the coupled Uzawa tolerance and the
+    // Measured: 13 Newton, 7 Uzawa, 34 GMRES iterations around 7 LDLᵀ
+    // factorisations: the Uzawa rate rule raises the penalty once the
+    // multiplier change stalls, and the raised tangent is refactored
+    // (before the rate rule: 14 Newton, 11 Uzawa, 64 GMRES, 4
+    // factorisations; before the coupled Uzawa tolerance and the
     // active-set lag: 23 Newton, 10 Uzawa, 84 GMRES).
     let scene = "hertz-cylinder h = 0.4";
     let c = counts(
@@ -129,10 +132,10 @@ fn hertz_cylinder_coarse() {
         .concat(),
     );
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (12, 16));
-    within("Uzawa iterations", scene, c.uzawa, (9, 13));
-    within("linear iterations", scene, c.ksp, (40, 70));
-    within("preconditioner builds", scene, c.builds, (3, 6));
+    within("Newton iterations", scene, c.newton, (11, 15));
+    within("Uzawa iterations", scene, c.uzawa, (6, 8));
+    within("linear iterations", scene, c.ksp, (25, 45));
+    within("preconditioner builds", scene, c.builds, (5, 8));
 }
 
 #[test]
@@ -225,7 +228,9 @@ fn tight_switches_restore_the_old_counts() {
     // Both levers off: every Newton solve to the final tolerance and the
     // factors rebuilt every Newton iteration of a step's first Uzawa
     // iteration, as before they existed (hertz-cylinder h = 0.4: 23 Newton;
-    // 25 with the first Uzawa iteration's main-part tangent, the default).
+    // 25 with the first Uzawa iteration's main-part tangent, the default;
+    // 20 with the Uzawa rate rule's penalty raise, which these switches do
+    // not turn off).
     let scene = "hertz-cylinder h = 0.4, levers off";
     let c = counts(&[
         "hertz-cylinder",
@@ -236,7 +241,7 @@ fn tight_switches_restore_the_old_counts() {
         "--set",
         "solver.lag_active_set=false",
     ]);
-    within("Newton iterations", scene, c.newton, (21, 25));
+    within("Newton iterations", scene, c.newton, (18, 22));
     assert_eq!(c.builds, 0, "{scene}: the watch ran while switched off");
 }
 

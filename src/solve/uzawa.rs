@@ -1,11 +1,14 @@
 //! The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with
 //! the multipliers λ fixed, then λ ← ⟨λ − εN gN⟩ at every link, until every
 //! pair's penetration and multiplier change are within its tolerances on
-//! every rank. A pair that converges too slowly has its penalty raised (at
-//! most `PENALTY_RAISES` times a step) before the step counts as failed.
+//! every rank. A frictionless pair whose multiplier change stalls far above
+//! its tolerance has its penalty raised once (the rate rule,
+//! `penalty::RATE_LIMIT`); a pair still unconverged after `max_uzawa` has
+//! it raised (at most `PENALTY_RAISES` times a step) before the step counts
+//! as failed.
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
-use super::penalty::{PENALTY_RAISE, PENALTY_RAISES};
+use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
 use super::tolerance;
 use crate::contact::{ContactPair, UzawaStats};
@@ -118,6 +121,10 @@ fn uzawa_rounds(
     // Uzawa iterations over every round (k counts within one).
     let mut total = 0;
     let mut solve_tight = !inner.is_inexact();
+    let mut progress = vec![Progress::default(); mech.contact.len()];
+    let mut rate_raises = 0;
+    // A raised penalty changes the tangent: the next solve refactors.
+    let mut refactor = false;
     loop {
         k += 1;
         total += 1;
@@ -126,7 +133,11 @@ fn uzawa_rounds(
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
         snes.set_lag_preconditioner(
-            if k == 1 || mech.contact.is_empty() || !reuse_preconditioner {
+            if k == 1
+                || std::mem::take(&mut refactor)
+                || mech.contact.is_empty()
+                || !reuse_preconditioner
+            {
                 1
             } else {
                 -1
@@ -156,12 +167,15 @@ fn uzawa_rounds(
             // count from here.
             restore_penalties(mech, softened, softening);
             k = 0;
+            progress.iter_mut().for_each(Progress::forget);
         }
-        let converged = mech
+        let pair_ok: Vec<bool> = mech
             .contact
             .iter()
             .zip(&stats)
-            .all(|(p, s)| pair_converged(p, s));
+            .map(|(p, s)| pair_converged(p, s))
+            .collect();
+        let converged = pair_ok.iter().all(|c| *c);
         match tolerance::round_end(converged, solve_tight) {
             tolerance::RoundEnd::Converged => {
                 outcome.iterations = newton;
@@ -175,6 +189,15 @@ fn uzawa_rounds(
             }
             tolerance::RoundEnd::Continue => {}
         }
+        if rate_raises < RATE_RAISES
+            && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
+        {
+            rate_raises += 1;
+            refactor = true;
+            if let Some(lag) = mech.lag.as_mut() {
+                lag.reset();
+            }
+        }
         if k >= max_uzawa && raises < PENALTY_RAISES {
             // Converging too slowly (soft bodies, long sliding): the
             // augmented Lagrangian keeps its solution for any penalty and
@@ -182,6 +205,7 @@ fn uzawa_rounds(
             // still outside their tolerances and give Uzawa another round.
             raises += 1;
             raise_slow_penalties(mech.contact, &stats);
+            progress.iter_mut().for_each(Progress::forget);
             k = 0;
             continue;
         }
@@ -317,6 +341,33 @@ fn raise_slow_penalties(pairs: &mut [ContactPair], stats: &[UzawaStats]) {
             p.raise_penalty(PENALTY_RAISE);
         }
     }
+}
+
+/// The rate rule (`penalty::RATE_LIMIT`): raises the penalty of every
+/// frictionless pair whose multiplier change contracted too slowly in this
+/// Uzawa iteration, and says whether any was raised. The figures are
+/// reduced over the ranks, so every rank decides alike. Friction keeps its
+/// penalty: its stick/slip classification, not the rate, sets its pace.
+fn raise_stalled_penalties(
+    pairs: &mut [ContactPair],
+    stats: &[UzawaStats],
+    converged: &[bool],
+    progress: &mut [Progress],
+) -> bool {
+    let mut raised = false;
+    for ((p, s), (ok, pr)) in pairs
+        .iter_mut()
+        .zip(stats)
+        .zip(converged.iter().zip(progress.iter_mut()))
+    {
+        let relative = s.max_change / s.max_force.max(p.force_floor());
+        if pr.stalls(relative, p.spec.multiplier_tol, *ok) && !p.has_friction() {
+            p.raise_penalty(RATE_RAISE);
+            pr.forget();
+            raised = true;
+        }
+    }
+    raised
 }
 
 /// The figures a failed Uzawa loop reports: maxima and counts over the pairs.

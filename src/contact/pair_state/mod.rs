@@ -66,6 +66,10 @@ pub struct ContactPair {
     /// mean element size; with no user value each slave facet uses its own
     /// h (`facet_penalty`), so graded meshes get a local penalty.
     pub penalty: f64,
+    /// The penalty the pair was built with: what the Uzawa test's force
+    /// floor is measured in, so that raising (or softening) the penalty
+    /// does not move the test's resolution.
+    built_penalty: f64,
     facet_penalty: Vec<f64>,
     pub search_distance: f64,
     links: Vec<Link>,
@@ -166,6 +170,7 @@ impl ContactPair {
             master,
             multipliers,
             penalty,
+            built_penalty: penalty,
             facet_penalty,
             tangent_signature: 0,
             main_part_tangent: false,
@@ -190,7 +195,7 @@ impl ContactPair {
     /// grazing touch) is not iterated to relative precision.
     pub fn force_floor(&self) -> f64 {
         let h = self.slave.h;
-        self.penalty * self.spec.penetration_tol * h * h * h
+        self.built_penalty * self.spec.penetration_tol * h * h * h
     }
 
     /// Translation of a rigid master at load factor `factor`.
