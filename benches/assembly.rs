@@ -90,7 +90,7 @@ fn main() {
     for n in sizes {
         let m = model(n);
         let mut part =
-            contactlink::partition::partition_cells(&m.mesh, rt.size()).expect("partition");
+            contactlink::partition::partition_cells(&m.mesh, rt.size(), &[]).expect("partition");
         rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
         let wanted = contactlink::distribution::Wanted::default();
         let (dofs, local) = DofMap::with_mesh(&m.mesh, &part, rt.rank(), rt.size(), &wanted);

@@ -204,7 +204,7 @@ fn unit_box(n: usize, grading: Grading) -> Result<Mesh, String> {
 
 fn partition_for(rt: &Runtime, mesh: &Mesh) -> Result<Vec<i32>, String> {
     let mut part =
-        contactlink::partition::partition_cells(mesh, rt.size()).map_err(|e| e.to_string())?;
+        contactlink::partition::partition_cells(mesh, rt.size(), &[]).map_err(|e| e.to_string())?;
     rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
     Ok(part)
 }

@@ -70,3 +70,39 @@ fn an_iterative_contact_run_caps_the_eisenstat_walker_forcing() {
     let t = option_table(&["scenes/block-on-plane.toml"]);
     assert!(!t.contains("-snes_ksp_ew"), "{t}");
 }
+
+/// The option table of a run on `ranks` ranks.
+fn option_table_on(ranks: usize, args: &[&str]) -> String {
+    let mut all = vec!["run"];
+    all.extend_from_slice(args);
+    all.push("-options_view");
+    let o = mpirun(ranks, &all);
+    let t = text(&o);
+    assert!(o.status.success(), "{args:?} on {ranks} ranks failed:\n{t}");
+    t
+}
+
+#[test]
+fn a_plain_linear_iterative_run_on_several_ranks_forms_the_galerkin_product_with_hypre() {
+    // Several ranks: hypre's P^T A P (PETSc's parallel one keeps A P and
+    // P's ghost rows at the set-up peak); one rank keeps PETSc's own.
+    let plain = [
+        "scenes/cantilever.toml",
+        "--set",
+        "solver.direct_max_dofs=0",
+    ];
+    let t = option_table_on(2, &plain);
+    assert!(t.contains("-matptap_via hypre"), "{t}");
+    let t = option_table(&plain);
+    assert!(!t.contains("-matptap_via"), "{t}");
+    // A run whose matrix changes refreshes its products: unchanged.
+    let t = option_table_on(
+        2,
+        &[
+            "scenes/block-on-plane.toml",
+            "--set",
+            "solver.direct_max_dofs=0",
+        ],
+    );
+    assert!(!t.contains("-matptap_via"), "{t}");
+}

@@ -82,7 +82,13 @@ pub fn even_block(n: usize, rank: usize, nranks: usize) -> std::ops::Range<usize
 pub fn distribute(world: &impl Communicator, mesh: &Mesh, wanted: &Wanted) -> Result<Piece> {
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let part = if rank == 0 {
-        crate::partition::partition_cells(mesh, size)
+        // Contact slave facets are balanced over the ranks with the cells.
+        let part = crate::partition::partition_cells(mesh, size, wanted.slave_sets);
+        if let (Ok(p), true) = (&part, crate::footprint::checkpoints_enabled()) {
+            let balance = crate::partition::Balance::of(mesh, p, size, wanted.slave_sets);
+            eprintln!("{}", balance.line());
+        }
+        part
     } else {
         Ok(Vec::new())
     };

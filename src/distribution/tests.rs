@@ -102,7 +102,7 @@ fn a_local_mesh_is_a_fraction_of_the_whole() {
     })
     .unwrap();
     let n = mesh.num_nodes();
-    let part = crate::partition::partition_cells(&mesh, 4).unwrap();
+    let part = crate::partition::partition_cells(&mesh, 4, &[]).unwrap();
     let numbering = Numbering::new(&mesh, &part, 4);
     for r in 0..4 {
         let p = numbering.piece(&mesh, &part, r, &Wanted::default());
