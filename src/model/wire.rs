@@ -528,6 +528,7 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
         uzawa_forcing,
         first_contact_softening,
         first_contact_main_tangent,
+        contact_schur,
     } = s;
     w.usize(*max_newton);
     w.f64(*rtol);
@@ -542,6 +543,7 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
     w.f64(*uzawa_forcing);
     w.f64(*first_contact_softening);
     w.bool(*first_contact_main_tangent);
+    w.bool(*contact_schur);
 }
 
 fn take_solver(r: &mut Reader) -> Result<SolverSettings> {
@@ -562,6 +564,7 @@ fn take_solver(r: &mut Reader) -> Result<SolverSettings> {
         uzawa_forcing: r.f64()?,
         first_contact_softening: r.f64()?,
         first_contact_main_tangent: r.bool()?,
+        contact_schur: r.bool()?,
     })
 }
 
