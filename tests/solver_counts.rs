@@ -107,9 +107,10 @@ const NO_SCHUR: [&str; 2] = ["--set", "solver.contact_schur=false"];
 
 #[test]
 fn hertz_cylinder_schur() {
-    // Measured: 14 Newton, 11 Uzawa, 14 exact solves; bulk factored once.
+    // Measured: 13 Newton, 7 Uzawa (the Uzawa rate rule raises the penalty
+    // once; without it 14 and 11), 13 exact solves; bulk factored once.
     let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.4"];
-    schur_path("hertz-cylinder h = 0.4, Schur", &args, (12, 16), (9, 13));
+    schur_path("hertz-cylinder h = 0.4, Schur", &args, (11, 15), (6, 8));
     let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.2"];
     schur_path("hertz-cylinder h = 0.2, Schur", &args, (6, 9), (3, 6));
     schur_path("patch-test, Schur", &["patch-test"], (5, 8), (3, 6));
@@ -160,9 +161,10 @@ fn hertz_cylinder_medium() {
 
 #[test]
 fn hertz_cylinder_coarse_on_the_krylov_path() {
-    // GMRES + GAMG forced (direct_max_dofs = 0), serial. Measured: 39
-    // Newton, 11 Uzawa, 323 GMRES iterations around one GAMG set-up kept
-    // for the whole step. Before the Eisenstat–Walker cap and the kept
+    // GMRES + GAMG forced (direct_max_dofs = 0), serial. Measured: 42
+    // Newton, 8 Uzawa, 292 GMRES iterations, two GAMG set-ups (the Uzawa
+    // rate rule's penalty raise resets the lag); without the rate rule 39,
+    // 11, 323 around one set-up kept for the whole step. Before the Eisenstat–Walker cap and the kept
     // hierarchy the step was cut back 8 times and the run failed at load
     // factor 0.996 (30 Newton iterations without convergence).
     let scene = "hertz-cylinder h = 0.4, GMRES + GAMG";
@@ -174,9 +176,9 @@ fn hertz_cylinder_coarse_on_the_krylov_path() {
         "solver.direct_max_dofs=0",
     ]);
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (35, 44));
-    within("Uzawa iterations", scene, c.uzawa, (9, 13));
-    within("linear iterations", scene, c.ksp, (280, 370));
+    within("Newton iterations", scene, c.newton, (37, 47));
+    within("Uzawa iterations", scene, c.uzawa, (7, 10));
+    within("linear iterations", scene, c.ksp, (250, 340));
     within("preconditioner builds", scene, c.builds, (1, 2));
 }
 
