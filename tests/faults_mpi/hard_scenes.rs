@@ -138,10 +138,13 @@ fn cantilever_with_an_inverted_cell_ends_with_one_error_on_every_rank_count() {
 /// Contact patch test, non-matching 4×4 over 5×5 quads, loaded by a
 /// follower pressure on the upper block's top: on 2 ranks METIS puts the
 /// whole upper block on one rank, so only that rank has follower facets.
+/// The slave is the lower block's top, four layers above its fixed bottom:
+/// the partition spreads the slave facets over the ranks, and the upper
+/// block (no slave facets, 16 of 116 cells) still fits on one side.
 const FOLLOWER_PATCH: &str = r#"
 [mesh]
 generator = "stacked-blocks"
-lower_divisions = [5, 5, 1]
+lower_divisions = [5, 5, 4]
 upper_divisions = [4, 4, 1]
 
 [[body]]
@@ -173,8 +176,8 @@ value = 10.0
 
 [[contact]]
 name = "interface"
-slave = "upper.bottom"
-master = "lower.top"
+slave = "lower.top"
+master = "upper.bottom"
 "#;
 
 #[test]
@@ -203,7 +206,7 @@ fn follower_patch_test_with_its_loaded_facets_on_one_rank_matches_one_rank() {
             // loaded facet) on one rank, none on the other.
             let (part, _) =
                 contactlink::output::read_dataset::<i32>(&out, layout::MESH_PARTITION).unwrap();
-            let upper = &part[25..];
+            let upper = &part[100..];
             assert!(
                 upper.iter().all(|r| *r == upper[0]),
                 "upper block split: {part:?}"
