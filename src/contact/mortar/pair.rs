@@ -144,7 +144,16 @@ impl MortarPair {
         let assembled: Vec<bool> = mesh.shared.get(&spec.slave).map_or(Vec::new(), |s| {
             s.cells.iter().map(|&c| dofs.is_local_cell(c)).collect()
         });
-        let mut mine = vec![false; n_slave];
+        // A rank evaluates the nodes of its own facets and the slave nodes
+        // it owns: the owner of a node (the lowest rank among the cells
+        // holding it) may hold none of its slave facets (a tet touching the
+        // surface at that node only), yet it is the one that writes the
+        // node's fields. The surface is whole on every rank, so it can.
+        let mut mine: Vec<bool> = slave
+            .node_local
+            .iter()
+            .map(|&l| dofs.is_owned(LocalNode::from_u32(l)))
+            .collect();
         for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
             for &n in &f[..nf] {
                 mine[n as usize] = true;
