@@ -11,20 +11,9 @@
 //! the final ones and the consistent tangent's terms in `p_j` open and
 //! close nodes inside the zone; the residual is unchanged, so the answer is.
 use super::system::{
-    merged, segment_nodes, Interface, NodalData, NodeDof, NodeState, Segment, SEGMENT_DOFS,
+    emit_scaled_outer, force_coefficient, segment_nodes, Interface, NodalData, NodeDof, NodeState,
+    Segment, SEGMENT_DOFS,
 };
-use crate::fem::MAX_FACET_NODES;
-
-/// The force coefficient of node `a` on segment variable `v` (see
-/// `system::force_coefficient`), in f64.
-fn coefficient(seg: &Segment<f64>, a: usize, v: usize) -> f64 {
-    let (b, i) = (v / 3, v % 3);
-    if b < MAX_FACET_NODES {
-        seg.terms.d[a][b] * seg.terms.normal[i]
-    } else {
-        -(seg.terms.m[a][b - MAX_FACET_NODES] * seg.terms.normal[i])
-    }
-}
 
 /// Adds the main-part tangent: `emit(row, col, value)`. `segments` must hold
 /// every segment of every closed node of an assembled facet.
@@ -33,7 +22,7 @@ pub(super) fn tangent(
     nodal: &NodalData,
     segments: &[Segment<f64>],
     states: &[NodeState],
-    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+    emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
     let ns = interface.slave_type.nodes();
     let nn = nodal.nodes.len();
@@ -56,7 +45,7 @@ pub(super) fn tangent(
                 if id == u32::MAX {
                     continue;
                 }
-                let c = coefficient(seg, a, v);
+                let c = force_coefficient(&seg.terms, a, v);
                 all[j].push(((id, v % 3), c));
                 if assembled {
                     rows[j].push(((id, v % 3), c));
@@ -64,19 +53,5 @@ pub(super) fn tangent(
             }
         }
     }
-    for j in 0..nn {
-        if rows[j].is_empty() {
-            continue;
-        }
-        let scale = nodal.penalty[j] / nodal.area[j];
-        let f = merged(std::mem::take(&mut all[j]));
-        for (row, c) in merged(std::mem::take(&mut rows[j])) {
-            for (col, fc) in &f {
-                let v = c * fc * scale;
-                if v != 0.0 {
-                    emit(row, *col, v);
-                }
-            }
-        }
-    }
+    emit_scaled_outer(nodal, 1.0, rows, all, emit);
 }

@@ -24,7 +24,7 @@
 //! (`RigidSurface::moved` at the current load factor) and, with friction,
 //! through the master's increment in the slip (`rigid_friction`).
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
-use super::system::{merged, NodalData, NodeDof, NodeState, Seed};
+use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState, Seed};
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
@@ -286,19 +286,5 @@ pub fn tangent(
         }
     }
     // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
-    for j in 0..nn {
-        if rows[j].is_empty() {
-            continue;
-        }
-        let scale = -nodal.penalty[j] / nodal.area[j];
-        let g = merged(std::mem::take(&mut grad[j]));
-        for (row, c) in merged(std::mem::take(&mut rows[j])) {
-            for (col, dg) in &g {
-                let v = c * dg * scale;
-                if v != 0.0 {
-                    emit(row, *col, v);
-                }
-            }
-        }
-    }
+    emit_scaled_outer(nodal, -1.0, rows, grad, emit);
 }

@@ -257,7 +257,7 @@ pub(super) fn segment_nodes(
 
 /// The coefficient of node `a`'s pressure in the force on segment variable
 /// `v = 3 b + i` (`b < 4` slave node, else master node `b − 4`).
-fn force_coefficient<T: Scalar>(terms: &SegmentTerms<T>, a: usize, v: usize) -> T {
+pub(super) fn force_coefficient<T: Scalar>(terms: &SegmentTerms<T>, a: usize, v: usize) -> T {
     let (b, i) = (v / 3, v % 3);
     if b < MAX_FACET_NODES {
         terms.d[a][b] * terms.normal[i]
@@ -384,12 +384,25 @@ pub fn tangent(
         }
     }
     // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
-    for j in 0..nn {
+    emit_scaled_outer(nodal, -1.0, rows, grad, emit);
+}
+
+/// Emits `sign (ε_j/A_j) r_j ⊗ g_j` for every node `j` with rows: `rows[j]`
+/// and `cols[j]` are unmerged (dof, value) lists, merged here. The normal
+/// tangents (deformable and rigid masters, and the main part) end this way.
+pub(super) fn emit_scaled_outer(
+    nodal: &NodalData,
+    sign: f64,
+    mut rows: Vec<Vec<(NodeDof, f64)>>,
+    mut cols: Vec<Vec<(NodeDof, f64)>>,
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    for j in 0..rows.len() {
         if rows[j].is_empty() {
             continue;
         }
-        let scale = -nodal.penalty[j] / nodal.area[j];
-        let g = merged(std::mem::take(&mut grad[j]));
+        let scale = sign * nodal.penalty[j] / nodal.area[j];
+        let g = merged(std::mem::take(&mut cols[j]));
         for (row, c) in merged(std::mem::take(&mut rows[j])) {
             for (col, dg) in &g {
                 let v = c * dg * scale;
