@@ -52,6 +52,17 @@ pub enum Error {
     /// NaN or infinite values where a finite result was expected.
     #[error("non-finite values in the {0}")]
     NonFinite(String),
+    /// SIGTERM or SIGINT reached a rank; all ranks stopped together at the
+    /// end of a load step (every converged step is written).
+    #[error(
+        "stopped by {} after load step {step} (load factor {load_factor:.6}); every converged step is written",
+        crate::petsc::signals::name(*signal)
+    )]
+    Stopped {
+        signal: i32,
+        step: usize,
+        load_factor: f64,
+    },
     /// A fault injected by `CONTACTLINK_FAULT` (tests only).
     #[error("injected fault at {0} (CONTACTLINK_FAULT)")]
     Fault(&'static str),

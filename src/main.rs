@@ -307,11 +307,22 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
             if printer == Some(rank) {
                 eprintln!("contactlink: {e}");
             }
-            ExitCode::FAILURE
+            failure_code(&e)
         }
     };
     drop(rt);
     code
+}
+
+/// 1 for a failed run; 128 + the signal's number for a run stopped by
+/// SIGTERM or SIGINT, the shell's convention batch systems look for.
+fn failure_code(e: &contactlink::Error) -> ExitCode {
+    match e {
+        contactlink::Error::Stopped { signal, .. } => {
+            ExitCode::from(u8::try_from(128 + signal).unwrap_or(1))
+        }
+        _ => ExitCode::FAILURE,
+    }
 }
 
 /// `/footprint` in the closed result file; a failure only warns (the

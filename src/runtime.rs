@@ -23,6 +23,12 @@ impl Runtime {
         let mut args = vec!["contactlink".to_owned()];
         args.extend(petsc_args.iter().cloned());
         let petsc = PetscGuard::initialize(&world, &args)?;
+        // After PETSc's start-up, which installs its own handlers: a
+        // termination signal then ends the run at a step boundary.
+        crate::petsc::signals::defer_termination(world.rank() == 0).map_err(|e| {
+            let why = format!("cannot install the SIGTERM/SIGINT handler: {e}");
+            Error::Io(std::io::Error::new(e.kind(), why))
+        })?;
         // Set-up time counts from here: the scene, the mesh, the partition
         // and the matrix, not MPI's and PETSc's own start-up.
         crate::footprint::setup_started();

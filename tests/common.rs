@@ -73,3 +73,34 @@ pub fn write(dir: &Path, name: &str, body: &str) -> PathBuf {
     std::fs::write(&p, body).expect("write scene");
     p
 }
+
+/// Step indices in a history CSV (its first column), header skipped.
+pub fn csv_steps(path: &Path) -> Vec<usize> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    text.lines()
+        .skip(1)
+        // A row being written when the run died may be cut short.
+        .filter(|l| l.ends_with(|c: char| c.is_ascii_digit()))
+        .filter_map(|l| l.split(',').next()?.parse().ok())
+        .collect()
+}
+
+/// Every step the CSV lists is in the HDF5 file, and its displacement reads.
+pub fn assert_file_holds(h5: &Path, csv_listed: &[usize]) {
+    let steps = contactlink::output::list_steps(h5)
+        .unwrap_or_else(|e| panic!("{} does not open after the fault: {e}", h5.display()));
+    for s in csv_listed {
+        assert!(
+            steps.contains(s),
+            "step {s} in the CSV but not in the file ({steps:?})"
+        );
+        let (u, rows, cols) =
+            contactlink::output::read_nodal(h5, *s, contactlink::output::layout::DISPLACEMENT)
+                .unwrap_or_else(|e| panic!("step {s} unreadable: {e}"));
+        assert_eq!((u.len(), cols), (rows * 3, 3));
+        assert!(
+            u.iter().all(|v| v.is_finite()),
+            "step {s} holds non-finite values"
+        );
+    }
+}

@@ -1,13 +1,10 @@
 //! Faults a run must survive with a clear one-line error, a non-zero exit
 //! code, no panic, and a result file that is never corrupt: tangled input
-//! cells, an unwritable output path, Newton failure after every cutback, and
-//! a run killed (SIGKILL of one rank, SIGTERM to mpirun) in the middle.
+//! cells, an unwritable output path, Newton failure after every cutback. Runs
+//! killed or stopped by a signal are in tests/interrupt.rs.
 mod common;
 use common::*;
-use contactlink::output::layout;
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::path::Path;
 
 const TWO_BOXES: &str = r#"
 [mesh]
@@ -120,36 +117,6 @@ fn missing_output_directory_is_created() {
     assert!(!contactlink::output::list_steps(&out).unwrap().is_empty());
 }
 
-/// Step indices in a history CSV (its first column), header skipped.
-fn csv_steps(path: &Path) -> Vec<usize> {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    text.lines()
-        .skip(1)
-        // A row being written when the run died may be cut short.
-        .filter(|l| l.ends_with(|c: char| c.is_ascii_digit()))
-        .filter_map(|l| l.split(',').next()?.parse().ok())
-        .collect()
-}
-
-/// Every step the CSV lists is in the HDF5 file, and its displacement reads.
-fn assert_file_holds(h5: &Path, csv_listed: &[usize]) {
-    let steps = contactlink::output::list_steps(h5)
-        .unwrap_or_else(|e| panic!("{} does not open after the fault: {e}", h5.display()));
-    for s in csv_listed {
-        assert!(
-            steps.contains(s),
-            "step {s} in the CSV but not in the file ({steps:?})"
-        );
-        let (u, rows, cols) = contactlink::output::read_nodal(h5, *s, layout::DISPLACEMENT)
-            .unwrap_or_else(|e| panic!("step {s} unreadable: {e}"));
-        assert_eq!((u.len(), cols), (rows * 3, 3));
-        assert!(
-            u.iter().all(|v| v.is_finite()),
-            "step {s} holds non-finite values"
-        );
-    }
-}
-
 #[test]
 fn newton_failure_keeps_every_converged_step() {
     // Two small steps converge, then the pressure jumps a millionfold: Newton
@@ -196,111 +163,4 @@ max_newton = 8
     );
     assert_file_holds(&out, &listed);
     assert_eq!(contactlink::output::list_steps(&out).unwrap(), listed);
-}
-
-/// `mpirun -n 2 contactlink run impact` long enough to be interrupted.
-fn start_long_run(out: &Path) -> Child {
-    Command::new("mpirun")
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .env("OMPI_MCA_btl", "self,vader")
-        .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
-        .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
-        .args([
-            "--allow-run-as-root",
-            "--oversubscribe",
-            "-n",
-            "2",
-            binary(),
-        ])
-        .args(["run", "impact", "--set", "steps.count=2000", "-q", "-o"])
-        .arg(out)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("spawn mpirun")
-}
-
-/// Waits until the history CSV lists at least `rows` steps.
-fn wait_for_rows(csv: &Path, rows: usize, child: &mut Child) -> Vec<usize> {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    loop {
-        let steps = csv_steps(csv);
-        if steps.len() >= rows {
-            return steps;
-        }
-        if let Ok(Some(status)) = child.try_wait() {
-            panic!("the run ended ({status}) before {rows} steps");
-        }
-        assert!(Instant::now() < deadline, "no {rows} steps after 120 s");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-/// The rank processes: mpirun's children running the contactlink binary.
-fn rank_pids(mpirun: u32) -> Vec<u32> {
-    let mut pids = Vec::new();
-    let tasks = std::fs::read_dir(format!("/proc/{mpirun}/task")).expect("mpirun's tasks");
-    for task in tasks.flatten() {
-        let children = std::fs::read_to_string(task.path().join("children")).unwrap_or_default();
-        pids.extend(
-            children
-                .split_whitespace()
-                .filter_map(|p| p.parse::<u32>().ok()),
-        );
-    }
-    pids.retain(|p| {
-        std::fs::read_to_string(format!("/proc/{p}/comm")).is_ok_and(|c| c.trim() == "contactlink")
-    });
-    pids
-}
-
-fn signal(pid: u32, sig: &str) {
-    let ok = Command::new("kill")
-        .args([sig, &pid.to_string()])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(ok, "kill {sig} {pid} failed");
-}
-
-/// Waits for mpirun to end (it aborts the job when a rank dies).
-fn wait_exit(child: &mut Child) {
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while child.try_wait().expect("wait mpirun").is_none() {
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("mpirun still running 60 s after the signal");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-}
-
-fn interrupted_run(name: &str, interrupt: impl FnOnce(&Child)) -> (PathBuf, Vec<usize>) {
-    let dir = scratch(name);
-    let out = dir.join("k.h5");
-    let csv = out.with_extension("csv");
-    let mut child = start_long_run(&out);
-    let before = wait_for_rows(&csv, 3, &mut child);
-    interrupt(&child);
-    wait_exit(&mut child);
-    // Rows written after `before` was read belong to steps flushed too.
-    let listed = csv_steps(&csv);
-    assert!(listed.starts_with(&before), "{before:?} vs {listed:?}");
-    (out, listed)
-}
-
-#[test]
-fn run_killed_midway_keeps_every_completed_step() {
-    let (out, listed) = interrupted_run("fault-sigkill", |child| {
-        let ranks = rank_pids(child.id());
-        assert_eq!(ranks.len(), 2, "rank processes of mpirun: {ranks:?}");
-        signal(ranks[1], "-KILL");
-    });
-    assert_file_holds(&out, &listed);
-}
-
-#[test]
-fn run_terminated_keeps_every_completed_step() {
-    let (out, listed) = interrupted_run("fault-sigterm", |child| signal(child.id(), "-TERM"));
-    assert_file_holds(&out, &listed);
 }

@@ -7,6 +7,7 @@ pub mod options;
 pub mod reason;
 pub mod scatter;
 pub mod schur;
+pub mod signals;
 pub mod snes;
 pub mod sys;
 pub mod vector;

@@ -192,6 +192,7 @@ impl<'m> Simulation<'m> {
         };
         while steps.done < 1.0 - 1e-12 {
             steps.attempt(sink)?;
+            steps.stop_if_signalled()?;
         }
         steps.finish(started)
     }
@@ -427,6 +428,22 @@ impl LoadSteps<'_> {
 
     /// Collective: a converged step advances the predictor and the time
     /// stepper, goes to the sink, and its contact state is committed.
+    /// Collective, at a step boundary: if any rank received SIGTERM or
+    /// SIGINT, every rank ends the run here (the signal reaches the ranks at
+    /// different moments, so each asks all the others).
+    fn stop_if_signalled(&self) -> Result<()> {
+        let local = crate::petsc::signals::received().unwrap_or(0);
+        let [signal] = parallel::max(&self.world, [f64::from(local)]);
+        if signal > 0.0 {
+            return Err(Error::Stopped {
+                signal: signal as i32,
+                step: self.first_step + self.reports.len(),
+                load_factor: self.done,
+            });
+        }
+        Ok(())
+    }
+
     fn accept(
         &mut self,
         sink: &mut dyn StepSink,
