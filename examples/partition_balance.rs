@@ -10,6 +10,10 @@
 //! ```
 //!
 //! RANKS defaults to 2, RADIUS (of the zone counted, around the axis) to 1.3.
+//! It runs serially (the partition is computed where the mesh is, as rank 0
+//! does) and exits with status 1 when the largest rank's owned nodes or
+//! Jacobian blocks exceed the mean by more than 5 %: the bulk work and the
+//! solve's `MatMult` then wait for that rank.
 use contactlink::mesh::generate::{hertz_sphere, HertzSphereSpec};
 use contactlink::mesh::{FacetRef, Mesh};
 use std::collections::BTreeSet;
@@ -81,6 +85,15 @@ fn run(ranks: usize, radius: f64) -> Result<(), String> {
     println!("  slave facets ({slave}) {slaves:?}");
     println!("  slave facets within {radius} of the axis {slave_zone:?}");
     println!("  master facets (block.top) within {radius} of the axis {master_zone:?}");
+    for (what, per_rank) in [("owned nodes", &nodes), ("Jacobian blocks", &blocks)] {
+        let mean = per_rank.iter().sum::<usize>() as f64 / ranks as f64;
+        let largest = per_rank.iter().copied().max().unwrap_or(0);
+        if largest as f64 > 1.05 * mean {
+            return Err(format!(
+                "{what} per rank {per_rank:?}: the largest more than 5 % above the mean"
+            ));
+        }
+    }
     Ok(())
 }
 
