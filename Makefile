@@ -116,10 +116,14 @@ work-precision: build
 	$(PYTHON) scripts/work_precision.py --scene hertz-sphere --np $(NP) --repeats 3 \
 	  --sizes 0.7,0.5 --penalties 0.1,1,10 --tols 1e-2,1e-3
 
-# Strong (152k DOFs on the iterative path, 1/2 ranks, 4 oversubscribed for
-# correctness) and weak scaling of the Hertz line contact, with the halo
-# volume and the peak memory per rank; ends with the 2-rank efficiency
-# T1/(2·T2) and memory lines (medians of 3 runs).
+# Strong scaling on the iterative path: hertz-sphere (167k DOFs, GMRES +
+# GAMG) on 1 and 2 ranks, and the plain elastic solve of the same mesh (the
+# machine's ceiling); one table with the Newton/Uzawa/KSP counts, solve and
+# CPU seconds, T1/(P·TP), peak memory of the largest and smallest rank, work
+# per rank and halo, then the time per phase and the headline lines (medians
+# of 3 runs, 1 and 2 ranks alternating; a few minutes on a quiet 2-core
+# machine). `python3 scripts/scaling.py --help` for the direct-path case and
+# the 4-rank run.
 scaling: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/scaling.py --repeats 3
