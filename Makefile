@@ -130,8 +130,10 @@ scaling: build
 
 # Peak memory per rank (largest, smallest) against the ranks: set-up only of a
 # 1.28M-DOF mesh on 1, 2, 4, 8 ranks and a 167k-DOF plain elastic solve on
-# 1, 2, 4, with each phase's resident memory and the ratios to 1 rank against
-# the targets (about 5 minutes on 2 cores; the 8-rank set-up needs ~3 GB).
+# 1, 2, 4; per rank count the largest and smallest rank's peak, their ratios
+# to 1 rank, the largest peak less file-backed (library) pages, each phase's
+# resident memory and the ratios against the targets (about 5 minutes on 2
+# cores; the 8-rank set-up needs ~3 GB).
 memory: build
 	@mkdir -p bench-results
 	$(PYTHON) scripts/memory.py --mpirun "$(MPIRUN)"

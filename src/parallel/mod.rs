@@ -8,7 +8,8 @@
 //! result on every rank, carrying the lowest failing rank's message, and
 //! [`any_rank`], [`all_ranks`], [`sum`] and [`max`] are the reductions the
 //! run loop steers by; [`gather_all`] concatenates every rank's slice on
-//! every rank ([`gather_equal`] when all slices have one length), and
+//! every rank ([`gather_equal`] when all slices have one length,
+//! [`gather_root`] on rank 0 only), and
 //! [`all_to_all`] sends each rank its own array; [`from_root`] hands the
 //! outcome of work only one rank does (success or error) to every rank.
 //! [`fault`] makes one rank fail on purpose (tests only).
@@ -23,5 +24,5 @@ pub use agree::{
     RankFailure,
 };
 pub use exchange::all_to_all;
-pub use gather::{gather_all, gather_equal};
+pub use gather::{gather_all, gather_equal, gather_root};
 pub use relay::from_root;

@@ -582,8 +582,8 @@ impl LoadSteps<'_> {
         parallel::agree(&self.world, values)
     }
 
-    /// Collective: the run's report, with the final displacement on every
-    /// rank and the phase times and halo volumes over the ranks.
+    /// Collective: the run's report, with the final displacement on rank 0
+    /// and the phase times and halo volumes over the ranks.
     fn finish(self, started: Instant) -> Result<RunReport> {
         let LoadSteps {
             world,
@@ -596,8 +596,7 @@ impl LoadSteps<'_> {
             ..
         } = self;
         let dofs = mech.dofs;
-        let mut natural = NaturalOrder::nodal(dofs)?;
-        let displacement = natural.gather_all(&x)?;
+        let displacement = NaturalOrder::nodal(dofs)?.gather_root(&x)?;
         Ok(RunReport {
             steps: reports,
             global_dofs: DIM * dofs.num_global_nodes(),

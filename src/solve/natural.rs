@@ -94,12 +94,15 @@ impl NaturalOrder {
         Ok((self.block.start, data))
     }
 
-    /// The whole field in natural order on every rank (for tests and small
-    /// post-processing; O(N) memory per rank). Collective.
-    pub fn gather_all(&mut self, v: &Vector) -> Result<Vec<f64>> {
-        self.scatter.forward(v, &mut self.target)?;
-        let (to_all, mut all) = Scatter::to_all(&self.target)?;
-        to_all.forward(&self.target, &mut all)?;
-        Ok(all.with_array(|a| a.to_vec())?)
+    /// The whole field in natural order on rank 0, empty on the other ranks
+    /// (the run report's final displacement: O(N) memory on rank 0 only,
+    /// which receives the natural-order blocks straight into the result).
+    /// Collective.
+    pub fn gather_root(mut self, v: &Vector) -> Result<Vec<f64>> {
+        let (_, block) = self.block_of(v)?;
+        // This rank's block is all it needs from here on.
+        drop(self);
+        let world = mpi::topology::SimpleCommunicator::world();
+        Ok(crate::parallel::gather_root(&world, block))
     }
 }

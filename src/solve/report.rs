@@ -58,7 +58,9 @@ pub struct RunReport {
     pub steps: Vec<StepReport>,
     pub global_dofs: usize,
     pub wall_seconds: f64,
-    /// Final displacement in natural node order, on every rank (N×3 flat).
+    /// Final displacement in natural node order (N×3 flat) on rank 0; empty
+    /// on the other ranks, so that no rank but 0 holds an array of the
+    /// global node count.
     pub displacement: Vec<f64>,
     pub bulk_tangent_assemblies: usize,
     pub pattern_builds: usize,
