@@ -79,8 +79,9 @@ impl PatternBuilder {
         let mut raw: sys::Mat = std::ptr::null_mut();
         // SAFETY: the preallocator (several ranks) is assembled before use;
         // the new matrix has the same sizes; out-pointer valid. On one rank
-        // the compressed rows hold `n + 1` offsets into `cols` (sorted,
-        // distinct, in range) and `zeros` as many values; PETSc copies them.
+        // `lengths` holds one row length per row and `cols` their sum of
+        // column indices, sorted and distinct per row and in range, which
+        // is what MatSeqAIJSetColumnIndices needs; PETSc copies both.
         unsafe {
             if serial.is_none() {
                 final_assembly(self.raw)?;
@@ -98,14 +99,14 @@ impl PatternBuilder {
             petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
             match serial {
                 Some(p) => {
-                    let (offsets, cols) = p.compressed_rows()?;
-                    let zeros = vec![0.0; cols.len()];
-                    petsc_call!(MatSeqAIJSetPreallocationCSR(
-                        raw,
-                        offsets.as_ptr(),
-                        cols.as_ptr(),
-                        zeros.as_ptr()
-                    ))?;
+                    // Exact row lengths, then the column indices in one copy
+                    // (MatSeqAIJSetPreallocationCSR would insert them entry
+                    // by entry), then explicit zeros.
+                    let (lengths, mut cols) = p.compressed_rows()?;
+                    petsc_call!(MatSeqAIJSetPreallocation(raw, 0, lengths.as_ptr()))?;
+                    petsc_call!(MatSeqAIJSetColumnIndices(raw, cols.as_mut_ptr()))?;
+                    final_assembly(raw)?;
+                    petsc_call!(MatZeroEntries(raw))?;
                 }
                 None => petsc_call!(MatPreallocatorPreallocate(
                     self.raw,
@@ -185,14 +186,17 @@ impl SerialPattern {
     fn whole_nodes(&mut self, dofs: &[PetscInt]) -> Result<bool> {
         let bs = self.bs;
         self.scratch.clear();
-        if dofs.len() % bs != 0 || self.rows % bs != 0 {
+        if !dofs.len().is_multiple_of(bs) || !self.rows.is_multiple_of(bs) {
             return Ok(false);
         }
         for chunk in dofs.chunks_exact(bs) {
             let first = chunk[0];
             let whole = first >= 0
-                && first as usize % bs == 0
-                && chunk.iter().enumerate().all(|(c, &d)| d == first + c as PetscInt);
+                && (first as usize).is_multiple_of(bs)
+                && chunk
+                    .iter()
+                    .enumerate()
+                    .all(|(c, &d)| d == first + c as PetscInt);
             if !whole {
                 return Ok(false);
             }
@@ -233,21 +237,20 @@ impl SerialPattern {
         Ok(())
     }
 
-    /// Row offsets and sorted, distinct column indices of every row.
+    /// Row lengths and the sorted, distinct column indices of every row.
     fn compressed_rows(mut self) -> Result<(Vec<PetscInt>, Vec<PetscInt>)> {
         self.nodes.sort_unstable();
         self.nodes.dedup();
         self.entries.sort_unstable();
         self.entries.dedup();
         let bs = self.bs;
-        let mut offsets = Vec::with_capacity(self.rows + 1);
+        let mut lengths = Vec::with_capacity(self.rows);
         let mut cols: Vec<PetscInt> = Vec::with_capacity(self.nodes.len() * bs * bs);
-        offsets.push(0);
         let (mut ni, mut ei) = (0, 0);
         let mut row_nodes: &[(u32, u32)] = &[];
         let mut merged: Vec<PetscInt> = Vec::new();
         for row in 0..self.rows {
-            if row % bs == 0 {
+            if row.is_multiple_of(bs) {
                 let node = (row / bs) as u32;
                 let start = ni;
                 while ni < self.nodes.len() && self.nodes[ni].0 == node {
@@ -260,9 +263,9 @@ impl SerialPattern {
                 ei += 1;
             }
             let extra = &self.entries[start..ei];
-            let expanded = row_nodes.iter().flat_map(|&(_, m)| {
-                (0..bs).map(move |c| (m as usize * bs + c) as PetscInt)
-            });
+            let expanded = row_nodes
+                .iter()
+                .flat_map(|&(_, m)| (0..bs).map(move |c| (m as usize * bs + c) as PetscInt));
             if extra.is_empty() {
                 cols.extend(expanded);
             } else {
@@ -273,9 +276,13 @@ impl SerialPattern {
                 merged.dedup();
                 cols.extend_from_slice(&merged);
             }
-            offsets.push(to_petsc_int(cols.len())?);
+            lengths.push(to_petsc_int(cols.len())?);
         }
-        Ok((offsets, cols))
+        let mut last = 0;
+        for l in lengths.iter_mut() {
+            (*l, last) = (*l - last, *l);
+        }
+        Ok((lengths, cols))
     }
 }
 

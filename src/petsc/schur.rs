@@ -373,12 +373,7 @@ impl SchurPreconditioner {
             self.factor = None;
             let mut kd = self.k.duplicate()?;
             kd.zero_rows_columns_identity(&self.constrained)?;
-            self.factor = Some(SchurFactor::new(
-                &kd,
-                c,
-                &self.constrained,
-                self.cholesky,
-            )?);
+            self.factor = Some(SchurFactor::new(&kd, c, &self.constrained, self.cholesky)?);
             self.bulk_factorisations += 1;
         }
         let f = self
