@@ -25,6 +25,7 @@ For each size the script
   1. runs contactlink twice: the contact solve, and the plain elastic solve
      of the same mesh, materials, conditions and solver without the contact
      pair (one linear-elastic step, as benches/solve_costs.rs defines it);
+     on one rank (--np 1) the program is started directly, without mpirun;
   2. writes a CalculiX deck of the same mesh: the same nodes, C3D8 cells,
      element-face surfaces and boundary conditions, a penalty
      surface-to-surface contact pair with the linear pressure-overclosure
@@ -227,8 +228,12 @@ def children_cpu():
 
 
 def run_contactlink(a, scene, contact=True):
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(a.np),
-           a.bin, "run", scene, "-o", scene[:-5] + ".h5"] + a.extra
+    """One contactlink run: on one rank the program is started by itself (a
+    single MPI process needs no launcher, as ccx needs none), on more under
+    mpirun."""
+    launch = [] if a.np == 1 else ["mpirun", "--allow-run-as-root", "--oversubscribe",
+                                    "-n", str(a.np)]
+    cmd = launch + [a.bin, "run", scene, "-o", scene[:-5] + ".h5"] + a.extra
     t0, c0 = time.perf_counter(), children_cpu()
     p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
     wall, cpu = time.perf_counter() - t0, children_cpu() - c0

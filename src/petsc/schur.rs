@@ -4,12 +4,14 @@
 //!
 //! With C the contact candidate DOFs and I the rest, MUMPS factors K_II
 //! and returns S0 = K_CC − K_CI K_II⁻¹ K_IC (dense). A Jacobian J = K + Kc
-//! has the Schur complement S0 + Kc_CC = (S0 − K_CC) + J_CC, so each new
-//! Jacobian costs a dense factorisation of |C|² entries instead of a sparse
-//! one of the whole matrix; MatSolve on the MUMPS factor then condenses the
+//! has the Schur complement S0 + Kc_CC, so each new contact tangent Kc
+//! costs a dense factorisation of |C|² entries instead of a sparse one of
+//! the whole matrix; MatSolve on the MUMPS factor then condenses the
 //! right-hand side on C, solves with the dense factors held in the factor
-//! matrix, and expands back. PETSc supports Schur complements of MUMPS on
-//! one process only.
+//! matrix, and expands back. The preconditioner is set up from Kc alone
+//! (the operator SNES hands it holds only the contact tangent; K is in the
+//! factor), so nothing of the size of K is copied per Jacobian. PETSc
+//! supports Schur complements of MUMPS on one process only.
 use super::{petsc_call, sys, Matrix, PetscError, PetscInt, Result, Vector};
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -19,14 +21,22 @@ pub struct SchurFactor {
     factor: sys::Mat,
     is: sys::IS,
     c: Vec<PetscInt>,
-    /// S0 − K_CC, column-major |C| × |C|, both triangles.
+    /// Whether the DOF at each position of `c` is constrained (its row and
+    /// column are the identity's in the factored K).
+    fixed: Vec<bool>,
+    /// S0, column-major |C| × |C|, both triangles.
     base: Vec<f64>,
 }
 
-/// Dense column-major |C| × |C| copy of a (square, sequential) sparse
-/// submatrix `m`'s values added into `out`, scaled by `a`.
-fn add_sparse_dense(m: sys::Mat, n: usize, a: f64, out: &mut [f64]) -> Result<()> {
+/// A (square, sequential) sparse submatrix `m`'s values added into the
+/// dense column-major |C| × |C| `out`, except in the rows and columns
+/// `fixed` marks.
+fn add_sparse_dense(m: sys::Mat, fixed: &[bool], out: &mut [f64]) -> Result<()> {
+    let n = fixed.len();
     for row in 0..n {
+        if fixed[row] {
+            continue;
+        }
         let mut nz: PetscInt = 0;
         let mut cols: *const PetscInt = std::ptr::null();
         let mut vals: *const f64 = std::ptr::null();
@@ -39,7 +49,9 @@ fn add_sparse_dense(m: sys::Mat, n: usize, a: f64, out: &mut [f64]) -> Result<()
                 let cs = std::slice::from_raw_parts(cols, nz as usize);
                 let vs = std::slice::from_raw_parts(vals, nz as usize);
                 for (&c, &v) in cs.iter().zip(vs) {
-                    out[c as usize * n + row] += a * v;
+                    if !fixed[c as usize] {
+                        out[c as usize * n + row] += v;
+                    }
                 }
             }
             petsc_call!(MatRestoreRow(
@@ -63,10 +75,16 @@ fn error(call: &'static str, message: String) -> PetscError {
 }
 
 impl SchurFactor {
-    /// Factors `k` (assembled, sequential, Dirichlet rows and columns
-    /// replaced by the identity) with the Schur complement on the sorted,
-    /// distinct DOFs `c`: LDLᵀ when `cholesky`, else LU.
-    pub fn new(k: &Matrix, c: Vec<PetscInt>, cholesky: bool) -> Result<Self> {
+    /// Factors `k` (assembled, sequential, the rows and columns of the
+    /// sorted DOFs `constrained` replaced by the identity) with the Schur
+    /// complement on the sorted, distinct DOFs `c`: LDLᵀ when `cholesky`,
+    /// else LU.
+    pub fn new(
+        k: &Matrix,
+        c: Vec<PetscInt>,
+        constrained: &[PetscInt],
+        cholesky: bool,
+    ) -> Result<Self> {
         if c.is_empty() || c.windows(2).any(|w| w[0] >= w[1]) {
             return Err(error(
                 "SchurFactor::new",
@@ -74,10 +92,15 @@ impl SchurFactor {
             ));
         }
         let n = c.len();
+        let fixed = c
+            .iter()
+            .map(|d| constrained.binary_search(d).is_ok())
+            .collect();
         let mut me = SchurFactor {
             factor: std::ptr::null_mut(),
             is: std::ptr::null_mut(),
             c,
+            fixed,
             base: vec![0.0; n * n],
         };
         let kind = if cholesky {
@@ -86,12 +109,11 @@ impl SchurFactor {
             sys::MatFactorType_MAT_FACTOR_LU
         };
         let mut s0: sys::Mat = std::ptr::null_mut();
-        let mut kcc: sys::Mat = std::ptr::null_mut();
         // SAFETY: `k` is a valid assembled matrix; the factor and the index
         // set are owned by `me` (destroyed in Drop, also on an early error);
         // `me.c` outlives the IS (PETSC_COPY_VALUES copies it anyway). The
-        // Schur copy `s0` and the submatrix `kcc` are destroyed below on
-        // every path; their arrays are read only while they live.
+        // Schur copy `s0` is destroyed below on every path; its array is
+        // read only while it lives.
         unsafe {
             petsc_call!(ISCreateGeneral(
                 super::comm_world(),
@@ -143,19 +165,10 @@ impl SchurFactor {
                 if cholesky {
                     symmetrise(&mut me.base, n);
                 }
-                petsc_call!(MatCreateSubMatrix(
-                    k.raw(),
-                    me.is,
-                    me.is,
-                    sys::MatReuse_MAT_INITIAL_MATRIX,
-                    &mut kcc
-                ))?;
                 Ok(())
             })();
             sys::MatDestroy(&mut s0);
-            let sub = read.and_then(|()| add_sparse_dense(kcc, n, -1.0, &mut me.base));
-            sys::MatDestroy(&mut kcc);
-            sub?;
+            read?;
         }
         Ok(me)
     }
@@ -180,16 +193,18 @@ impl SchurFactor {
         &self.c
     }
 
-    /// Sets the dense Schur complement to that of `j` (which must equal the
-    /// factored K outside C × C) and factors it.
-    pub fn update(&mut self, j: &Matrix) -> Result<()> {
+    /// Sets the dense Schur complement to that of K + `kc` and factors it:
+    /// `kc` is the contact tangent alone (non-zero only in C × C; its
+    /// entries in constrained rows and columns are ignored, as the
+    /// Jacobian's Dirichlet replacement would drop them).
+    pub fn update(&mut self, kc: &Matrix) -> Result<()> {
         let n = self.c.len();
         let mut jcc: sys::Mat = std::ptr::null_mut();
         let mut s: sys::Mat = std::ptr::null_mut();
         let mut status: sys::MatFactorSchurStatus = 0;
         let mut dense = self.base.clone();
         // SAFETY: valid factor with a Schur complement of size n (set in
-        // `new`) and valid index set; `j` is a valid assembled matrix of the
+        // `new`) and valid index set; `kc` is a valid assembled matrix of the
         // factored size. The submatrix is destroyed on every path. The Schur
         // matrix is the factor's own (borrowed between Get and Restore); its
         // array holds n × n column-major values and is written only between
@@ -197,13 +212,13 @@ impl SchurFactor {
         // its old dense factors, so the factorisation that follows is fresh.
         unsafe {
             petsc_call!(MatCreateSubMatrix(
-                j.raw(),
+                kc.raw(),
                 self.is,
                 self.is,
                 sys::MatReuse_MAT_INITIAL_MATRIX,
                 &mut jcc
             ))?;
-            let added = add_sparse_dense(jcc, n, 1.0, &mut dense);
+            let added = add_sparse_dense(jcc, &self.fixed, &mut dense);
             sys::MatDestroy(&mut jcc);
             added?;
             petsc_call!(MatFactorGetSchurComplement(
@@ -235,7 +250,9 @@ impl SchurFactor {
         Ok(())
     }
 
-    /// x = (K + Kc)⁻¹ b with the Kc of the last [`Self::update`].
+    /// x = (K + Kc)⁻¹ b with the Kc of the last [`Self::update`] (K with
+    /// its Dirichlet replacement, Kc without the constrained rows and
+    /// columns).
     pub fn solve(&self, b: &Vector, x: &mut Vector) -> Result<()> {
         // SAFETY: valid factor, its Schur complement set and factored by
         // `update` (MatSolve factors it first otherwise); vectors of the
@@ -302,9 +319,12 @@ pub struct SchurPreconditioner {
 
 impl SchurPreconditioner {
     /// `k`: the linear bulk stiffness; `constrained`: the rows and columns
-    /// the Jacobian has replaced by the identity (K is factored with the same
-    /// replacement, made on a copy that lives only while it is factored).
-    pub fn new(k: Matrix, constrained: Vec<PetscInt>, cholesky: bool) -> Self {
+    /// the Jacobian replaces by the identity (K is factored with the same
+    /// replacement, made on a copy that lives only while it is factored,
+    /// and the contact tangent's entries there are dropped).
+    pub fn new(k: Matrix, mut constrained: Vec<PetscInt>, cholesky: bool) -> Self {
+        constrained.sort_unstable();
+        constrained.dedup();
         SchurPreconditioner {
             k,
             constrained,
@@ -331,8 +351,9 @@ impl SchurPreconditioner {
         self.factor.as_ref().map_or(0, |f| f.dofs().len())
     }
 
-    /// Set-up for the Jacobian `j`: K factored again only when C must grow.
-    pub fn set_up(&mut self, j: &Matrix) -> Result<()> {
+    /// Set-up for the Jacobian K + `kc`, from the contact tangent `kc`
+    /// alone: K factored again only when C must grow.
+    pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
         let grow = match &self.factor {
             None => true,
             Some(f) => !is_subset(&self.wanted, f.dofs()),
@@ -352,14 +373,14 @@ impl SchurPreconditioner {
             self.factor = None;
             let mut kd = self.k.duplicate()?;
             kd.zero_rows_columns_identity(&self.constrained)?;
-            self.factor = Some(SchurFactor::new(&kd, c, self.cholesky)?);
+            self.factor = Some(SchurFactor::new(&kd, c, &self.constrained, self.cholesky)?);
             self.bulk_factorisations += 1;
         }
         let f = self
             .factor
             .as_mut()
             .ok_or_else(|| error("SchurPreconditioner::set_up", "no factor".into()))?;
-        f.update(j)?;
+        f.update(kc)?;
         self.schur_factorisations += 1;
         Ok(())
     }
@@ -443,8 +464,10 @@ unsafe extern "C" fn set_up_trampoline(pc: sys::PC) -> sys::PetscErrorCode {
     let r = catch_unwind(AssertUnwindSafe(|| {
         got?;
         // SAFETY: the preconditioning matrix is valid during the set-up.
-        let j = unsafe { Matrix::borrowed(p) };
-        state.set_up(&j)
+        // On this path it holds the contact tangent alone (see
+        // `solve::mechanics`).
+        let kc = unsafe { Matrix::borrowed(p) };
+        state.set_up(&kc)
     }));
     code_of(r, Some(state))
 }

@@ -40,7 +40,10 @@ pub struct Mechanics<'a> {
     pub lag: Option<PreconditionerLag>,
     /// Rebuild the preconditioner at every Jacobian (the contact Schur
     /// path, where a rebuild is a small dense factorisation): each linear
-    /// solve is then exact.
+    /// solve is then exact. Set exactly when the Schur preconditioner is
+    /// installed, so the Jacobian matrix then holds only the contact
+    /// tangent: K is in the preconditioner's factor, and nothing else
+    /// reads the operator (the linear solve is the preconditioner alone).
     pub always_rebuild: bool,
     stages: Stages,
     /// The callbacks agree their outcome over these ranks (PETSc's world).
@@ -345,6 +348,9 @@ impl<'a> Mechanics<'a> {
         if let Some(LinearStiffness::Shared(_)) = self.linear_k {
             return self.shared_jacobian(j);
         }
+        if self.always_rebuild {
+            return self.contact_jacobian(x, j);
+        }
         self.load_state(x)?;
         self.stages.time(Phase::BulkAssembly, &mut self.times, || {
             stiffness_on_pattern(&self.linear_k, &mut self.k_on_pattern, j)
@@ -410,6 +416,34 @@ impl<'a> Mechanics<'a> {
             j.zero_rows_columns_identity(&rows)?;
             Ok(())
         })?;
+        local
+    }
+
+    /// The contact Schur path's operator: the contact tangent alone, on the
+    /// Jacobian's pattern, without the Dirichlet replacement (the
+    /// preconditioner drops constrained rows and columns itself). Collective
+    /// like [`Self::jacobian_impl`].
+    fn contact_jacobian(&mut self, x: &Vector, j: &mut Matrix) -> Result<()> {
+        self.load_state(x)?;
+        let (dofs, factor) = (self.dofs, self.factor);
+        let (stages, times) = (self.stages, &mut self.times);
+        let (u, u_tail, contact) = (&self.u, &self.u_tail, &mut *self.contact);
+        stages.time(Phase::BulkAssembly, times, || j.zero_entries())?;
+        let local = stages.time(Phase::ContactAssembly, times, || {
+            u.with_local(|u_local| -> Result<()> {
+                fault::check(FaultPhase::Jacobian)?;
+                fault::check(FaultPhase::ContactAssembly)?;
+                let u_ext = extended(u_local, u_tail);
+                for pair in contact.iter_mut() {
+                    pair.add_tangent(dofs, &u_ext, factor, j)?;
+                }
+                Ok(())
+            })?
+        });
+        if fault::fires(FaultPhase::LinearSolve) {
+            poison_diagonal(dofs, self.dirichlet, j)?;
+        }
+        stages.time(Phase::BulkAssembly, times, || j.assemble())?;
         local
     }
 
