@@ -24,6 +24,7 @@
 //!   `pair_restart`: taking them over from a result file.
 pub mod friction;
 pub mod geometry;
+mod halo;
 mod main_part;
 pub mod pair;
 mod pair_output;

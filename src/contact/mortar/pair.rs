@@ -1,27 +1,26 @@
 //! A mortar contact pair at run time: candidate segments per load step,
 //! residual and tangent contributions, the nodal Uzawa update.
 //!
-//! Parallel layout. Both sides' nodes are ghosted on every rank (the slave
-//! set joins the master halo). A rank assembles the segments of the slave
-//! facets whose cell it owns, and evaluates in addition every slave facet
-//! that shares a node with one of those, so the weighted gap `g̃_j` of each
-//! node of its own facets is complete. Segments are integrated in a fixed
-//! order (slave facet, then master facet, by set index) from the same ghosted
-//! positions, so every rank that sees node `j` computes the same `g̃_j` and
-//! the same update of `λ_j` bit for bit; the owner of the node is the one
-//! that counts it in the Uzawa statistics and writes it out.
+//! Parallel layout: see `halo`. A rank holds the slave facets of its own
+//! cells (assembled here) and the other ranks' facets around their nodes
+//! (evaluated only, so each node's weighted gap is complete), and the
+//! master facets near its slave nodes. Segments are integrated in a fixed
+//! order (slave facet, then master facet, by set index), so every rank
+//! that holds node `j` computes the same `g̃_j` and the same update of
+//! `λ_j` bit for bit; the owner of the node is the one that counts it in
+//! the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
+use super::halo::Holding;
 use super::rigid_master::RigidMaster;
 use super::rows::{signature, Rows};
 use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeState, Segment};
 use super::tangential::PairFriction;
-use crate::assembly::{MatrixSink, PatternSink};
+use crate::assembly::{MatrixSink, PatternSink, RankExchange};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::UzawaStats;
-use crate::contact::surfaces::SharedSurface;
 use crate::distribution::LocalMesh;
-use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
+use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
 use crate::model::{FrictionSpec, PairSpec, RigidSurface};
@@ -62,13 +61,19 @@ pub(super) struct Evaluation<T> {
 
 pub struct MortarPair {
     pub(super) facet_type: FacetType,
-    /// Slave nodes are ids `0..n`, master nodes follow (n = slave nodes).
+    /// Slave nodes are ids `0..n_slave`, held master nodes follow.
+    pub(super) n_slave: usize,
+    /// Per node id: its slot in the extended local array (a local node,
+    /// or past them a tail slot), global DOFs and reference position.
     pub(super) node_local: Vec<u32>,
+    pub(super) node_dofs: Vec<[GlobalDof; DIM]>,
     pub(super) x_ref: Vec<[f64; 3]>,
     pub(super) slave_facets: Vec<[u32; MAX_FACET_NODES]>,
+    /// Per slave facet: its position in the slave set.
+    pub(super) slave_set_index: Vec<u32>,
     pub(super) master_facets: Vec<[u32; MAX_FACET_NODES]>,
     pub(super) assembled: Vec<bool>,
-    /// Slave facets this rank evaluates (ascending).
+    /// Slave facets this rank evaluates (ascending): all it holds.
     pub(super) evaluated: Vec<u32>,
     pub nodal: NodalData,
     /// Per slot: all of the node's facets are evaluated here ...
@@ -82,11 +87,20 @@ pub struct MortarPair {
     pub(super) rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
     pub(super) owned_mesh_nodes: usize,
+    /// Owned nodes on either surface (local index, reference position).
+    pub(super) owned_pair_nodes: Vec<(u32, [f64; 3])>,
     pub(super) friction: Option<PairFriction>,
     /// A rigid analytic master instead of master facets (none then).
     pub(super) rigid: Option<RigidMaster>,
     /// Every pair node's natural (file) number, for restarts.
     pub(super) natural: Vec<usize>,
+    /// The master facets held and the tail (see `halo`).
+    pub(super) holding: Holding,
+    /// The rows of [`MortarPair::restart_nodes`].
+    pub(super) restart_rows: Vec<usize>,
+    /// A restart's slip origins of the owned pair nodes, until the first
+    /// step after it has converged.
+    pub(super) pending_origins: Option<Vec<[f64; 3]>>,
 }
 
 /// The master side of a mortar pair.
@@ -114,45 +128,81 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
 }
 
 impl MortarPair {
-    /// `master`: the master facet set or rigid surface; `penalty(h)`: the
-    /// pair's εN for a node of element size `h`; `friction`: the pair's
-    /// Coulomb friction, if it computes any (μ > 0).
+    /// `master`: the master facet set or rigid surface, and the ranks its
+    /// set-up exchanges with (collective); `penalty(h)`: the pair's εN for a
+    /// node of element size `h`; `friction`: the pair's Coulomb friction, if
+    /// it computes any (μ > 0).
     pub fn new(
         mesh: &LocalMesh,
         dofs: &DofMap,
         spec: &PairSpec,
-        master: MortarMaster,
+        (master, ranks): (MortarMaster, &dyn RankExchange),
         penalty: impl Fn(f64) -> f64,
         search_distance: f64,
         friction: Option<FrictionSpec>,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
-        let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
-        let (master, rigid) = match master {
-            MortarMaster::Facets(set) => (Some(SharedSurface::new(mesh, dofs, set)?), None),
+        let nf = facet_type.nodes();
+        let (master_set, rigid) = match master {
+            MortarMaster::Facets(set) => (Some(set), None),
             MortarMaster::Rigid(r) => (None, Some(r)),
         };
-        let n_slave = slave.x_ref.len();
-        let offset = n_slave as u32;
-        let nf = facet_type.nodes();
-        let slave_facets: Vec<_> = slave.facets.iter().map(|f| facet_row(&f[..nf])).collect();
-        let master_facets: Vec<_> = master
+        let share = super::halo::slave_share(mesh, dofs, &spec.slave, master_set, ranks)?;
+        // Slave node ids in natural order.
+        let mut nodes: Vec<(u64, [GlobalDof; DIM], [f64; 3])> = share
+            .facets
             .iter()
-            .flat_map(|m| &m.facets)
-            .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
+            .flat_map(|f| {
+                (0..nf).map(move |a| {
+                    let d = [0, 1, 2].map(|c| f.dofs[DIM * a + c]);
+                    (f.natural[a], d, f.x_ref[a])
+                })
+            })
             .collect();
-        let assembled: Vec<bool> = mesh.shared.get(&spec.slave).map_or(Vec::new(), |s| {
-            s.cells.iter().map(|&c| dofs.is_local_cell(c)).collect()
-        });
+        nodes.sort_by_key(|v| v.0);
+        nodes.dedup_by_key(|v| v.0);
+        let n_slave = nodes.len();
+        let id_of = |v: u64| nodes.binary_search_by_key(&v, |e| e.0).unwrap_or(0) as u32;
+        let slave_facets: Vec<_> = share
+            .facets
+            .iter()
+            .map(|f| {
+                facet_row(
+                    &f.natural[..nf]
+                        .iter()
+                        .map(|&v| id_of(v))
+                        .collect::<Vec<_>>(),
+                )
+            })
+            .collect();
+        let slave_set_index = share.facets.iter().map(|f| f.set_index).collect();
+        let assembled = share.assembled;
+        let local: Vec<Option<LocalNode>> = nodes
+            .iter()
+            .map(|v| dofs.local(NaturalNode(v.0 as usize)))
+            .collect();
+        let n_local = dofs.num_local_nodes();
+        let mut slave_tail = Vec::new();
+        let node_local: Vec<u32> = local
+            .iter()
+            .enumerate()
+            .map(|(id, l)| match l {
+                Some(l) => l.to_u32(),
+                None => {
+                    slave_tail.push(id as u32);
+                    (n_local + slave_tail.len() - 1) as u32
+                }
+            })
+            .collect();
+        let x_ref: Vec<[f64; 3]> = nodes.iter().map(|v| v.2).collect();
         // A rank evaluates the nodes of its own facets and the slave nodes
         // it owns: the owner of a node (the lowest rank among the cells
         // holding it) may hold none of its slave facets (a tet touching the
         // surface at that node only), yet it is the one that writes the
-        // node's fields. The surface is whole on every rank, so it can.
-        let mut mine: Vec<bool> = slave
-            .node_local
+        // node's fields.
+        let mut mine: Vec<bool> = local
             .iter()
-            .map(|&l| dofs.is_owned(LocalNode::from_u32(l)))
+            .map(|l| l.is_some_and(|l| dofs.is_owned(l)))
             .collect();
         for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
             for &n in &f[..nf] {
@@ -176,7 +226,7 @@ impl MortarPair {
         let mut in_evaluated = vec![false; n_slave];
         for &f in &evaluated {
             let nodes = &slave_facets[f as usize][..nf];
-            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| slave.x_ref[n as usize]).collect();
+            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| x_ref[n as usize]).collect();
             let weights = crate::contact::kernel::reference_weights(facet_type, &x, &rule);
             let h = shortest_edge(&x);
             for (zeta, w) in weights {
@@ -201,9 +251,7 @@ impl MortarPair {
         let complete = slots.iter().map(|&n| mine[n as usize]).collect();
         let owned = slots
             .iter()
-            .map(|&n| {
-                mine[n as usize] && dofs.is_owned(LocalNode::from_u32(slave.node_local[n as usize]))
-            })
+            .map(|&n| mine[n as usize] && local[n as usize].is_some_and(|l| dofs.is_owned(l)))
             .collect();
         let nodal = NodalData::new(
             slots.clone(),
@@ -216,28 +264,33 @@ impl MortarPair {
                 "contact",
                 format!(
                     "pair '{}': slave node {} has no contact area",
-                    spec.name, slots[bad]
+                    spec.name, nodes[slots[bad] as usize].0
                 ),
             ));
         }
-        let mut node_local = slave.node_local;
         let rigid = rigid.map(|r| RigidMaster::new(r, spec, &slots, &h_count));
-        let mut x_ref = slave.x_ref;
-        if let Some(m) = &master {
-            node_local.extend(&m.node_local);
-            x_ref.extend(&m.x_ref);
-        }
-        let natural = node_local
+        let natural: Vec<usize> = nodes.iter().map(|v| v.0 as usize).collect();
+        let restart_rows = natural
             .iter()
-            .map(|&l| dofs.natural(LocalNode::from_u32(l)).0)
+            .copied()
+            .chain(
+                share
+                    .owned_pair_nodes
+                    .iter()
+                    .map(|&(l, _)| dofs.natural(LocalNode::from_u32(l)).0),
+            )
             .collect();
+        let node_dofs = nodes.iter().map(|v| v.1).collect();
         let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
             facet_type,
+            n_slave,
             node_local,
+            node_dofs,
             x_ref,
             slave_facets,
-            master_facets,
+            slave_set_index,
+            master_facets: Vec::new(),
             assembled,
             evaluated,
             nodal,
@@ -248,10 +301,30 @@ impl MortarPair {
             search_distance,
             rules: MortarRules::default(),
             owned_mesh_nodes: dofs.num_owned_nodes(),
+            owned_pair_nodes: share.owned_pair_nodes,
             friction,
             rigid,
             natural,
+            holding: Holding {
+                slave_tail,
+                ..Holding::default()
+            },
+            restart_rows,
+            pending_origins: None,
         })
+    }
+
+    /// Current position of node `id` (its slot must be in `u_local`).
+    pub(super) fn position(&self, id: u32, u_local: &[f64]) -> [f64; 3] {
+        let (x, b) = (
+            self.x_ref[id as usize],
+            DIM * self.node_local[id as usize] as usize,
+        );
+        [
+            x[0] + u_local[b],
+            x[1] + u_local[b + 1],
+            x[2] + u_local[b + 2],
+        ]
     }
 
     pub(super) fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
@@ -322,7 +395,19 @@ impl MortarPair {
             found.sort_unstable();
             candidates.extend(found.into_iter().map(|m| (s, m)));
         }
-        let changed = candidates != self.candidates;
+        // Compared by set index: the held master's numbering changes
+        // with each exchange.
+        let key: Vec<(u32, u32)> = candidates
+            .iter()
+            .map(|&(s, m)| {
+                (
+                    self.slave_set_index[s as usize],
+                    self.holding.master_set_index[m as usize],
+                )
+            })
+            .collect();
+        let changed = key != self.holding.candidate_key;
+        self.holding.candidate_key = key;
         self.candidates = candidates;
         changed
     }
@@ -331,8 +416,8 @@ impl MortarPair {
         DIM * self.node_local[id as usize] as usize + c
     }
 
-    pub(super) fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
-        dofs.dof(LocalNode::from_u32(self.node_local[id as usize]), c)
+    pub(super) fn global_dof(&self, _dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
+        self.node_dofs[id as usize][c]
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
@@ -615,6 +700,7 @@ impl MortarPair {
 
     /// A converged step is final: the next one measures slip from here.
     pub fn commit(&mut self) {
+        self.pending_origins = None;
         if let Some(f) = &mut self.friction {
             f.start.clone_from(&f.last);
         }
