@@ -28,7 +28,7 @@ impl StepSink for Discard {
 /// contact, so the contact zone spans the ranks that hold slave facets.
 /// After the run, every rank holds fewer master facets than the whole
 /// master and at least two ranks hold some (one rank: all of them), and the
-/// contact force is the one rank's to 1e-10.
+/// contact force is the uniform stress's, E ε A.
 pub fn a_mortar_pair_holds_only_the_master_near_its_slave_facets(
     rt: &Runtime,
 ) -> Result<(), String> {

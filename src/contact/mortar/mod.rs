@@ -29,6 +29,7 @@ mod main_part;
 pub mod pair;
 mod pair_output;
 pub mod pair_restart;
+mod pair_setup;
 pub mod rigid;
 pub mod rigid_friction;
 mod rigid_master;
