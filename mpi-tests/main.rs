@@ -17,6 +17,7 @@ use mpi::traits::*;
 use std::process::ExitCode;
 
 mod lagging;
+mod mortar_halo;
 mod rank0;
 
 type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
@@ -71,6 +72,10 @@ const CASES: &[Case] = &[
     (
         "the_watch_rebuilds_factors_on_a_change_and_amg_once_worn",
         lagging::the_watch_rebuilds_factors_on_a_change_and_amg_once_worn,
+    ),
+    (
+        "a_mortar_pair_holds_only_the_master_near_its_slave_facets",
+        mortar_halo::a_mortar_pair_holds_only_the_master_near_its_slave_facets,
     ),
 ];
 

@@ -282,6 +282,11 @@ impl HeldMaster {
             .map(|i| i as u32)
     }
 
+    /// Natural ids of the held nodes (ascending).
+    pub fn natural_ids(&self) -> &[u64] {
+        &self.natural
+    }
+
     /// Tail nodes (held nodes this rank does not see).
     pub fn tail_nodes(&self) -> usize {
         self.tail_dofs.len() / DIM

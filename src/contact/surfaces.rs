@@ -1,15 +1,12 @@
-//! The two sides of a contact pair as one rank sees them.
+//! The slave side of a contact pair as one rank sees it.
 //!
 //! Slave facets belong to the rank that owns their cell; that rank evaluates
-//! their links. Master facets (of a deformable master) are known to every rank:
-//! their nodes are ghosted on every rank (the master halo), so each rank
-//! searches and evaluates its own slave points without further messages.
+//! their links. The master facets a rank holds are `held_master`'s.
 use super::kernel::reference_weights;
 use crate::distribution::{LocalFacetSet, LocalMesh, SlaveSetPiece};
-use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
+use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, FacetType, QuadRule};
-use crate::mesh::Mesh;
 
 /// A slave facet this rank evaluates.
 #[derive(Debug, Clone)]
@@ -131,99 +128,6 @@ impl SlaveSurface {
     }
 }
 
-/// A facet set every rank sees in full (its nodes are ghosted on every
-/// rank): the master of a deformable pair, and both sides of a mortar pair.
-/// Every facet of the set, with its nodes numbered compactly (0..n) for the
-/// search, and their local indices.
-#[derive(Debug, Clone)]
-pub struct SharedSurface {
-    pub facet_type: FacetType,
-    /// Local node index (owned or ghost) of each master node.
-    pub node_local: Vec<u32>,
-    pub x_ref: Vec<[f64; 3]>,
-    /// Facets as indices into the master node arrays (tri3 uses 3).
-    pub facets: Vec<[u32; 4]>,
-}
-
-impl SharedSurface {
-    /// The natural ids of the master nodes, which every rank must ghost.
-    pub fn natural_nodes(mesh: &Mesh, set: &str) -> Result<Vec<usize>> {
-        let known = || mesh.facet_sets.keys().map(String::as_str).collect();
-        let facets = mesh
-            .facet_sets
-            .get(set)
-            .ok_or_else(|| unknown_set(set, known()))?;
-        let mut nodes: Vec<usize> = Vec::new();
-        for f in facets {
-            nodes.extend(mesh.facet_nodes(f)?);
-        }
-        nodes.sort_unstable();
-        nodes.dedup();
-        Ok(nodes)
-    }
-
-    /// The whole set as every rank received it (`mesh.shared`); its nodes
-    /// are ghosted on every rank, so their coordinates are local.
-    pub fn new(mesh: &LocalMesh, dofs: &DofMap, set: &str) -> Result<Self> {
-        let shared = mesh
-            .shared
-            .get(set)
-            .ok_or_else(|| unknown_set(set, mesh.facet_set_names()))?;
-        let nf = mesh.cell_type.facet_type().nodes();
-        let mut natural = shared.nodes.clone();
-        natural.sort_unstable();
-        natural.dedup();
-        let node_local = natural
-            .iter()
-            .map(|&v| local_node(dofs, v))
-            .collect::<Result<Vec<_>>>()?;
-        let x_ref = node_local
-            .iter()
-            .map(|&l| mesh.nodes[LocalNode::from_u32(l).index()])
-            .collect();
-        let mut facets = Vec::new();
-        for facet in shared.nodes.chunks_exact(nf) {
-            let mut ids = [0u32; 4];
-            for (slot, &v) in ids.iter_mut().zip(facet) {
-                // `natural` is sorted, so the compact index is a binary search away.
-                *slot = natural
-                    .binary_search(&v)
-                    .map_err(|_| Error::Partition(format!("master node {v} missing")))?
-                    as u32;
-            }
-            facets.push(ids);
-        }
-        Ok(SharedSurface {
-            facet_type: mesh.cell_type.facet_type(),
-            node_local,
-            x_ref,
-            facets,
-        })
-    }
-
-    /// Current positions of all master nodes.
-    pub fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
-        let mut out = vec![[0.0; 3]; self.x_ref.len()];
-        current_positions(&self.node_local, &self.x_ref, u_local, &mut out);
-        out
-    }
-
-    /// Local node of surface node `m` (an index into `node_local`).
-    pub fn local_node(&self, m: u32) -> LocalNode {
-        LocalNode::from_u32(self.node_local[m as usize])
-    }
-
-    pub fn facet_nodes(&self, facet: u32) -> &[u32] {
-        &self.facets[facet as usize][..self.facet_type.nodes()]
-    }
-
-    pub fn facet_dofs(&self, facet: u32, dofs: &DofMap, out: &mut Vec<GlobalDof>) {
-        for &m in self.facet_nodes(facet) {
-            out.extend(dofs.node_dofs(self.local_node(m)));
-        }
-    }
-}
-
 fn shortest_edge(x: &[[f64; 3]]) -> f64 {
     (0..x.len())
         .map(|i| {
@@ -259,15 +163,4 @@ fn unknown_set(set: &str, known: Vec<&str>) -> Error {
             known.join(", ")
         ),
     )
-}
-
-fn local_node(dofs: &DofMap, natural: usize) -> Result<u32> {
-    dofs.local(NaturalNode(natural))
-        .map(LocalNode::to_u32)
-        .ok_or_else(|| {
-            Error::Partition(format!(
-                "node {natural} is not visible on rank {}",
-                dofs.rank
-            ))
-        })
 }

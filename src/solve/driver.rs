@@ -292,10 +292,37 @@ impl LoadSteps<'_> {
     fn search_contact(&mut self, target: f64) -> Result<()> {
         if !self.mech.contact.is_empty() {
             let mark = PhaseMark::new(&self.mech.times, self.mech.contact);
-            let (mech, x) = (&mut self.mech, &self.x);
+            let (mech, x, x_prev) = (&mut self.mech, &self.x, &self.x_prev);
             let offset = self.stepper.as_ref().map(|s| s.slip_offset());
             let searched = self.stages.scope(Phase::ContactSearch, || {
                 mech.exchange_masters(x)?;
+                // The pairs are the same on every rank: so is this choice.
+                if mech.contact.iter().any(|p| p.starts_slip_from_committed()) {
+                    // `x_prev`: the last converged state, with a restart's
+                    // slip origins at the owned nodes until its first step
+                    // has converged.
+                    let mut committed = x_prev.duplicate()?;
+                    committed.copy_from(x_prev)?;
+                    let dofs = mech.dofs;
+                    let start = dofs.owned_dof_start();
+                    let origins: Vec<_> = mech
+                        .contact
+                        .iter()
+                        .flat_map(|p| p.committed_origins())
+                        .collect();
+                    committed.with_array_mut(|a| {
+                        for (l, d) in &origins {
+                            let l = crate::dofs::LocalNode::from_u32(*l);
+                            for (c, v) in d.iter().enumerate() {
+                                a[dofs.dof(l, c).0 as usize - start] = *v;
+                            }
+                        }
+                    })?;
+                    mech.with_state(&committed, |u, pairs| {
+                        pairs.iter_mut().for_each(|p| p.start_slip_from(u));
+                        Ok(())
+                    })?;
+                }
                 if let Some(offset) = offset {
                     mech.extend_slip_rates(offset)?;
                 }

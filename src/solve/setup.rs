@@ -14,7 +14,6 @@ use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::fem::Material;
 use crate::mesh::Mesh;
-use crate::model::MasterSpec;
 use crate::model::{Model, SolverSettings};
 use crate::parallel;
 use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
@@ -168,18 +167,12 @@ pub(super) struct SetUp {
 pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<SetUp> {
     let world = rt.world();
     crate::footprint::checkpoint("model build");
-    // Mortar pairs see both their surfaces whole on every rank; a links
-    // pair's master is exchanged at each search (`contact::held_master`).
-    // Their nodes are only read where the mesh is, on rank 0 (`distribute`
-    // reads `wanted` there only): the other ranks may hold no mesh at all.
-    let master_nodes = match world.rank() {
-        0 => mortar_nodes(model, &mesh),
-        _ => Ok(Vec::new()),
-    };
-    let master_nodes = parallel::agree(&world, master_nodes)?;
+    // Contact pairs hold the master facets near their slave side,
+    // exchanged at the searches (`contact::held_master`): no node is
+    // ghosted beyond the cells' own.
     let slave_sets: Vec<String> = model.contact.iter().map(|p| p.slave.clone()).collect();
     let wanted = distribution::Wanted {
-        extra_ghosts: &master_nodes,
+        extra_ghosts: &[],
         slave_sets: &slave_sets,
     };
     let mut piece = distribution::distribute(&world, &mesh, &wanted)?;
@@ -187,7 +180,6 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
     // run) is freed before the element data and the Jacobian are allocated.
     let owned = matches!(mesh, Cow::Owned(_));
     drop(mesh);
-    drop(master_nodes);
     if owned {
         crate::footprint::checkpoint("pieces cut, global mesh freed");
     }
@@ -253,27 +245,6 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
         contact,
         jac,
     })
-}
-
-/// The natural nodes of every mortar pair's surfaces, which every rank must
-/// see (read from the global mesh).
-fn mortar_nodes(model: &Model, mesh: &Mesh) -> Result<Vec<usize>> {
-    let mut nodes = Vec::new();
-    for pair in &model.contact {
-        if pair.formulation != crate::model::Formulation::Mortar {
-            continue;
-        }
-        if let MasterSpec::Surface { set } = &pair.master {
-            nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-                mesh, set,
-            )?);
-        }
-        nodes.extend(crate::contact::surfaces::SharedSurface::natural_nodes(
-            mesh,
-            &pair.slave,
-        )?);
-    }
-    Ok(nodes)
 }
 
 /// The Jacobian's storage for the current contact couplings: bulk cells,

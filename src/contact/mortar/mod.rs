@@ -9,6 +9,9 @@
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
+//!   `pair_setup` builds it on a rank, `halo` decides what the rank holds
+//!   (its slave facets and those around their nodes, the master facets
+//!   near them) and numbers the nodes it does not see;
 //! - `main_part`: the tangent without the derivatives of `D`, `M`, `ν`
 //!   (the first Uzawa iteration from no contact);
 //! - `rows`: the tangent as the solver gets it (entries merged into matrix
@@ -24,10 +27,12 @@
 //!   `pair_restart`: taking them over from a result file.
 pub mod friction;
 pub mod geometry;
+mod halo;
 mod main_part;
 pub mod pair;
 mod pair_output;
 pub mod pair_restart;
+mod pair_setup;
 pub mod rigid;
 pub mod rigid_friction;
 mod rigid_master;

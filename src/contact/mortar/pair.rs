@@ -1,16 +1,16 @@
 //! A mortar contact pair at run time: candidate segments per load step,
 //! residual and tangent contributions, the nodal Uzawa update.
 //!
-//! Parallel layout. Both sides' nodes are ghosted on every rank (the slave
-//! set joins the master halo). A rank assembles the segments of the slave
-//! facets whose cell it owns, and evaluates in addition every slave facet
-//! that shares a node with one of those, so the weighted gap `g̃_j` of each
-//! node of its own facets is complete. Segments are integrated in a fixed
-//! order (slave facet, then master facet, by set index) from the same ghosted
-//! positions, so every rank that sees node `j` computes the same `g̃_j` and
-//! the same update of `λ_j` bit for bit; the owner of the node is the one
-//! that counts it in the Uzawa statistics and writes it out.
+//! Parallel layout: see `halo`. A rank holds the slave facets of its own
+//! cells (assembled here) and the other ranks' facets around their nodes
+//! (evaluated only, so each node's weighted gap is complete), and the
+//! master facets near its slave nodes. Segments are integrated in a fixed
+//! order (slave facet, then master facet, by set index), so every rank
+//! that holds node `j` computes the same `g̃_j` and the same update of
+//! `λ_j` bit for bit; the owner of the node is the one that counts it in
+//! the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
+use super::halo::Holding;
 use super::rigid_master::RigidMaster;
 use super::rows::{signature, Rows};
 use super::segment::MortarRules;
@@ -19,12 +19,10 @@ use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::dual::Dual;
 use crate::contact::outcome::UzawaStats;
-use crate::contact::surfaces::SharedSurface;
-use crate::distribution::LocalMesh;
-use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
-use crate::error::{Error, Result};
-use crate::fem::{shape::facet_shape, FacetType, QuadRule, MAX_FACET_NODES};
-use crate::model::{FrictionSpec, PairSpec, RigidSurface};
+use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::error::Result;
+use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::model::RigidSurface;
 
 /// The nodal fields the output writes, one entry per owned mesh node of
 /// this rank (zero at nodes off the slave surface).
@@ -62,13 +60,19 @@ pub(super) struct Evaluation<T> {
 
 pub struct MortarPair {
     pub(super) facet_type: FacetType,
-    /// Slave nodes are ids `0..n`, master nodes follow (n = slave nodes).
+    /// Slave nodes are ids `0..n_slave`, held master nodes follow.
+    pub(super) n_slave: usize,
+    /// Per node id: its slot in the extended local array (a local node,
+    /// or past them a tail slot), global DOFs and reference position.
     pub(super) node_local: Vec<u32>,
+    pub(super) node_dofs: Vec<[GlobalDof; DIM]>,
     pub(super) x_ref: Vec<[f64; 3]>,
     pub(super) slave_facets: Vec<[u32; MAX_FACET_NODES]>,
+    /// Per slave facet: its position in the slave set.
+    pub(super) slave_set_index: Vec<u32>,
     pub(super) master_facets: Vec<[u32; MAX_FACET_NODES]>,
     pub(super) assembled: Vec<bool>,
-    /// Slave facets this rank evaluates (ascending).
+    /// Slave facets this rank evaluates (ascending): all it holds.
     pub(super) evaluated: Vec<u32>,
     pub nodal: NodalData,
     /// Per slot: all of the node's facets are evaluated here ...
@@ -82,11 +86,20 @@ pub struct MortarPair {
     pub(super) rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
     pub(super) owned_mesh_nodes: usize,
+    /// Owned nodes on either surface (local index, reference position).
+    pub(super) owned_pair_nodes: Vec<(u32, [f64; 3])>,
     pub(super) friction: Option<PairFriction>,
     /// A rigid analytic master instead of master facets (none then).
     pub(super) rigid: Option<RigidMaster>,
     /// Every pair node's natural (file) number, for restarts.
     pub(super) natural: Vec<usize>,
+    /// The master facets held and the tail (see `halo`).
+    pub(super) holding: Holding,
+    /// The rows of [`MortarPair::restart_nodes`].
+    pub(super) restart_rows: Vec<usize>,
+    /// A restart's slip origins of the owned pair nodes, until the first
+    /// step after it has converged.
+    pub(super) pending_origins: Option<Vec<[f64; 3]>>,
 }
 
 /// The master side of a mortar pair.
@@ -98,160 +111,18 @@ pub enum MortarMaster<'a> {
     Rigid(RigidSurface),
 }
 
-fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
-    let mut row = [0; MAX_FACET_NODES];
-    row[..nodes.len()].copy_from_slice(nodes);
-    row
-}
-
-/// Shortest edge of a facet.
-fn shortest_edge(x: &[[f64; 3]]) -> f64 {
-    (0..x.len())
-        .map(|i| {
-            crate::contact::dual::norm(&crate::contact::dual::sub(&x[i], &x[(i + 1) % x.len()]))
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 impl MortarPair {
-    /// `master`: the master facet set or rigid surface; `penalty(h)`: the
-    /// pair's εN for a node of element size `h`; `friction`: the pair's
-    /// Coulomb friction, if it computes any (μ > 0).
-    pub fn new(
-        mesh: &LocalMesh,
-        dofs: &DofMap,
-        spec: &PairSpec,
-        master: MortarMaster,
-        penalty: impl Fn(f64) -> f64,
-        search_distance: f64,
-        friction: Option<FrictionSpec>,
-    ) -> Result<Self> {
-        let facet_type = mesh.cell_type.facet_type();
-        let slave = SharedSurface::new(mesh, dofs, &spec.slave)?;
-        let (master, rigid) = match master {
-            MortarMaster::Facets(set) => (Some(SharedSurface::new(mesh, dofs, set)?), None),
-            MortarMaster::Rigid(r) => (None, Some(r)),
-        };
-        let n_slave = slave.x_ref.len();
-        let offset = n_slave as u32;
-        let nf = facet_type.nodes();
-        let slave_facets: Vec<_> = slave.facets.iter().map(|f| facet_row(&f[..nf])).collect();
-        let master_facets: Vec<_> = master
-            .iter()
-            .flat_map(|m| &m.facets)
-            .map(|f| facet_row(&f[..nf].iter().map(|&n| n + offset).collect::<Vec<_>>()))
-            .collect();
-        let assembled: Vec<bool> = mesh.shared.get(&spec.slave).map_or(Vec::new(), |s| {
-            s.cells.iter().map(|&c| dofs.is_local_cell(c)).collect()
-        });
-        // A rank evaluates the nodes of its own facets and the slave nodes
-        // it owns: the owner of a node (the lowest rank among the cells
-        // holding it) may hold none of its slave facets (a tet touching the
-        // surface at that node only), yet it is the one that writes the
-        // node's fields. The surface is whole on every rank, so it can.
-        let mut mine: Vec<bool> = slave
-            .node_local
-            .iter()
-            .map(|&l| dofs.is_owned(LocalNode::from_u32(l)))
-            .collect();
-        for (f, _) in slave_facets.iter().zip(&assembled).filter(|(_, a)| **a) {
-            for &n in &f[..nf] {
-                mine[n as usize] = true;
-            }
-        }
-        let evaluated: Vec<u32> = (0..slave_facets.len() as u32)
-            .filter(|&f| {
-                slave_facets[f as usize][..nf]
-                    .iter()
-                    .any(|&n| mine[n as usize])
-            })
-            .collect();
-        // Nodal reference areas ∫ N_j dA₀ and element sizes.
-        let rule = QuadRule::default_for_facet(facet_type);
-        let (mut area, mut h_sum, mut h_count) = (
-            vec![0.0; n_slave],
-            vec![0.0; n_slave],
-            vec![0usize; n_slave],
+    /// Current position of node `id` (its slot must be in `u_local`).
+    pub(super) fn position(&self, id: u32, u_local: &[f64]) -> [f64; 3] {
+        let (x, b) = (
+            self.x_ref[id as usize],
+            DIM * self.node_local[id as usize] as usize,
         );
-        let mut in_evaluated = vec![false; n_slave];
-        for &f in &evaluated {
-            let nodes = &slave_facets[f as usize][..nf];
-            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| slave.x_ref[n as usize]).collect();
-            let weights = crate::contact::kernel::reference_weights(facet_type, &x, &rule);
-            let h = shortest_edge(&x);
-            for (zeta, w) in weights {
-                let s = facet_shape(facet_type, zeta);
-                for (a, &n) in nodes.iter().enumerate() {
-                    area[n as usize] += s.n[a] * w;
-                }
-            }
-            for &n in nodes {
-                h_sum[n as usize] += h;
-                h_count[n as usize] += 1;
-                in_evaluated[n as usize] = true;
-            }
-        }
-        let slots: Vec<u32> = (0..n_slave as u32)
-            .filter(|&n| in_evaluated[n as usize])
-            .collect();
-        let h: Vec<f64> = slots
-            .iter()
-            .map(|&n| h_sum[n as usize] / h_count[n as usize] as f64)
-            .collect();
-        let complete = slots.iter().map(|&n| mine[n as usize]).collect();
-        let owned = slots
-            .iter()
-            .map(|&n| {
-                mine[n as usize] && dofs.is_owned(LocalNode::from_u32(slave.node_local[n as usize]))
-            })
-            .collect();
-        let nodal = NodalData::new(
-            slots.clone(),
-            vec![0.0; slots.len()],
-            h.iter().map(|&h| penalty(h)).collect(),
-            slots.iter().map(|&n| area[n as usize]).collect(),
-        );
-        if let Some(bad) = nodal.area.iter().position(|a| a.is_nan() || *a <= 0.0) {
-            return Err(Error::scene(
-                "contact",
-                format!(
-                    "pair '{}': slave node {} has no contact area",
-                    spec.name, slots[bad]
-                ),
-            ));
-        }
-        let mut node_local = slave.node_local;
-        let rigid = rigid.map(|r| RigidMaster::new(r, spec, &slots, &h_count));
-        let mut x_ref = slave.x_ref;
-        if let Some(m) = &master {
-            node_local.extend(&m.node_local);
-            x_ref.extend(&m.x_ref);
-        }
-        let natural = node_local
-            .iter()
-            .map(|&l| dofs.natural(LocalNode::from_u32(l)).0)
-            .collect();
-        let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
-        Ok(MortarPair {
-            facet_type,
-            node_local,
-            x_ref,
-            slave_facets,
-            master_facets,
-            assembled,
-            evaluated,
-            nodal,
-            complete,
-            owned,
-            h,
-            candidates: Vec::new(),
-            search_distance,
-            rules: MortarRules::default(),
-            owned_mesh_nodes: dofs.num_owned_nodes(),
-            friction,
-            rigid,
-            natural,
-        })
+        [
+            x[0] + u_local[b],
+            x[1] + u_local[b + 1],
+            x[2] + u_local[b + 2],
+        ]
     }
 
     pub(super) fn positions(&self, u_local: &[f64]) -> Vec<[f64; 3]> {
@@ -322,7 +193,19 @@ impl MortarPair {
             found.sort_unstable();
             candidates.extend(found.into_iter().map(|m| (s, m)));
         }
-        let changed = candidates != self.candidates;
+        // Compared by set index: the held master's numbering changes
+        // with each exchange.
+        let key: Vec<(u32, u32)> = candidates
+            .iter()
+            .map(|&(s, m)| {
+                (
+                    self.slave_set_index[s as usize],
+                    self.holding.master_set_index[m as usize],
+                )
+            })
+            .collect();
+        let changed = key != self.holding.candidate_key;
+        self.holding.candidate_key = key;
         self.candidates = candidates;
         changed
     }
@@ -331,8 +214,8 @@ impl MortarPair {
         DIM * self.node_local[id as usize] as usize + c
     }
 
-    pub(super) fn global_dof(&self, dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
-        dofs.dof(LocalNode::from_u32(self.node_local[id as usize]), c)
+    pub(super) fn global_dof(&self, _dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
+        self.node_dofs[id as usize][c]
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
@@ -615,6 +498,7 @@ impl MortarPair {
 
     /// A converged step is final: the next one measures slip from here.
     pub fn commit(&mut self) {
+        self.pending_origins = None;
         if let Some(f) = &mut self.friction {
             f.start.clone_from(&f.last);
         }

@@ -83,11 +83,14 @@ impl MortarPair {
             weighted_gap: vec![0.0; n],
             traction: vec![[0.0; 3]; n],
             lambda_t: self.friction.as_ref().map(|_| vec![[0.0; 3]; n]),
-            slip_origin: self.friction.as_ref().map(|f| {
+            // Every owned node of either surface (held here or not): where
+            // it was at the last Uzawa update, the state written.
+            slip_origin: self.friction.as_ref().map(|_| {
                 let mut origin = vec![[0.0; 3]; n];
-                for (&l, x) in self.node_local.iter().zip(&f.last) {
+                for &(l, x) in &self.owned_pair_nodes {
                     if let Some(o) = origin.get_mut(l as usize) {
-                        *o = *x;
+                        let u = crate::dofs::LocalNode::from_u32(l).value(u_local);
+                        *o = [x[0] + u[0], x[1] + u[1], x[2] + u[2]];
                     }
                 }
                 origin

@@ -17,10 +17,11 @@ pub struct MortarRows {
 }
 
 impl MortarPair {
-    /// The natural (file) rows a restart reads: every node of the pair this
-    /// rank holds, in pair node order.
+    /// The natural (file) rows a restart reads: the slave nodes this rank
+    /// holds (in id order), then its owned nodes of either surface (whose
+    /// slip origins it hands on, see [`MortarPair::committed_origins`]).
     pub fn restart_nodes(&self) -> &[usize] {
-        &self.natural
+        &self.restart_rows
     }
 
     /// Whether a restart reads λT and the slip origins.
@@ -31,7 +32,6 @@ impl MortarPair {
     /// Takes over `rows` as the end of a converged step (then committed, as
     /// the step end did). On a mismatch, says which dataset does not fit.
     pub fn restart(&mut self, rows: &MortarRows) -> Result<(), &'static str> {
-        let nodes = self.natural.len();
         let slots: Vec<usize> = self.nodal.nodes.iter().map(|&id| id as usize).collect();
         let lambda = slots
             .iter()
@@ -39,6 +39,7 @@ impl MortarPair {
             .collect::<Option<Vec<f64>>>()
             .filter(|l| l.iter().all(|v| v.is_finite() && *v >= 0.0))
             .ok_or("node_lambda")?;
+        let mut pending = None;
         if let Some(f) = &mut self.friction {
             let lambda_t = rows.lambda_t.as_ref().ok_or("node_lambda_t")?;
             let origin = rows.slip_origin.as_ref().ok_or("node_slip_origin")?;
@@ -52,13 +53,36 @@ impl MortarPair {
                 .ok_or(what)
             };
             f.nodal.lambda = take(lambda_t, &mut slots.iter().copied(), "node_lambda_t")?;
-            f.last = take(origin, &mut (0..nodes), "node_slip_origin")?;
+            let owned = self.owned_pair_nodes.len();
+            let origins = take(
+                origin,
+                &mut (self.n_slave..self.n_slave + owned),
+                "node_slip_origin",
+            )?;
+            pending = Some(origins);
         }
         self.nodal.lambda = lambda;
         if let Some(r) = &mut self.rigid {
             r.last_factor = rows.load_factor;
         }
         self.commit();
+        self.pending_origins = pending;
         Ok(())
+    }
+
+    /// After a restart, until its first step has converged: the file's slip
+    /// origins of this rank's owned pair nodes, as displacements (local
+    /// node, origin − reference position). The solver writes them into the
+    /// committed state the search hands [`MortarPair::start_slip_from`],
+    /// so every rank holding a node measures from the file's origin.
+    pub fn committed_origins(&self) -> Vec<(u32, [f64; 3])> {
+        let Some(origins) = &self.pending_origins else {
+            return Vec::new();
+        };
+        self.owned_pair_nodes
+            .iter()
+            .zip(origins)
+            .map(|(&(l, x), o)| (l, [0, 1, 2].map(|c| o[c] - x[c])))
+            .collect()
     }
 }

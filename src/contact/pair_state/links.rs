@@ -44,8 +44,12 @@ impl ContactPair {
         tail_base: usize,
         ranks: &dyn RankExchange,
     ) -> usize {
-        if self.mortar.is_some() {
-            return 0;
+        if let Some(mortar) = &mut self.mortar {
+            let held = match &mut self.master {
+                MasterSide::Deformable(m) => Some(m.as_mut()),
+                MasterSide::Rigid(_) => None,
+            };
+            return mortar.exchange(held, u_local, dofs, tail_base, ranks);
         }
         let MasterSide::Deformable(m) = &mut self.master else {
             return 0;
@@ -72,27 +76,52 @@ impl ContactPair {
 
     /// Global DOFs of the held master nodes this rank does not see (the
     /// tail of the extended local array), node-major.
+    /// (A mortar pair's tail also holds the other ranks' slave nodes it
+    /// evaluates.)
     pub fn master_tail(&self) -> &[crate::dofs::GlobalDof] {
         match (&self.master, &self.mortar) {
+            (_, Some(m)) => m.tail_dofs(),
             (MasterSide::Deformable(m), None) => &m.tail_dofs,
             _ => &[],
         }
     }
 
     /// Master facets this rank holds now, and in the whole master (None:
-    /// rigid or mortar master).
+    /// rigid master).
     pub fn held_master_facets(&self) -> Option<(usize, usize)> {
-        match (&self.master, &self.mortar) {
-            (MasterSide::Deformable(m), None) => Some((m.set_index.len(), m.whole)),
-            _ => None,
+        match &self.master {
+            MasterSide::Deformable(m) => Some((m.set_index.len(), m.whole)),
+            MasterSide::Rigid(_) => None,
         }
     }
 
-    /// Facets received at the last exchange (None: rigid or mortar master).
+    /// Facets received at the last exchange (None: rigid master).
     pub fn received_master_facets(&self) -> Option<usize> {
-        match (&self.master, &self.mortar) {
-            (MasterSide::Deformable(m), None) => Some(m.received),
-            _ => None,
+        match &self.master {
+            MasterSide::Deformable(m) => Some(m.received),
+            MasterSide::Rigid(_) => None,
+        }
+    }
+
+    /// Whether the pair measures its slip from the committed state given to
+    /// [`ContactPair::start_slip_from`] (a frictional mortar pair).
+    pub fn starts_slip_from_committed(&self) -> bool {
+        self.mortar.as_ref().is_some_and(|m| m.restarts_friction())
+    }
+
+    /// See [`crate::contact::mortar::pair::MortarPair::committed_origins`].
+    pub fn committed_origins(&self) -> Vec<(u32, [f64; 3])> {
+        self.mortar
+            .as_ref()
+            .map_or_else(Vec::new, |m| m.committed_origins())
+    }
+
+    /// A frictional mortar pair: the step's slip is measured from
+    /// `u_committed` (the last converged state, extended like every local
+    /// array), set at the search once the held nodes are known.
+    pub fn start_slip_from(&mut self, u_committed: &[f64]) {
+        if let Some(m) = &mut self.mortar {
+            m.start_slip_from(u_committed);
         }
     }
 

@@ -105,8 +105,8 @@ impl ContactPair {
         let rule = spec.quadrature.rule(mesh.cell_type.facet_type());
         let slave = SlaveSurface::new(mesh, dofs, &spec.slave, slave_piece, &rule)?;
         let master = match &spec.master {
-            // A mortar pair searches its own replicated surfaces; it holds
-            // no exchanged facets, only the set-wide sizes from here.
+            // Both formulations hold the master facets near their slave
+            // side, exchanged by boxes (`contact::held_master`).
             MasterSpec::Surface { set } => {
                 MasterSide::Deformable(Box::new(HeldMaster::new(mesh, dofs, set, ranks)?))
             }
@@ -145,10 +145,13 @@ impl ContactPair {
                 mesh,
                 dofs,
                 spec,
-                match master {
-                    MasterSpec::Surface { set } => MortarMaster::Facets(set),
-                    MasterSpec::Rigid(r) => MortarMaster::Rigid(*r),
-                },
+                (
+                    match master {
+                        MasterSpec::Surface { set } => MortarMaster::Facets(set),
+                        MasterSpec::Rigid(r) => MortarMaster::Rigid(*r),
+                    },
+                    ranks,
+                ),
                 |h| spec.penalty.unwrap_or(10.0 * softest_youngs / h),
                 // Candidates are fixed for a step and every one widens the
                 // Jacobian pattern: one element size of margin, not the
