@@ -275,6 +275,45 @@ pub fn triangulate<T: Scalar>(poly: &Polygon<T>) -> impl Iterator<Item = Triangl
     })
 }
 
+/// Fan triangulation of a convex polygon from its first vertex: `n − 2`
+/// triangles, two on a quadrilateral overlap where [`triangulate`] makes
+/// four. Used where both facets map affinely onto the plane: the
+/// integrands are then polynomials the triangle rule integrates exactly on
+/// any triangulation (elsewhere its larger triangles leave a larger error:
+/// 3.3e-7 against 1.9e-8 on the 30 %-distorted patch test).
+pub fn triangulate_from_vertex<T: Scalar>(
+    poly: &Polygon<T>,
+) -> impl Iterator<Item = Triangle<T>> + '_ {
+    let p = poly.points();
+    let end = if p.len() >= 3 { p.len() - 1 } else { 1 };
+    (1..end).map(move |i| Triangle {
+        corners: [p[0], p[i], p[i + 1]],
+    })
+}
+
+/// Relative size of a projected quad's bilinear term (`x₀ − x₁ + x₂ − x₃`
+/// against its largest coordinate) under which its map counts as affine.
+/// Switching triangulations changes an integral by the rule's error on the
+/// non-affine part, here below 1e-10 of it.
+pub const AFFINE_TOL: f64 = 1e-9;
+
+/// Whether the projected facet is a parallelogram (or a triangle): its
+/// parametric map onto the plane is affine.
+fn is_affine<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>]) -> bool {
+    match facet {
+        FacetType::Tri3 => true,
+        FacetType::Quad4 => {
+            let c = |i: usize, k: usize| nodes[i][k].re();
+            let b = [0, 1].map(|k| c(0, k) - c(1, k) + c(2, k) - c(3, k));
+            let size = nodes[..4]
+                .iter()
+                .flat_map(|v| [v[0].re().abs(), v[1].re().abs()])
+                .fold(0.0, f64::max);
+            b[0].hypot(b[1]) <= AFFINE_TOL * size
+        }
+    }
+}
+
 /// Facet shape functions at a parametric point in `T` (bilinear quad,
 /// linear triangle), so a dual-valued point carries its derivative.
 pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
@@ -407,6 +446,8 @@ pub struct Overlap<T> {
     pub master_nodes: [Vec2<T>; MAX_FACET_NODES],
     /// The clipped polygon, counter-clockwise about the plane normal.
     pub polygon: Polygon<T>,
+    /// Both facets map affinely onto the plane (see [`is_affine`]).
+    pub affine: bool,
 }
 
 /// A quadrature point of an overlap: its weight (area in the plane) and its
@@ -455,11 +496,13 @@ pub fn overlap<T: Scalar>(
     if polygon.len < 3 || polygon.signed_area().re() <= area_tol {
         return None;
     }
+    let affine = is_affine(slave_type, &slave_nodes) && is_affine(master_type, &master_nodes);
     Some(Overlap {
         plane,
         slave_nodes,
         master_nodes,
         polygon,
+        affine,
     })
 }
 
@@ -475,7 +518,12 @@ impl<T: Scalar> Overlap<T> {
         rule: &[([f64; 2], f64)],
         mut f: impl FnMut(&SegmentPoint<T>),
     ) -> bool {
-        for tri in triangulate(&self.polygon) {
+        let triangles: &mut dyn Iterator<Item = Triangle<T>> = if self.affine {
+            &mut triangulate_from_vertex(&self.polygon)
+        } else {
+            &mut triangulate(&self.polygon)
+        };
+        for tri in triangles {
             let area = tri.area();
             for (xi_ref, w) in rule {
                 let p = tri.point(*xi_ref);

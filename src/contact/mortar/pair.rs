@@ -405,11 +405,13 @@ impl MortarPair {
                 .iter()
                 .any(|&n| self.nodal.slot_of(n).is_some_and(|j| states[j].closed))
         };
-        let live: Vec<(u32, u32)> = self
-            .candidates
+        // The overlaps the f64 pass found: the dual pass makes the same
+        // clipping decisions (on the values), so the rest would be clipped
+        // in dual numbers only to be dropped.
+        let live: Vec<(u32, u32)> = values
             .iter()
-            .copied()
-            .filter(|&(s, _)| closed(s))
+            .filter(|s| closed(s.slave))
+            .map(|s| (s.slave, s.master))
             .collect();
         let interface = Interface {
             candidates: &live,

@@ -136,7 +136,7 @@ fn seeded<T: Seed>(
 pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
     let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
     let mut out = Vec::new();
-    let mut cached: Option<(u32, [[T; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
+    let mut cached: Option<(u32, [[f64; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
     for &(s, m) in interface.candidates {
         let snodes = &interface.slave_facets[s as usize][..ns];
         let mnodes = &interface.master_facets[m as usize][..nm];
@@ -152,7 +152,6 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
             Some((f, a)) if f == s => a,
             _ => match dual_coefficients::<f64>(interface.slave_type, &x_ref[..ns], rules) {
                 Some(a) => {
-                    let a = a.map(|row| row.map(T::from_f64));
                     cached = Some((s, a));
                     a
                 }
@@ -346,9 +345,13 @@ pub fn tangent(
     // force coefficients c_j (rows).
     let mut grad: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
     let mut rows: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    // Σ_j p_j ∂c_j/∂x of one segment, summed over its nodes before it is
+    // emitted (a quarter of the entries a node-by-node emission made).
+    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
     for seg in segments {
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
+        let mut any = false;
         for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
             .iter()
             .enumerate()
@@ -371,20 +374,39 @@ pub fn tangent(
                 }
                 let c = force_coefficient(&seg.terms, a, v);
                 rows[j].push(((id, v % 3), c.re));
-                // p_j ∂c_j/∂x: local to the segment.
                 if p != 0.0 {
-                    for (w, d) in c.eps.iter().enumerate() {
-                        let col = ids[w / 3];
-                        if col != u32::MAX && *d != 0.0 {
-                            emit((id, v % 3), (col, w % 3), p * d);
-                        }
+                    any = true;
+                    for (l, d) in local[v].iter_mut().zip(&c.eps) {
+                        *l += p * d;
                     }
                 }
             }
         }
+        if any {
+            emit_local(&ids, &mut local, &mut emit);
+        }
     }
     // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
     emit_scaled_outer(nodal, -1.0, rows, grad, emit);
+}
+
+/// Emits a segment's dense block `local[v][w]` (segment variables, node ids
+/// `ids`) and clears it.
+pub(super) fn emit_local(
+    ids: &[u32; 2 * MAX_FACET_NODES],
+    local: &mut [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    for (v, row) in local.iter_mut().enumerate() {
+        let id = ids[v / 3];
+        for (w, x) in row.iter_mut().enumerate() {
+            let col = ids[w / 3];
+            if id != u32::MAX && col != u32::MAX && *x != 0.0 {
+                emit((id, v % 3), (col, w % 3), *x);
+            }
+            *x = 0.0;
+        }
+    }
 }
 
 /// Emits `sign (ε_j/A_j) r_j ⊗ g_j` for every node `j` with rows: `rows[j]`
