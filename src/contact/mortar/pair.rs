@@ -377,7 +377,7 @@ impl MortarPair {
         rate: Option<&Rate>,
     ) -> Evaluation<T> {
         let interface = self.interface(x);
-        let segments = system::segments::<T>(&interface, &self.rules);
+        let segments = T::segments(&self.nodal.cache, &interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
         self.with_friction(&interface, segments, states, x, u_local, rate)
@@ -396,7 +396,7 @@ impl MortarPair {
         rate: Option<&Rate>,
     ) -> Evaluation<Dual<{ system::SEGMENT_DOFS }>> {
         let interface = self.interface(x);
-        let values = system::segments::<f64>(&interface, &self.rules);
+        let values = self.nodal.cache.segments(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &values);
         let states = system::node_states(&self.nodal, &gap, &covered);
         let nf = self.facet_type.nodes();

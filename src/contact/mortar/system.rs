@@ -57,6 +57,56 @@ pub struct NodalData {
     pub penalty: Vec<f64>,
     pub area: Vec<f64>,
     slot: std::collections::HashMap<u32, usize>,
+    /// The f64 segments of the last evaluation (see [`SegmentCache`]).
+    pub cache: SegmentCache,
+}
+
+/// The f64 segments of the last positions they were integrated at. Newton
+/// asks for the residual and then the tangent at the same iterate, and the
+/// Uzawa update follows the last residual: the tangent's node states and
+/// the update reuse the residual's segments instead of clipping and
+/// integrating them again. Keyed by the positions and the candidates (all
+/// else an interface holds is fixed for a pair); a clone starts empty.
+#[derive(Default)]
+pub struct SegmentCache(std::sync::Mutex<Option<CachedSegments>>);
+
+struct CachedSegments {
+    positions: Vec<[f64; 3]>,
+    candidates: Vec<(u32, u32)>,
+    segments: Vec<Segment<f64>>,
+}
+
+impl SegmentCache {
+    /// `segments::<f64>` of the interface, from the cache when its
+    /// positions and candidates are those of the last call.
+    pub fn segments(&self, interface: &Interface, rules: &MortarRules) -> Vec<Segment<f64>> {
+        let mut last = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = last
+            .as_ref()
+            .filter(|c| c.positions == interface.positions && c.candidates == interface.candidates)
+        {
+            return c.segments.clone();
+        }
+        let segments = segments::<f64>(interface, rules);
+        *last = Some(CachedSegments {
+            positions: interface.positions.to_vec(),
+            candidates: interface.candidates.to_vec(),
+            segments: segments.clone(),
+        });
+        segments
+    }
+}
+
+impl Clone for SegmentCache {
+    fn clone(&self) -> Self {
+        SegmentCache::default()
+    }
+}
+
+impl std::fmt::Debug for SegmentCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SegmentCache")
+    }
 }
 
 impl NodalData {
@@ -68,6 +118,7 @@ impl NodalData {
             penalty,
             area,
             slot,
+            cache: SegmentCache::default(),
         }
     }
 
@@ -83,6 +134,15 @@ pub trait Seed: Scalar {
     /// Value `v` with derivative `slope` along variable `i` (an affine
     /// function of that variable, such as a slip increment).
     fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
+    /// [`segments`] in this type; f64 through the pair's cache.
+    fn segments(
+        cache: &SegmentCache,
+        interface: &Interface,
+        rules: &MortarRules,
+    ) -> Vec<Segment<Self>> {
+        let _ = cache;
+        segments(interface, rules)
+    }
 }
 
 impl Seed for f64 {
@@ -92,6 +152,14 @@ impl Seed for f64 {
 
     fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
         v
+    }
+
+    fn segments(
+        cache: &SegmentCache,
+        interface: &Interface,
+        rules: &MortarRules,
+    ) -> Vec<Segment<f64>> {
+        cache.segments(interface, rules)
     }
 }
 
