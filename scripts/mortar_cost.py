@@ -39,7 +39,8 @@ def run(exe, args, formulation):
     text = p.stdout + p.stderr
     done = re.search(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs.*?, ([\d.]+) s", text)
     solver = re.search(r"solver: (\d+) Uzawa iterations, (\d+) linear iterations, "
-                       r"preconditioner built (\d+) times", text)
+                       r"(?:preconditioner built (\d+) times|.*?Schur complement factored (\d+) time)",
+                       text)
     contact = re.search(r"contact assembly ([\d.]+) s", text)
     linear = re.search(r"linear solve ([\d.]+) s", text)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -50,7 +51,9 @@ def run(exe, args, formulation):
         # solver line.
         "uzawa": int(solver.group(1)) if solver else -1,
         "ksp": int(solver.group(2)) if solver else -1,
-        "builds": int(solver.group(3)) if solver else -1,
+        # Factorisations: of the preconditioner, or of the contact Schur
+        # complement on that path.
+        "builds": int(solver.group(3) or solver.group(4)) if solver else -1,
         "wall": float(done.group(4)),
         "cpu": cpu,
         "contact": float(contact.group(1)),

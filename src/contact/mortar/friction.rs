@@ -23,8 +23,8 @@
 //! segments' `Dual<24>` gives `∂tT_j/∂x`: the slip branch, the coupling to
 //! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
 use super::system::{
-    for_each_slave_node, merged, segment_nodes, Interface, NodalData, NodeDof, NodeState, Seed,
-    Segment,
+    emit_local, for_each_slave_node, merged, segment_nodes, Interface, NodalData, NodeDof,
+    NodeState, Seed, Segment, SEGMENT_DOFS,
 };
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
 use crate::fem::MAX_FACET_NODES;
@@ -279,9 +279,13 @@ pub fn tangent(
     // coefficients D_jk / −M_jl by node id.
     let mut grad: Vec<[Vec<(NodeDof, f64)>; 3]> = vec![Default::default(); nn];
     let mut coef: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    // Σ_j tT_j ∂c/∂x of one segment, summed over its nodes before it is
+    // emitted (rows 3 b + i: node slot b, component i of tT).
+    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
     for (seg, s) in segments.iter().zip(slips) {
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
+        let mut any = false;
         for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
             .iter()
             .enumerate()
@@ -321,19 +325,16 @@ pub fn tangent(
             for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
                 let c = coefficient(seg, a, b);
                 coef[j].push(((id, 0), c.re));
-                // tT_j ∂c/∂x: local to the segment.
-                for (w, d) in c.eps.iter().enumerate() {
-                    let col = ids[w / 3];
-                    if col == u32::MAX || *d == 0.0 {
-                        continue;
-                    }
-                    for (i, t) in f.traction.iter().enumerate() {
-                        if *t != 0.0 {
-                            emit((id, i), (col, w % 3), t * d);
-                        }
+                for (i, t) in f.traction.iter().enumerate().filter(|e| *e.1 != 0.0) {
+                    any = true;
+                    for (l, d) in local[3 * b + i].iter_mut().zip(&c.eps) {
+                        *l += t * d;
                     }
                 }
             }
+        }
+        if any {
+            emit_local(&ids, &mut local, &mut emit);
         }
     }
     // c ⊗ ∂tT_j/∂x.

@@ -275,6 +275,60 @@ pub fn triangulate<T: Scalar>(poly: &Polygon<T>) -> impl Iterator<Item = Triangl
     })
 }
 
+/// Fan triangulation of a convex polygon from its first vertex: `n − 2`
+/// triangles, two on a quadrilateral overlap where [`triangulate`] makes
+/// four. Used where both facets map affinely onto the plane: the
+/// integrands are then polynomials the triangle rule integrates exactly on
+/// any triangulation (elsewhere its larger triangles leave a larger error:
+/// 3.3e-7 against 1.9e-8 on the 30 %-distorted patch test).
+pub fn triangulate_from_vertex<T: Scalar>(
+    poly: &Polygon<T>,
+) -> impl Iterator<Item = Triangle<T>> + '_ {
+    let p = poly.points();
+    let end = if p.len() >= 3 { p.len() - 1 } else { 1 };
+    (1..end).map(move |i| Triangle {
+        corners: [p[0], p[i], p[i + 1]],
+    })
+}
+
+/// Relative size of a projected quad's bilinear term (`x₀ − x₁ + x₂ − x₃`
+/// against its largest coordinate) under which its map counts as affine.
+/// Switching triangulations changes an integral by the rule's error on the
+/// non-affine part, here below 1e-10 of it.
+pub const AFFINE_TOL: f64 = 1e-9;
+
+/// Relative size of the bilinear term under which the map is affine to
+/// rounding: one Newton step from anywhere is its inverse, value and
+/// derivative (the error is that term times the step squared).
+pub const EXACTLY_AFFINE_TOL: f64 = 1e-13;
+
+/// The relative size of a projected facet's bilinear term (zero for a
+/// triangle and a parallelogram: the parametric map onto the plane is
+/// then affine).
+fn bilinear_term<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>]) -> f64 {
+    match facet {
+        FacetType::Tri3 => 0.0,
+        FacetType::Quad4 => {
+            let c = |i: usize, k: usize| nodes[i][k].re();
+            let b = [0, 1].map(|k| c(0, k) - c(1, k) + c(2, k) - c(3, k));
+            let size = nodes[..4]
+                .iter()
+                .flat_map(|v| [v[0].re().abs(), v[1].re().abs()])
+                .fold(0.0, f64::max);
+            b[0].hypot(b[1]) / size
+        }
+    }
+}
+
+/// [`inverse_map`] of a facet whose map is affine to rounding: one Newton
+/// step in `T` from the facet centre.
+fn affine_inverse<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
+    let c = crate::contact::projection::reference_centre(facet);
+    let zeta = [T::from_f64(c[0]), T::from_f64(c[1])];
+    let step = newton_step(facet, nodes, p, zeta)?;
+    Some([zeta[0] + step[0], zeta[1] + step[1]])
+}
+
 /// Facet shape functions at a parametric point in `T` (bilinear quad,
 /// linear triangle), so a dual-valued point carries its derivative.
 pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
@@ -407,6 +461,9 @@ pub struct Overlap<T> {
     pub master_nodes: [Vec2<T>; MAX_FACET_NODES],
     /// The clipped polygon, counter-clockwise about the plane normal.
     pub polygon: Polygon<T>,
+    /// Relative bilinear terms of the projected slave and master facets
+    /// (zero: the facet maps affinely onto the plane).
+    pub bilinear: [f64; 2],
 }
 
 /// A quadrature point of an overlap: its weight (area in the plane) and its
@@ -455,11 +512,16 @@ pub fn overlap<T: Scalar>(
     if polygon.len < 3 || polygon.signed_area().re() <= area_tol {
         return None;
     }
+    let bilinear = [
+        bilinear_term(slave_type, &slave_nodes),
+        bilinear_term(master_type, &master_nodes),
+    ];
     Some(Overlap {
         plane,
         slave_nodes,
         master_nodes,
         polygon,
+        bilinear,
     })
 }
 
@@ -475,12 +537,25 @@ impl<T: Scalar> Overlap<T> {
         rule: &[([f64; 2], f64)],
         mut f: impl FnMut(&SegmentPoint<T>),
     ) -> bool {
-        for tri in triangulate(&self.polygon) {
+        let affine = self.bilinear[0].max(self.bilinear[1]) <= AFFINE_TOL;
+        let map = |facet, nodes: &[Vec2<T>], p: &Vec2<T>, bilinear: f64| {
+            if bilinear <= EXACTLY_AFFINE_TOL {
+                affine_inverse(facet, nodes, p)
+            } else {
+                inverse_map(facet, nodes, p)
+            }
+        };
+        let triangles: &mut dyn Iterator<Item = Triangle<T>> = if affine {
+            &mut triangulate_from_vertex(&self.polygon)
+        } else {
+            &mut triangulate(&self.polygon)
+        };
+        for tri in triangles {
             let area = tri.area();
             for (xi_ref, w) in rule {
                 let p = tri.point(*xi_ref);
-                let zeta = inverse_map(slave_type, &self.slave_nodes, &p);
-                let xi = inverse_map(master_type, &self.master_nodes, &p);
+                let zeta = map(slave_type, &self.slave_nodes, &p, self.bilinear[0]);
+                let xi = map(master_type, &self.master_nodes, &p, self.bilinear[1]);
                 let (Some(zeta), Some(xi)) = (zeta, xi) else {
                     return false;
                 };

@@ -260,7 +260,7 @@ impl MortarPair {
         rate: Option<&Rate>,
     ) -> Evaluation<T> {
         let interface = self.interface(x);
-        let segments = system::segments::<T>(&interface, &self.rules);
+        let segments = T::segments(&self.nodal.cache, &interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
         self.with_friction(&interface, segments, states, x, u_local, rate)
@@ -279,7 +279,7 @@ impl MortarPair {
         rate: Option<&Rate>,
     ) -> Evaluation<Dual<{ system::SEGMENT_DOFS }>> {
         let interface = self.interface(x);
-        let values = system::segments::<f64>(&interface, &self.rules);
+        let values = self.nodal.cache.segments(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &values);
         let states = system::node_states(&self.nodal, &gap, &covered);
         let nf = self.facet_type.nodes();
@@ -288,11 +288,13 @@ impl MortarPair {
                 .iter()
                 .any(|&n| self.nodal.slot_of(n).is_some_and(|j| states[j].closed))
         };
-        let live: Vec<(u32, u32)> = self
-            .candidates
+        // The overlaps the f64 pass found: the dual pass makes the same
+        // clipping decisions (on the values), so the rest would be clipped
+        // in dual numbers only to be dropped.
+        let live: Vec<(u32, u32)> = values
             .iter()
-            .copied()
-            .filter(|&(s, _)| closed(s))
+            .filter(|s| closed(s.slave))
+            .map(|s| (s.slave, s.master))
             .collect();
         let interface = Interface {
             candidates: &live,

@@ -5,7 +5,7 @@
 //!
 //! Per slave facet, with the facet's dual basis `Φ_j` (of the reference
 //! facet, as for deformable masters) and a rule over the whole facet (4×4
-//! Gauss on quads, the collapsed degree-6 rule on triangles: the distance to
+//! Gauss on quads, the degree-6 segment-triangle rule on triangles: the distance to
 //! a curved surface is not polynomial over the facet):
 //! - `g(x)` the signed distance of the slave point `x = Σ N_k x_k` to the
 //!   placed surface (> 0 outside the rigid body), `n(x) = ∂g/∂x` its outward

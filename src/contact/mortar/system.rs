@@ -57,6 +57,56 @@ pub struct NodalData {
     pub penalty: Vec<f64>,
     pub area: Vec<f64>,
     slot: std::collections::HashMap<u32, usize>,
+    /// The f64 segments of the last evaluation (see [`SegmentCache`]).
+    pub cache: SegmentCache,
+}
+
+/// The f64 segments of the last positions they were integrated at. Newton
+/// asks for the residual and then the tangent at the same iterate, and the
+/// Uzawa update follows the last residual: the tangent's node states and
+/// the update reuse the residual's segments instead of clipping and
+/// integrating them again. Keyed by the positions and the candidates (all
+/// else an interface holds is fixed for a pair); a clone starts empty.
+#[derive(Default)]
+pub struct SegmentCache(std::sync::Mutex<Option<CachedSegments>>);
+
+struct CachedSegments {
+    positions: Vec<[f64; 3]>,
+    candidates: Vec<(u32, u32)>,
+    segments: Vec<Segment<f64>>,
+}
+
+impl SegmentCache {
+    /// `segments::<f64>` of the interface, from the cache when its
+    /// positions and candidates are those of the last call.
+    pub fn segments(&self, interface: &Interface, rules: &MortarRules) -> Vec<Segment<f64>> {
+        let mut last = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(c) = last
+            .as_ref()
+            .filter(|c| c.positions == interface.positions && c.candidates == interface.candidates)
+        {
+            return c.segments.clone();
+        }
+        let segments = segments::<f64>(interface, rules);
+        *last = Some(CachedSegments {
+            positions: interface.positions.to_vec(),
+            candidates: interface.candidates.to_vec(),
+            segments: segments.clone(),
+        });
+        segments
+    }
+}
+
+impl Clone for SegmentCache {
+    fn clone(&self) -> Self {
+        SegmentCache::default()
+    }
+}
+
+impl std::fmt::Debug for SegmentCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SegmentCache")
+    }
 }
 
 impl NodalData {
@@ -68,6 +118,7 @@ impl NodalData {
             penalty,
             area,
             slot,
+            cache: SegmentCache::default(),
         }
     }
 
@@ -83,6 +134,15 @@ pub trait Seed: Scalar {
     /// Value `v` with derivative `slope` along variable `i` (an affine
     /// function of that variable, such as a slip increment).
     fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
+    /// [`segments`] in this type; f64 through the pair's cache.
+    fn segments(
+        cache: &SegmentCache,
+        interface: &Interface,
+        rules: &MortarRules,
+    ) -> Vec<Segment<Self>> {
+        let _ = cache;
+        segments(interface, rules)
+    }
 }
 
 impl Seed for f64 {
@@ -92,6 +152,14 @@ impl Seed for f64 {
 
     fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
         v
+    }
+
+    fn segments(
+        cache: &SegmentCache,
+        interface: &Interface,
+        rules: &MortarRules,
+    ) -> Vec<Segment<f64>> {
+        cache.segments(interface, rules)
     }
 }
 
@@ -136,7 +204,7 @@ fn seeded<T: Seed>(
 pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
     let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
     let mut out = Vec::new();
-    let mut cached: Option<(u32, [[T; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
+    let mut cached: Option<(u32, [[f64; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
     for &(s, m) in interface.candidates {
         let snodes = &interface.slave_facets[s as usize][..ns];
         let mnodes = &interface.master_facets[m as usize][..nm];
@@ -152,7 +220,6 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
             Some((f, a)) if f == s => a,
             _ => match dual_coefficients::<f64>(interface.slave_type, &x_ref[..ns], rules) {
                 Some(a) => {
-                    let a = a.map(|row| row.map(T::from_f64));
                     cached = Some((s, a));
                     a
                 }
@@ -346,9 +413,13 @@ pub fn tangent(
     // force coefficients c_j (rows).
     let mut grad: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
     let mut rows: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
+    // Σ_j p_j ∂c_j/∂x of one segment, summed over its nodes before it is
+    // emitted (a quarter of the entries a node-by-node emission made).
+    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
     for seg in segments {
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
+        let mut any = false;
         for (a, &node) in interface.slave_facets[seg.slave as usize][..ns]
             .iter()
             .enumerate()
@@ -371,20 +442,39 @@ pub fn tangent(
                 }
                 let c = force_coefficient(&seg.terms, a, v);
                 rows[j].push(((id, v % 3), c.re));
-                // p_j ∂c_j/∂x: local to the segment.
                 if p != 0.0 {
-                    for (w, d) in c.eps.iter().enumerate() {
-                        let col = ids[w / 3];
-                        if col != u32::MAX && *d != 0.0 {
-                            emit((id, v % 3), (col, w % 3), p * d);
-                        }
+                    any = true;
+                    for (l, d) in local[v].iter_mut().zip(&c.eps) {
+                        *l += p * d;
                     }
                 }
             }
         }
+        if any {
+            emit_local(&ids, &mut local, &mut emit);
+        }
     }
     // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
     emit_scaled_outer(nodal, -1.0, rows, grad, emit);
+}
+
+/// Emits a segment's dense block `local[v][w]` (segment variables, node ids
+/// `ids`) and clears it.
+pub(super) fn emit_local(
+    ids: &[u32; 2 * MAX_FACET_NODES],
+    local: &mut [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+    mut emit: impl FnMut(NodeDof, NodeDof, f64),
+) {
+    for (v, row) in local.iter_mut().enumerate() {
+        let id = ids[v / 3];
+        for (w, x) in row.iter_mut().enumerate() {
+            let col = ids[w / 3];
+            if id != u32::MAX && col != u32::MAX && *x != 0.0 {
+                emit((id, v % 3), (col, w % 3), *x);
+            }
+            *x = 0.0;
+        }
+    }
 }
 
 /// Emits `sign (ε_j/A_j) r_j ⊗ g_j` for every node `j` with rows: `rows[j]`
