@@ -157,6 +157,9 @@ impl<'m> Simulation<'m> {
         let reaction = x.duplicate()?;
         let (mut snes, tolerance) = newton_solver(model, local)?;
         let global_dofs = DIM * mech.dofs.num_global_nodes();
+        if tangent.contact && global_dofs > model.solver.direct_max_dofs {
+            snes.set_linear_floor(super::tolerance::LINEAR_FLOOR)?;
+        }
         if schur::applies(model, tangent, mech.loads, rt.size(), global_dofs) {
             if let Some(k) = mech.separate_stiffness() {
                 schur::install(&mut snes, k, mech.dirichlet, tangent)?;
@@ -359,6 +362,7 @@ impl LoadSteps<'_> {
     fn solve(&mut self, target: f64) -> Result<StepResult> {
         let solver = &self.model.solver;
         let (world, mech) = (&self.world, &mut self.mech);
+        let krylov = DIM * mech.dofs.num_global_nodes() > solver.direct_max_dofs;
         let mut ctx = StepContext {
             snes: &mut self.snes,
             x: &mut self.x,
@@ -367,7 +371,7 @@ impl LoadSteps<'_> {
             stages: &self.stages,
             times: &mut self.times,
             reuse_preconditioner: solver.reuse.preconditioner,
-            forcing: solver.uzawa_forcing,
+            forcing: super::tolerance::inner_forcing(solver.uzawa_forcing, krylov),
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
         };

@@ -17,6 +17,43 @@
 //! are kept and Newton runs once more to the final tolerance, followed by
 //! the usual update and test: the step's answer is as tight as before.
 
+/// The forcing of non-final solves on the Krylov path (GMRES + AMG) when
+/// the settings keep the default (`DEFAULT_FORCING`, 1e-3).
+///
+/// There every decade of residual costs about six GMRES iterations with
+/// the same preconditioner applications a plain solve makes, while on the
+/// direct path it costs a Newton iteration around kept factors (one
+/// triangular solve). A non-final solve's error is only the start of the
+/// next multiplier update, so on the Krylov path one decade less per
+/// Uzawa iteration is cheaper than the Uzawa iterations it may add:
+/// hertz-sphere h = 0.35, 2 ranks, 21 → 17 Newton, 227 → 177 GMRES, PETSc
+/// flops 2.89e10 → 2.29e10, the same 7 Uzawa iterations; hertz-cylinder
+/// h = 0.4 on GMRES + GAMG 320 → 227 GMRES (1.85e9 → 1.39e9 flops);
+/// Hertz errors unchanged to 0.003 points.
+pub const KRYLOV_FORCING: f64 = 1e-2;
+
+/// The forcing of non-final solves: the setting, except that the Krylov
+/// path takes `KRYLOV_FORCING` where the setting is the default.
+pub fn inner_forcing(setting: f64, krylov: bool) -> f64 {
+    if krylov && setting == crate::model::DEFAULT_FORCING {
+        KRYLOV_FORCING
+    } else {
+        setting
+    }
+}
+
+/// On the Krylov path with contact, a Newton iteration's GMRES stops once
+/// its residual is below this fraction of what the Newton solve still has
+/// to remove (`Snes::set_linear_floor`), however tight the Eisenstat–Walker
+/// tolerance. That tolerance follows Newton's last rate and asks the last
+/// iteration of a solve for far more than is left: hertz-sphere h = 0.35
+/// went from 2.8e-6 to 4.4e-8 in its final iteration, 30 GMRES iterations,
+/// where 1.7e-6 was the target. With the floor at 0.1: see
+/// docs/performance.md; at 0.5 the sphere's residual after a cut-short
+/// iteration stayed above the target often enough to cost Uzawa
+/// iterations and a cutback.
+pub const LINEAR_FLOOR: f64 = 0.1;
+
 /// SNES's stopping rule for one Newton solve: |R| ≤ max(atol, rtol·|R0|).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonTolerance {
@@ -82,6 +119,48 @@ pub fn round_end(uzawa_converged: bool, solved_tight: bool) -> RoundEnd {
     }
 }
 
+/// The look-ahead that spares the confirming solve: a loose Uzawa iteration
+/// whose multiplier change, contracted once more at the rate of its last
+/// two, would pass the test, makes the next iteration a tight one, so the
+/// pass it expects ends the step there instead of one solve later.
+///
+/// On the iterative path the confirming solve was the dearest of a step:
+/// from the last update's residual to the final tolerance, 3 Newton and
+/// about 48 GMRES iterations of 227 (hertz-sphere h = 0.35, 2 ranks). A
+/// wrong guess costs only the tighter solve of one iteration that is not
+/// the last; the Uzawa test itself is unchanged.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LookAhead {
+    /// Per pair, the relative multiplier change of the last iteration.
+    last: Vec<Option<f64>>,
+}
+
+impl LookAhead {
+    /// Records this iteration's relative change per pair (`changes`, each
+    /// with its tolerance and whether its penetration is within its own)
+    /// and says whether every pair is expected to pass the next test.
+    pub fn expects_pass(&mut self, changes: &[(f64, f64, bool)]) -> bool {
+        self.last.resize(changes.len(), None);
+        let mut all = !changes.is_empty();
+        for (last, &(change, tol, penetration_ok)) in self.last.iter_mut().zip(changes) {
+            let expected = match last.replace(change) {
+                Some(before) => {
+                    let rate = change / before;
+                    rate.is_finite() && rate < 1.0 && change * rate <= tol
+                }
+                None => false,
+            };
+            all &= expected && penetration_ok;
+        }
+        all
+    }
+
+    /// Forgets the history (a penalty change starts a new contraction).
+    pub fn forget(&mut self) {
+        self.last.iter_mut().for_each(|l| *l = None);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,6 +186,42 @@ mod tests {
             assert!(!t.is_inexact());
             assert_eq!(t.for_solve(false), TIGHT);
         }
+    }
+
+    #[test]
+    fn the_krylov_path_loosens_only_the_default_forcing() {
+        let d = crate::model::DEFAULT_FORCING;
+        assert_eq!(inner_forcing(d, false), d);
+        assert_eq!(inner_forcing(d, true), KRYLOV_FORCING);
+        for f in [0.0, 1e-4, 0.1] {
+            assert_eq!(inner_forcing(f, true), f, "a user's forcing stands");
+        }
+    }
+
+    #[test]
+    fn a_contraction_that_will_pass_next_time_is_expected_to() {
+        let mut l = LookAhead::default();
+        // hertz-sphere h = 0.35: 4.44e-3 then 1.44e-3 (rate 0.32): next
+        // 4.7e-4, within 1e-3.
+        assert!(!l.expects_pass(&[(4.44e-3, 1e-3, true)]), "no rate yet");
+        assert!(l.expects_pass(&[(1.44e-3, 1e-3, true)]));
+        // A penetration outside its tolerance or a slow rate: no.
+        let mut l = LookAhead::default();
+        l.expects_pass(&[(4.44e-3, 1e-3, true)]);
+        assert!(!l.expects_pass(&[(1.44e-3, 1e-3, false)]));
+        let mut l = LookAhead::default();
+        l.expects_pass(&[(2e-3, 1e-3, true)]);
+        assert!(!l.expects_pass(&[(1.8e-3, 1e-3, true)]), "0.9: 1.6e-3 next");
+    }
+
+    #[test]
+    fn every_pair_must_be_expected_to_pass_and_forgetting_starts_over() {
+        let mut l = LookAhead::default();
+        l.expects_pass(&[(4e-3, 1e-3, true), (4e-3, 1e-3, true)]);
+        assert!(!l.expects_pass(&[(1e-3, 1e-3, true), (3.9e-3, 1e-3, true)]));
+        l.forget();
+        assert!(!l.expects_pass(&[(1e-4, 1e-3, true), (1e-4, 1e-3, true)]));
+        assert!(!LookAhead::default().expects_pass(&[]));
     }
 
     #[test]

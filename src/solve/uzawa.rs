@@ -121,6 +121,7 @@ fn uzawa_rounds(
     // Uzawa iterations over every round (k counts within one).
     let mut total = 0;
     let mut solve_tight = !inner.is_inexact();
+    let mut look_ahead = tolerance::LookAhead::default();
     let mut progress = vec![Progress::default(); mech.contact.len()];
     let mut rate_raises = 0;
     // A raised penalty changes the tangent: the next solve refactors.
@@ -168,6 +169,7 @@ fn uzawa_rounds(
             restore_penalties(mech, softened, softening);
             k = 0;
             progress.iter_mut().for_each(Progress::forget);
+            look_ahead.forget();
         }
         let pair_ok: Vec<bool> = mech
             .contact
@@ -189,11 +191,28 @@ fn uzawa_rounds(
             }
             tolerance::RoundEnd::Continue => {}
         }
+        if inner.is_inexact() && !solve_tight {
+            let changes: Vec<(f64, f64, bool)> = mech
+                .contact
+                .iter()
+                .zip(&stats)
+                .map(|(p, s)| {
+                    (
+                        s.max_change / s.max_force.max(p.force_floor()),
+                        p.spec.multiplier_tol,
+                        s.max_penetration <= p.spec.penetration_tol,
+                    )
+                })
+                .collect();
+            solve_tight = look_ahead.expects_pass(&changes);
+        }
         if rate_raises < RATE_RAISES
             && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
         {
             rate_raises += 1;
             refactor = true;
+            look_ahead.forget();
+            solve_tight = !inner.is_inexact();
             if let Some(lag) = mech.lag.as_mut() {
                 lag.reset();
             }
@@ -206,6 +225,8 @@ fn uzawa_rounds(
             raises += 1;
             raise_slow_penalties(mech.contact, &stats);
             progress.iter_mut().for_each(Progress::forget);
+            look_ahead.forget();
+            solve_tight = !inner.is_inexact();
             k = 0;
             continue;
         }
