@@ -204,9 +204,13 @@ impl Snes {
     /// whatever looser or tighter tolerance the linear solver had: the last
     /// Newton iteration of a solve needs only the reduction left, not the
     /// one the forcing sequence asks for. Keeps the KSP's own test (and the
-    /// Eisenstat–Walker tolerances it is given). Collective; after
-    /// [`Self::set_from_options`].
+    /// Eisenstat–Walker tolerances it is given). 0: no floor. Collective;
+    /// after [`Self::set_from_options`].
     pub fn set_linear_floor(&mut self, fraction: f64) -> Result<()> {
+        if let Some(f) = self.floor.as_mut() {
+            f.fraction = fraction;
+            return Ok(());
+        }
         let mut ksp: sys::KSP = std::ptr::null_mut();
         let mut floor = Box::new(LinearFloor {
             snes: self.raw,

@@ -157,9 +157,6 @@ impl<'m> Simulation<'m> {
         let reaction = x.duplicate()?;
         let (mut snes, tolerance) = newton_solver(model, local)?;
         let global_dofs = DIM * mech.dofs.num_global_nodes();
-        if tangent.contact && global_dofs > model.solver.direct_max_dofs {
-            snes.set_linear_floor(super::tolerance::LINEAR_FLOOR)?;
-        }
         if schur::applies(model, tangent, mech.loads, rt.size(), global_dofs) {
             if let Some(k) = mech.separate_stiffness() {
                 schur::install(&mut snes, k, mech.dirichlet, tangent)?;
@@ -372,6 +369,11 @@ impl LoadSteps<'_> {
             times: &mut self.times,
             reuse_preconditioner: solver.reuse.preconditioner,
             forcing: super::tolerance::inner_forcing(solver.uzawa_forcing, krylov),
+            linear_floor: if krylov {
+                super::tolerance::LINEAR_FLOOR
+            } else {
+                0.0
+            },
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
         };

@@ -34,6 +34,9 @@ pub(super) struct StepContext<'s> {
     pub(super) reuse_preconditioner: bool,
     /// Newton's relative forcing in non-final Uzawa iterations.
     pub(super) forcing: f64,
+    /// The GMRES floor of non-final solves (`tolerance::LINEAR_FLOOR`;
+    /// 0: none).
+    pub(super) linear_floor: f64,
     /// Penalty divisor of a contact-free step's first Uzawa iteration
     /// (1: off; see `soften_first_contact`).
     pub(super) softening: f64,
@@ -101,6 +104,7 @@ fn uzawa_rounds(
     (softened, main_part): (&mut bool, &mut bool),
 ) -> Result<StepResult> {
     let softening = ctx.softening;
+    let linear_floor = ctx.linear_floor;
     let StepContext {
         snes,
         x,
@@ -121,7 +125,6 @@ fn uzawa_rounds(
     // Uzawa iterations over every round (k counts within one).
     let mut total = 0;
     let mut solve_tight = !inner.is_inexact();
-    let mut look_ahead = tolerance::LookAhead::default();
     let mut progress = vec![Progress::default(); mech.contact.len()];
     let mut rate_raises = 0;
     // A raised penalty changes the tangent: the next solve refactors.
@@ -131,6 +134,9 @@ fn uzawa_rounds(
         total += 1;
         let tol = inner.for_solve(solve_tight);
         snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
+        if linear_floor > 0.0 {
+            snes.set_linear_floor(if solve_tight { 0.0 } else { linear_floor })?;
+        }
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
         snes.set_lag_preconditioner(
@@ -169,7 +175,6 @@ fn uzawa_rounds(
             restore_penalties(mech, softened, softening);
             k = 0;
             progress.iter_mut().for_each(Progress::forget);
-            look_ahead.forget();
         }
         let pair_ok: Vec<bool> = mech
             .contact
@@ -191,28 +196,11 @@ fn uzawa_rounds(
             }
             tolerance::RoundEnd::Continue => {}
         }
-        if inner.is_inexact() && !solve_tight {
-            let changes: Vec<(f64, f64, bool)> = mech
-                .contact
-                .iter()
-                .zip(&stats)
-                .map(|(p, s)| {
-                    (
-                        s.max_change / s.max_force.max(p.force_floor()),
-                        p.spec.multiplier_tol,
-                        s.max_penetration <= p.spec.penetration_tol,
-                    )
-                })
-                .collect();
-            solve_tight = look_ahead.expects_pass(&changes);
-        }
         if rate_raises < RATE_RAISES
             && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
         {
             rate_raises += 1;
             refactor = true;
-            look_ahead.forget();
-            solve_tight = !inner.is_inexact();
             if let Some(lag) = mech.lag.as_mut() {
                 lag.reset();
             }
@@ -225,8 +213,6 @@ fn uzawa_rounds(
             raises += 1;
             raise_slow_penalties(mech.contact, &stats);
             progress.iter_mut().for_each(Progress::forget);
-            look_ahead.forget();
-            solve_tight = !inner.is_inexact();
             k = 0;
             continue;
         }
