@@ -421,6 +421,9 @@ unsafe extern "C" fn floor_test(
         f.rnorm0 = rnorm;
         return 0;
     }
+    if f.fraction <= 0.0 {
+        return 0;
+    }
     // SAFETY: reason is valid for the call.
     if unsafe { *reason } != 0 {
         return 0;
@@ -444,7 +447,7 @@ unsafe extern "C" fn floor_test(
             && sys::SNESGetFunctionNorm(f.snes, &mut fnorm) == 0
             && sys::SNESGetConvergenceHistory(f.snes, &mut hist, &mut hist_its, &mut nhist) == 0
     };
-    if !got || hist.is_null() || nhist < 1 || !(fnorm > 0.0) {
+    if !got || hist.is_null() || nhist < 1 || fnorm.is_nan() || fnorm <= 0.0 {
         return 0;
     }
     // SAFETY: the history holds nhist >= 1 entries; the first is |R0|.
