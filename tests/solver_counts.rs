@@ -161,8 +161,10 @@ fn hertz_cylinder_medium() {
 
 #[test]
 fn hertz_cylinder_coarse_on_the_krylov_path() {
-    // GMRES + GAMG forced (direct_max_dofs = 0), serial. Measured: 42
-    // Newton, 8 Uzawa, 292 GMRES iterations, two GAMG set-ups (the Uzawa
+    // GMRES + GAMG forced (direct_max_dofs = 0), serial. Measured: 43
+    // Newton, 8 Uzawa, 215 GMRES iterations, two GAMG set-ups (before the
+    // Krylov path's non-final Uzawa solves at 1e-2 and their GMRES floor:
+    // 42, 8, 292) (the Uzawa
     // rate rule's penalty raise resets the lag); without the rate rule 39,
     // 11, 323 around one set-up kept for the whole step. Before the Eisenstat–Walker cap and the kept
     // hierarchy the step was cut back 8 times and the run failed at load
@@ -178,7 +180,7 @@ fn hertz_cylinder_coarse_on_the_krylov_path() {
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (37, 47));
     within("Uzawa iterations", scene, c.uzawa, (7, 10));
-    within("linear iterations", scene, c.ksp, (250, 340));
+    within("linear iterations", scene, c.ksp, (190, 245));
     within("preconditioner builds", scene, c.builds, (1, 2));
 }
 

@@ -69,6 +69,32 @@ pub struct Snes {
     /// its address, which the PC holds, stays fixed; dropped after the SNES
     /// (fields go after `Drop::drop`).
     schur: Option<Box<SchurPreconditioner>>,
+    /// The linear solves' floor (`set_linear_floor`), boxed for the same
+    /// reason and dropped after the SNES too.
+    floor: Option<Box<LinearFloor>>,
+}
+
+/// A KSP convergence test and the destructor of its context.
+type ConvergenceTest = Option<
+    unsafe extern "C" fn(
+        sys::KSP,
+        sys::PetscInt,
+        f64,
+        *mut sys::KSPConvergedReason,
+        *mut c_void,
+    ) -> sys::PetscErrorCode,
+>;
+type ConvergenceDestroy = Option<unsafe extern "C" fn(*mut c_void) -> sys::PetscErrorCode>;
+
+/// The state of the convergence test `set_linear_floor` installs: the
+/// KSP's own test it wraps and the solve's first residual norm.
+struct LinearFloor {
+    snes: sys::SNES,
+    fraction: f64,
+    inner: ConvergenceTest,
+    inner_ctx: *mut c_void,
+    inner_destroy: ConvergenceDestroy,
+    rnorm0: f64,
 }
 
 impl Snes {
@@ -78,7 +104,11 @@ impl Snes {
         let mut raw: sys::SNES = std::ptr::null_mut();
         // SAFETY: PETSc is initialised; out-pointer valid.
         unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
-        let snes = Snes { raw, schur: None };
+        let snes = Snes {
+            raw,
+            schur: None,
+            floor: None,
+        };
         Ok(snes)
     }
 
@@ -165,6 +195,52 @@ impl Snes {
                 petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
             }
             Ok(())
+        }
+    }
+
+    /// Stops each linear solve of a Newton iteration once its residual has
+    /// fallen to `fraction` of what that Newton solve still has to remove,
+    /// i.e. below `fraction` · max(atol, rtol·|R0|) / |R_k| of its start,
+    /// whatever looser or tighter tolerance the linear solver had: the last
+    /// Newton iteration of a solve needs only the reduction left, not the
+    /// one the forcing sequence asks for. Keeps the KSP's own test (and the
+    /// Eisenstat–Walker tolerances it is given). 0: no floor. Collective;
+    /// after [`Self::set_from_options`].
+    pub fn set_linear_floor(&mut self, fraction: f64) -> Result<()> {
+        if let Some(f) = self.floor.as_mut() {
+            f.fraction = fraction;
+            return Ok(());
+        }
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut floor = Box::new(LinearFloor {
+            snes: self.raw,
+            fraction,
+            inner: None,
+            inner_ctx: std::ptr::null_mut(),
+            inner_destroy: None,
+            rnorm0: 0.0,
+        });
+        let ptr: *mut LinearFloor = &mut *floor;
+        // SAFETY: valid snes; the KSP is borrowed from it. The KSP's own
+        // test is taken over (not destroyed) and called from `floor_test`;
+        // the box lives in `self` until after the SNES is destroyed and is
+        // never moved out while it lives; its inner context is destroyed
+        // in `Drop`, after the SNES.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetAndClearConvergenceTest(
+                ksp,
+                &mut floor.inner,
+                &mut floor.inner_ctx,
+                &mut floor.inner_destroy
+            ))?;
+            self.floor = Some(floor);
+            petsc_call!(KSPSetConvergenceTest(
+                ksp,
+                Some(floor_test),
+                ptr as *mut c_void,
+                None
+            ))
         }
     }
 
@@ -310,7 +386,78 @@ impl Drop for Snes {
         unsafe {
             sys::SNESDestroy(&mut self.raw);
         }
+        if let Some(f) = self.floor.as_mut() {
+            if let Some(destroy) = f.inner_destroy {
+                // SAFETY: the context `set_linear_floor` took over from the
+                // KSP, destroyed once, by the function it came with.
+                unsafe {
+                    destroy(f.inner_ctx);
+                }
+            }
+        }
     }
+}
+
+/// The convergence test of `Snes::set_linear_floor`: the KSP's own test,
+/// then convergence once the residual is below the floor.
+unsafe extern "C" fn floor_test(
+    ksp: sys::KSP,
+    n: sys::PetscInt,
+    rnorm: f64,
+    reason: *mut sys::KSPConvergedReason,
+    ctx: *mut c_void,
+) -> sys::PetscErrorCode {
+    // SAFETY: ctx is the boxed `LinearFloor` of a live Snes (set in
+    // `set_linear_floor`); PETSc passes a valid reason pointer.
+    let f = unsafe { &mut *(ctx as *mut LinearFloor) };
+    if let Some(inner) = f.inner {
+        // SAFETY: the KSP's own test with its own context.
+        let code = unsafe { inner(ksp, n, rnorm, reason, f.inner_ctx) };
+        if code != 0 {
+            return code;
+        }
+    }
+    if n == 0 {
+        f.rnorm0 = rnorm;
+        return 0;
+    }
+    if f.fraction <= 0.0 {
+        return 0;
+    }
+    // SAFETY: reason is valid for the call.
+    if unsafe { *reason } != 0 {
+        return 0;
+    }
+    let (mut atol, mut rtol, mut stol) = (0.0, 0.0, 0.0);
+    let (mut max_it, mut max_f): (sys::PetscInt, sys::PetscInt) = (0, 0);
+    let mut fnorm = 0.0;
+    let mut hist: *mut f64 = std::ptr::null_mut();
+    let mut hist_its: *mut sys::PetscInt = std::ptr::null_mut();
+    let mut nhist: sys::PetscInt = 0;
+    // SAFETY: valid snes (it owns this KSP); out-pointers are locals.
+    let got = unsafe {
+        sys::SNESGetTolerances(
+            f.snes,
+            &mut atol,
+            &mut rtol,
+            &mut stol,
+            &mut max_it,
+            &mut max_f,
+        ) == 0
+            && sys::SNESGetFunctionNorm(f.snes, &mut fnorm) == 0
+            && sys::SNESGetConvergenceHistory(f.snes, &mut hist, &mut hist_its, &mut nhist) == 0
+    };
+    if !got || hist.is_null() || nhist < 1 || fnorm.is_nan() || fnorm <= 0.0 {
+        return 0;
+    }
+    // SAFETY: the history holds nhist >= 1 entries; the first is |R0|.
+    let first = unsafe { *hist };
+    let target = atol.max(rtol * first);
+    if rnorm <= f.fraction * (target / fnorm) * f.rnorm0 {
+        // SAFETY: reason is valid for the call.
+        unsafe { *reason = sys::KSPConvergedReason_KSP_CONVERGED_ATOL };
+    }
+    0
 }
 
 /// Which callback is running: a domain error is flagged on its own kind.

@@ -387,6 +387,7 @@ impl LoadSteps<'_> {
     fn solve(&mut self, target: f64) -> Result<StepResult> {
         let solver = &self.model.solver;
         let (world, mech) = (&self.world, &mut self.mech);
+        let krylov = DIM * mech.dofs.num_global_nodes() > solver.direct_max_dofs;
         let mut ctx = StepContext {
             snes: &mut self.snes,
             x: &mut self.x,
@@ -395,7 +396,12 @@ impl LoadSteps<'_> {
             stages: &self.stages,
             times: &mut self.times,
             reuse_preconditioner: solver.reuse.preconditioner,
-            forcing: solver.uzawa_forcing,
+            forcing: super::tolerance::inner_forcing(solver.uzawa_forcing, krylov),
+            linear_floor: if krylov {
+                super::tolerance::LINEAR_FLOOR
+            } else {
+                0.0
+            },
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
         };

@@ -34,6 +34,9 @@ pub(super) struct StepContext<'s> {
     pub(super) reuse_preconditioner: bool,
     /// Newton's relative forcing in non-final Uzawa iterations.
     pub(super) forcing: f64,
+    /// The GMRES floor of non-final solves (`tolerance::LINEAR_FLOOR`;
+    /// 0: none).
+    pub(super) linear_floor: f64,
     /// Penalty divisor of a contact-free step's first Uzawa iteration
     /// (1: off; see `soften_first_contact`).
     pub(super) softening: f64,
@@ -101,6 +104,7 @@ fn uzawa_rounds(
     (softened, main_part): (&mut bool, &mut bool),
 ) -> Result<StepResult> {
     let softening = ctx.softening;
+    let linear_floor = ctx.linear_floor;
     let StepContext {
         snes,
         x,
@@ -130,6 +134,9 @@ fn uzawa_rounds(
         total += 1;
         let tol = inner.for_solve(solve_tight);
         snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
+        if linear_floor > 0.0 {
+            snes.set_linear_floor(if solve_tight { 0.0 } else { linear_floor })?;
+        }
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
         snes.set_lag_preconditioner(
