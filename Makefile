@@ -15,8 +15,12 @@ OMPI_ALLOW_RUN_AS_ROOT_CONFIRM ?= 1
 # between ranks. Multi-node runs need a network transport here.
 OMPI_MCA_btl ?= self,vader
 OMPI_MCA_btl_vader_single_copy_mechanism ?= none
+# The BTL message layer only: without it every rank also opens the network
+# (MTL) transports, two of which spend 0.1 s each timing the clock at start-up
+# (see src/runtime.rs). A cluster with InfiniBand or Omni-Path sets its own.
+OMPI_MCA_pml ?= ob1
 export OMPI_MCA_rmaps_base_oversubscribe OMPI_ALLOW_RUN_AS_ROOT OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
-export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism
+export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism OMPI_MCA_pml
 
 # The executable cargo built for target KIND NAME, from cargo's JSON messages
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).

@@ -216,7 +216,7 @@ def write_scenes(stem, base, contact, tail, hertz_part, **fmt):
 
 def mpi_env():
     return dict(dict(OMPI_MCA_btl="self,vader",
-                OMPI_MCA_btl_vader_single_copy_mechanism="none",
+                OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_pml="ob1",
                 OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                 OMP_NUM_THREADS="1"), **os.environ)
 

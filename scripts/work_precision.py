@@ -38,7 +38,7 @@ def run_once(binary, scene, np_, args, h5):
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
            binary, "run", scene, "-o", h5] + args
     env = dict(dict(OMPI_MCA_btl="self,vader",
-               OMPI_MCA_btl_vader_single_copy_mechanism="none",
+               OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_pml="ob1",
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"), **os.environ)
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)

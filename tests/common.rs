@@ -21,6 +21,7 @@ pub fn mpi_env(cmd: &mut Command) -> &mut Command {
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_btl", "self,vader")
         .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
+        .env("OMPI_MCA_pml", "ob1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
 }
 
