@@ -270,17 +270,31 @@ fn contact_scenes_same_on_1_2_3_ranks() {
     }
 }
 
-/// Each rank's mesh piece comes from rank 0's distribution: on 1, 3 and 4
-/// ranks (direct solver) displacement, contact pressure and reactions agree
-/// to 1e-10.
+/// Each rank's mesh piece comes from rank 0's distribution: on 1, 3, 4 and
+/// 8 ranks (8 oversubscribed; direct solver) displacement, contact pressure
+/// (the mortar's nodal multipliers) and reactions agree to 1e-10.
 #[test]
-fn contact_scenes_same_on_1_3_4_ranks() {
-    for (scene, pair) in [("patch-test", "interface"), ("block-on-plane", "floor")] {
-        let dir = scratch(&format!("contact-ranks-134-{scene}"));
-        let ranks = [1, 3, 4];
+fn contact_scenes_same_on_1_3_4_8_ranks() {
+    for (scene, pair, extra, pressure) in [
+        ("patch-test", "interface", None, "pressure"),
+        ("block-on-plane", "floor", None, "pressure"),
+        (
+            "patch-test",
+            "interface",
+            Some("contact.formulation=mortar"),
+            "node_lambda",
+        ),
+    ] {
+        let label = format!("{scene}{}", if extra.is_some() { "-mortar" } else { "" });
+        let dir = scratch(&format!("contact-ranks-1348-{label}"));
+        let ranks = [1, 3, 4, 8];
         let files: Vec<_> = ranks.iter().map(|n| dir.join(format!("{n}.h5"))).collect();
         for (n, f) in ranks.iter().zip(&files) {
-            run_scene(*n, scene, f, &["-q"]);
+            let mut args = vec!["-q"];
+            if let Some(set) = extra {
+                args.extend(["--set", set]);
+            }
+            run_scene(*n, scene, f, &args);
         }
         let step = last_step(&files[0]);
         let field = |f: &std::path::Path, name: &str| read_nodal(f, step, name).unwrap().0;
@@ -288,16 +302,22 @@ fn contact_scenes_same_on_1_3_4_ranks() {
             field(&files[0], "displacement"),
             field(&files[0], "reaction"),
         );
-        let p1 = dataset(&files[0], step, &format!("contact/{pair}/pressure"));
+        let p1 = dataset(&files[0], step, &format!("contact/{pair}/{pressure}"));
+        assert!(
+            p1.iter().any(|&p| p > 0.0),
+            "{label}: no contact pressure on 1 rank"
+        );
         for (n, f) in ranks[1..].iter().zip(&files[1..]) {
             let du = relative_difference(&u1, &field(f, "displacement"));
             let dr = relative_difference(&r1, &field(f, "reaction"));
-            let dp =
-                relative_difference(&p1, &dataset(f, step, &format!("contact/{pair}/pressure")));
-            println!("{scene}: {n} ranks vs 1: displacement {du:.3e}, pressure {dp:.3e}, reaction {dr:.3e}");
+            let dp = relative_difference(
+                &p1,
+                &dataset(f, step, &format!("contact/{pair}/{pressure}")),
+            );
+            println!("{label}: {n} ranks vs 1: displacement {du:.3e}, pressure {dp:.3e}, reaction {dr:.3e}");
             assert!(
                 du < 1e-10 && dp < 1e-10 && dr < 1e-10,
-                "{scene}: {n} ranks differ from 1: displacement {du:.3e}, pressure {dp:.3e}, reaction {dr:.3e}"
+                "{label}: {n} ranks differ from 1: displacement {du:.3e}, pressure {dp:.3e}, reaction {dr:.3e}"
             );
         }
     }
