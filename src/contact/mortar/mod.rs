@@ -28,6 +28,7 @@
 pub mod friction;
 pub mod geometry;
 mod halo;
+mod holding;
 mod main_part;
 pub mod pair;
 mod pair_output;

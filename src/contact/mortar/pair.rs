@@ -10,7 +10,7 @@
 //! `λ_j` bit for bit; the owner of the node is the one that counts it in
 //! the Uzawa statistics and writes it out.
 use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
-use super::halo::Holding;
+use super::holding::Holding;
 use super::rigid_master::RigidMaster;
 use super::rows::{signature, Rows};
 use super::segment::MortarRules;

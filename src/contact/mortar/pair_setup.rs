@@ -1,7 +1,8 @@
 //! Building a mortar pair on one rank: the slave facets it evaluates (see
 //! `halo`), the nodal slots with their areas, element sizes and penalties,
 //! and which of them this rank completes and owns.
-use super::halo::{self, Holding};
+use super::halo;
+use super::holding::Holding;
 use super::pair::{MortarMaster, MortarPair};
 use super::rigid_master::RigidMaster;
 use super::segment::MortarRules;

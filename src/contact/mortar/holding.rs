@@ -1,0 +1,21 @@
+//! What a rank holds of a mortar pair's master side and node tail between
+//! two master exchanges (filled by [`super::halo`], read by the pair).
+use crate::dofs::GlobalDof;
+
+/// The master side and the tail as they stand after the last exchange.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Holding {
+    /// Slave node ids this rank does not see (slots in the tail).
+    pub slave_tail: Vec<u32>,
+    /// The first tail slot the pair used at the last exchange.
+    pub tail_base: Option<usize>,
+    /// Global DOFs of the pair's tail, node-major: slave, then master.
+    pub tail_dofs: Vec<GlobalDof>,
+    /// Per owned pair node: its displacement at the last master exchange.
+    pub u_at_exchange: Vec<[f64; 3]>,
+    /// Master facets held, in the whole set, by set index (the candidates'
+    /// master facet `m` is `master_set_index[m]`).
+    pub master_set_index: Vec<u32>,
+    /// The last search's candidates by set indices (slave, master).
+    pub candidate_key: Vec<(u32, u32)>,
+}
