@@ -42,6 +42,11 @@ fn main() {
     }
     println!("cargo:rustc-link-search=native={petsc_dir}/lib");
     println!("cargo:rustc-link-lib={petsc_lib}");
+    // The contact Schur path's dense Cholesky calls LAPACK and BLAS itself
+    // (src/petsc/dense.rs): the libraries PETSc links, named here because
+    // the linker does not take symbols from a library's own dependencies.
+    println!("cargo:rustc-link-lib=lapack");
+    println!("cargo:rustc-link-lib=blas");
     // The binary must find libpetsc at run time without LD_LIBRARY_PATH.
     println!("cargo:rustc-link-arg=-Wl,-rpath,{petsc_dir}/lib");
 

@@ -256,13 +256,16 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                 if let Some(s) = &r.schur {
                     let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
                     println!(
-                        "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s)",
+                        "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s) ({} of them on a trailing block alone, of at most {} DOFs, after {} factorisation(s) of S0's leading block)",
                         r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
                         linear,
                         s.dofs,
                         s.bulk_factorisations,
                         s.growths,
-                        s.schur_factorisations
+                        s.schur_factorisations,
+                        s.trailing_factorisations,
+                        s.largest_trailing,
+                        s.leading_factorisations
                     );
                 }
                 if rt.size() > 1 {

@@ -170,6 +170,37 @@ fn small_matrices() {
     }
 }
 
+/// The symmetric path's partial dense factorisations: C ordered by the
+/// first tangent, a tangent reaching further into C (S0's leading block
+/// factored again), one that makes S indefinite (LDLᵀ of the whole S) and
+/// a definite one after it; each solve against the dense one.
+fn partial_factorisations() {
+    let rows: Vec<PetscInt> = vec![0, 1, 2];
+    let mut k = bulk();
+    dirichlet(&mut k, &[0, 1, 2]);
+    let mut pc = SchurPreconditioner::new(petsc_matrix(&k, &rows), rows.clone(), true);
+    pc.want((6..18).collect());
+    let steps: [(std::ops::Range<usize>, f64, &str); 5] = [
+        (12..18, 50.0, "first tangent, on half of C"),
+        (14..18, 70.0, "on a third of C"),
+        (10..18, 60.0, "reaching further into C"),
+        (12..18, -400.0, "indefinite"),
+        (10..18, 40.0, "definite again"),
+    ];
+    for (c, scale, what) in steps {
+        let c: Vec<usize> = c.collect();
+        let j = with_contact(&k, &c, scale, false);
+        check(&mut pc, &j, &minus(&j, &k), what);
+    }
+    let d = pc.dense_counts();
+    // The first and the indefinite one whole (LDLᵀ); the others on a
+    // trailing block: the second touched the last 4 of the 12 DOFs (split
+    // at 4, room to double), the third reached 6 and the fifth kept it.
+    assert_eq!((d.whole, d.trailing, d.leading), (2, 3, 1), "{d:?}");
+    assert_eq!(d.largest_trailing, 8, "{d:?}");
+    assert_eq!((pc.bulk_factorisations, pc.schur_factorisations), (1, 5));
+}
+
 /// Displacement, reactions and contact forces of a scene with and without
 /// the Schur path; and that the Schur path was taken.
 fn same_run(rt: &Runtime, scene: &str, overrides: &[&str]) {
@@ -229,6 +260,7 @@ fn same_run(rt: &Runtime, scene: &str, overrides: &[&str]) {
 fn schur_path() {
     let rt = Runtime::start(&[]).expect("MPI and PETSc start");
     small_matrices();
+    partial_factorisations();
     same_run(&rt, "hertz-cylinder", &["mesh.fine_size=0.4"]);
     // Coulomb friction (LU), two load steps (a second search and pattern).
     same_run(

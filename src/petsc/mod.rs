@@ -1,12 +1,14 @@
 //! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers the
 //! rest of the program uses. This is the only place with `unsafe` besides MPI
 //! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
+pub mod dense;
 pub mod log;
 pub mod matrix;
 pub mod options;
 pub mod reason;
 pub mod scatter;
 pub mod schur;
+mod schur_shell;
 pub mod signals;
 pub mod snes;
 pub mod sys;

@@ -12,55 +12,91 @@
 //! (the operator SNES hands it holds only the contact tangent; K is in the
 //! factor), so nothing of the size of K is copied per Jacobian. PETSc
 //! supports Schur complements of MUMPS on one process only.
+//!
+//! A symmetric Jacobian's dense part costs less than |C|³/3 flops: C is
+//! ordered by a key the caller gives (decreasing; the solve layer's is the
+//! distance to the other body, so the contact zone comes last), S0's
+//! leading block up to a little before the first DOF a tangent touches is
+//! factored once ([`PartialCholesky`]), and each later tangent factors the
+//! trailing block alone, in place in the Schur matrix PETSc solves with. A
+//! tangent that makes S indefinite falls back to LDLᵀ of the whole S
+//! (LAPACK's dsytrf, as every factorisation did before; the first one too).
+use super::dense::PartialCholesky;
 use super::{petsc_call, sys, Matrix, PetscError, PetscInt, Result, Vector};
-use std::ffi::c_void;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 
-/// K factored with a dense Schur complement on the sorted DOFs `c`.
+/// K factored with a dense Schur complement on the DOFs `c`.
 pub struct SchurFactor {
     factor: sys::Mat,
     is: sys::IS,
+    /// The Schur DOFs, sorted.
     c: Vec<PetscInt>,
-    /// Whether the DOF at each position of `c` is constrained (its row and
-    /// column are the identity's in the factored K).
+    /// The position in the Schur complement (the index set's order) of
+    /// each entry of `c`.
+    pos: Vec<usize>,
+    /// Whether the DOF at each position is constrained (its row and column
+    /// are the identity's in the factored K).
     fixed: Vec<bool>,
+    cholesky: bool,
     /// S0, column-major |C| × |C|, both triangles.
     base: Vec<f64>,
+    /// Symmetric only: S0's leading block factored, once per split.
+    partial: Option<PartialCholesky>,
+    /// S0's leading block was not positive definite: LDLᵀ from now on.
+    partial_refused: bool,
+    /// The split whose leading columns the factor matrix's Schur array
+    /// holds now (so a new tangent writes the trailing block only).
+    in_array: Option<usize>,
+    /// PETSc has factored the Schur matrix once (its solve operations are
+    /// installed) and nothing has marked it unfactored since.
+    factored_once: bool,
+    pub counts: DenseCounts,
 }
 
-/// A (square, sequential) sparse submatrix `m`'s values added into the
-/// dense column-major |C| × |C| `out`, except in the rows and columns
-/// `fixed` marks.
-fn add_sparse_dense(m: sys::Mat, fixed: &[bool], out: &mut [f64]) -> Result<()> {
-    let n = fixed.len();
-    for row in 0..n {
-        if fixed[row] {
-            continue;
-        }
+/// How the dense Schur complements were factored.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DenseCounts {
+    /// Factorisations of the trailing block alone (Cholesky).
+    pub trailing: usize,
+    /// The largest trailing block, in DOFs.
+    pub largest_trailing: usize,
+    /// Factorisations of S0's leading block (one per split).
+    pub leading: usize,
+    /// Factorisations of the whole S (LU; or LDLᵀ: the first, and where
+    /// the trailing block was not positive definite).
+    pub whole: usize,
+}
+
+impl DenseCounts {
+    fn add(&mut self, o: DenseCounts) {
+        self.trailing += o.trailing;
+        self.largest_trailing = self.largest_trailing.max(o.largest_trailing);
+        self.leading += o.leading;
+        self.whole += o.whole;
+    }
+}
+
+/// Calls `f(row, columns, values)` for each row in `rows` of the assembled
+/// sequential matrix `m`.
+fn for_rows(
+    m: sys::Mat,
+    rows: impl Iterator<Item = PetscInt>,
+    mut f: impl FnMut(PetscInt, &[PetscInt], &[f64]),
+) -> Result<()> {
+    for row in rows {
         let mut nz: PetscInt = 0;
         let mut cols: *const PetscInt = std::ptr::null();
         let mut vals: *const f64 = std::ptr::null();
-        // SAFETY: `m` is a valid assembled sequential matrix with n rows;
-        // the row's pointers are read only between MatGetRow and the paired
-        // MatRestoreRow, and hold `nz` entries each.
+        // SAFETY: `m` is a valid assembled matrix holding `row` on this
+        // process; the row's pointers are read only between MatGetRow and
+        // the paired MatRestoreRow, and hold `nz` entries each.
         unsafe {
-            petsc_call!(MatGetRow(m, row as PetscInt, &mut nz, &mut cols, &mut vals))?;
+            petsc_call!(MatGetRow(m, row, &mut nz, &mut cols, &mut vals))?;
             if nz > 0 && !cols.is_null() && !vals.is_null() {
                 let cs = std::slice::from_raw_parts(cols, nz as usize);
                 let vs = std::slice::from_raw_parts(vals, nz as usize);
-                for (&c, &v) in cs.iter().zip(vs) {
-                    if !fixed[c as usize] {
-                        out[c as usize * n + row] += v;
-                    }
-                }
+                f(row, cs, vs);
             }
-            petsc_call!(MatRestoreRow(
-                m,
-                row as PetscInt,
-                &mut nz,
-                &mut cols,
-                &mut vals
-            ))?;
+            petsc_call!(MatRestoreRow(m, row, &mut nz, &mut cols, &mut vals))?;
         }
     }
     Ok(())
@@ -74,16 +110,31 @@ fn error(call: &'static str, message: String) -> PetscError {
     }
 }
 
+/// The Schur order of the sorted DOFs `c` by decreasing `key` (DOFs
+/// without a key first, in DOF order; ties in DOF order).
+fn by_key(c: &[PetscInt], key: &[(PetscInt, f64)]) -> Vec<PetscInt> {
+    let of = |d: PetscInt| {
+        key.binary_search_by_key(&d, |e| e.0)
+            .map_or(f64::INFINITY, |i| key[i].1)
+    };
+    let mut order: Vec<(f64, PetscInt)> = c.iter().map(|&d| (of(d), d)).collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    order.into_iter().map(|e| e.1).collect()
+}
+
 impl SchurFactor {
     /// Factors `k` (assembled, sequential, the rows and columns of the
     /// sorted DOFs `constrained` replaced by the identity) with the Schur
     /// complement on the sorted, distinct DOFs `c`: LDLᵀ when `cholesky`,
-    /// else LU.
+    /// else LU. `key` (sorted by DOF) orders C for the partial dense
+    /// factorisations (symmetric only): the DOFs a contact tangent is
+    /// likely to touch should have the smallest keys.
     pub fn new(
         k: &Matrix,
         c: Vec<PetscInt>,
         constrained: &[PetscInt],
         cholesky: bool,
+        key: &[(PetscInt, f64)],
     ) -> Result<Self> {
         if c.is_empty() || c.windows(2).any(|w| w[0] >= w[1]) {
             return Err(error(
@@ -92,16 +143,33 @@ impl SchurFactor {
             ));
         }
         let n = c.len();
-        let fixed = c
+        let fixed_sorted: Vec<bool> = c
             .iter()
             .map(|d| constrained.binary_search(d).is_ok())
             .collect();
+        let order = if cholesky { by_key(&c, key) } else { c.clone() };
+        let mut pos = vec![0; n];
+        let mut fixed = vec![false; n];
+        for (p, d) in order.iter().enumerate() {
+            let i = c
+                .binary_search(d)
+                .map_err(|_| error("SchurFactor::new", "the Schur order lost a DOF".into()))?;
+            pos[i] = p;
+            fixed[p] = fixed_sorted[i];
+        }
         let mut me = SchurFactor {
             factor: std::ptr::null_mut(),
             is: std::ptr::null_mut(),
             c,
+            pos,
             fixed,
+            cholesky,
             base: vec![0.0; n * n],
+            partial: None,
+            partial_refused: false,
+            in_array: None,
+            factored_once: false,
+            counts: DenseCounts::default(),
         };
         let kind = if cholesky {
             sys::MatFactorType_MAT_FACTOR_CHOLESKY
@@ -111,14 +179,14 @@ impl SchurFactor {
         let mut s0: sys::Mat = std::ptr::null_mut();
         // SAFETY: `k` is a valid assembled matrix; the factor and the index
         // set are owned by `me` (destroyed in Drop, also on an early error);
-        // `me.c` outlives the IS (PETSC_COPY_VALUES copies it anyway). The
+        // `order` outlives the IS (PETSC_COPY_VALUES copies it anyway). The
         // Schur copy `s0` is destroyed below on every path; its array is
         // read only while it lives.
         unsafe {
             petsc_call!(ISCreateGeneral(
                 super::comm_world(),
                 super::to_petsc_int(n)?,
-                me.c.as_ptr(),
+                order.as_ptr(),
                 sys::PetscCopyMode_PETSC_COPY_VALUES,
                 &mut me.is
             ))?;
@@ -193,34 +261,113 @@ impl SchurFactor {
         &self.c
     }
 
+    /// The contact tangent's entries in C × C as (row, column, value) in
+    /// Schur positions, without constrained rows and columns and zeros.
+    fn tangent_entries(&self, kc: &Matrix) -> Result<Vec<(usize, usize, f64)>> {
+        let mut out = Vec::new();
+        let (c, pos, fixed) = (&self.c, &self.pos, &self.fixed);
+        for_rows(kc.raw(), c.iter().copied(), |row, cols, vals| {
+            let Ok(i) = c.binary_search(&row) else { return };
+            let r = pos[i];
+            if fixed[r] {
+                return;
+            }
+            for (&col, &v) in cols.iter().zip(vals) {
+                if v == 0.0 {
+                    continue;
+                }
+                if let Ok(j) = c.binary_search(&col) {
+                    if !fixed[pos[j]] {
+                        out.push((r, pos[j], v));
+                    }
+                }
+            }
+        })?;
+        Ok(out)
+    }
+
     /// Sets the dense Schur complement to that of K + `kc` and factors it:
     /// `kc` is the contact tangent alone (non-zero only in C × C; its
     /// entries in constrained rows and columns are ignored, as the
     /// Jacobian's Dirichlet replacement would drop them).
     pub fn update(&mut self, kc: &Matrix) -> Result<()> {
+        let d = self.tangent_entries(kc)?;
+        if self.cholesky && self.trailing_update(&d)? {
+            return Ok(());
+        }
         let n = self.c.len();
-        let mut jcc: sys::Mat = std::ptr::null_mut();
+        let mut dense = self.base.clone();
+        for &(r, c, v) in &d {
+            dense[c * n + r] += v;
+        }
+        // Not known to be definite: LDLᵀ (or LU) of the whole matrix.
+        self.factor_whole(&dense)?;
+        self.counts.whole += 1;
+        Ok(())
+    }
+
+    /// The symmetric fast path: S0's leading block factored (again only
+    /// when a tangent touches a DOF before its split), the trailing block
+    /// with the tangent factored into the Schur matrix's array. False when
+    /// it does not apply: the first factorisation (PETSc has not installed
+    /// its solve yet), a tangent without entries, or an S that is not
+    /// positive definite.
+    fn trailing_update(&mut self, d: &[(usize, usize, f64)]) -> Result<bool> {
+        let n = self.c.len();
+        // The first factorisation is PETSc's own (it installs the dense
+        // solve); the first contact tangent is often a first touch, smaller
+        // than the zone the later ones settle on, so the split waits for
+        // the second. Without contact coupling S is S0: factored whole.
+        if !self.factored_once || self.partial_refused || d.is_empty() {
+            return Ok(false);
+        }
+        let first = d.iter().map(|&(r, c, _)| r.min(c)).min().unwrap_or(n);
+        if self.partial.as_ref().is_none_or(|p| p.split() > first) {
+            // Room for the touched tail to double before S0's leading block
+            // must be factored again: a first touch grows (hertz line b/40:
+            // the tail from 324 to 504 DOFs between the first two tangents),
+            // and a trailing block of 2t DOFs still costs (2t/n)³ of the
+            // whole (6 % at t = n/5).
+            let split = first.saturating_sub(n - first);
+            self.in_array = None;
+            self.partial = PartialCholesky::new(&self.base, n, split);
+            self.partial_refused = self.partial.is_none();
+            self.counts.leading += 1;
+        }
+        let Some(partial) = &self.partial else {
+            return Ok(false);
+        };
+        let split = partial.split();
+        let leading = self.in_array != Some(split);
+        let mut ok = false;
+        with_factored_schur(self.factor, n, |arr| {
+            ok = partial.factor_into(d, arr, leading);
+        })?;
+        if !ok {
+            self.in_array = None;
+            return Ok(false);
+        }
+        self.in_array = Some(split);
+        self.counts.trailing += 1;
+        self.counts.largest_trailing = self.counts.largest_trailing.max(n - split);
+        Ok(true)
+    }
+
+    /// PETSc's factorisation of the whole dense S = `dense`: LDLᵀ (dsytrf,
+    /// S need not be definite) or LU (dgetrf).
+    fn factor_whole(&mut self, dense: &[f64]) -> Result<()> {
+        let n = self.c.len();
         let mut s: sys::Mat = std::ptr::null_mut();
         let mut status: sys::MatFactorSchurStatus = 0;
-        let mut dense = self.base.clone();
+        self.in_array = None;
+        self.factored_once = false;
         // SAFETY: valid factor with a Schur complement of size n (set in
-        // `new`) and valid index set; `kc` is a valid assembled matrix of the
-        // factored size. The submatrix is destroyed on every path. The Schur
-        // matrix is the factor's own (borrowed between Get and Restore); its
-        // array holds n × n column-major values and is written only between
-        // MatDenseGetArray and its restore. Restoring it as unfactored clears
-        // its old dense factors, so the factorisation that follows is fresh.
+        // `new`); the Schur matrix is the factor's own (borrowed between Get
+        // and Restore); its array holds n × n column-major values and is
+        // written only between MatDenseGetArray and its restore. Restoring
+        // it as unfactored clears its old dense factors, so the
+        // factorisation that follows is fresh.
         unsafe {
-            petsc_call!(MatCreateSubMatrix(
-                kc.raw(),
-                self.is,
-                self.is,
-                sys::MatReuse_MAT_INITIAL_MATRIX,
-                &mut jcc
-            ))?;
-            let added = add_sparse_dense(jcc, &self.fixed, &mut dense);
-            sys::MatDestroy(&mut jcc);
-            added?;
             petsc_call!(MatFactorGetSchurComplement(
                 self.factor,
                 &mut s,
@@ -238,8 +385,16 @@ impl SchurFactor {
             ))?;
             let mut arr: *mut f64 = std::ptr::null_mut();
             petsc_call!(MatDenseGetArray(s, &mut arr))?;
-            std::slice::from_raw_parts_mut(arr, n * n).copy_from_slice(&dense);
+            std::slice::from_raw_parts_mut(arr, n * n).copy_from_slice(dense);
             petsc_call!(MatDenseRestoreArray(s, &mut arr))?;
+            if self.cholesky {
+                // Cleared after the fast path's Cholesky factors.
+                petsc_call!(MatSetOption(
+                    s,
+                    sys::MatOption_MAT_SPD,
+                    sys::PetscBool_PETSC_FALSE
+                ))?;
+            }
             petsc_call!(MatFactorRestoreSchurComplement(
                 self.factor,
                 &mut s,
@@ -247,6 +402,7 @@ impl SchurFactor {
             ))?;
             petsc_call!(MatFactorFactorizeSchurComplement(self.factor))?;
         }
+        self.factored_once = true;
         Ok(())
     }
 
@@ -259,6 +415,39 @@ impl SchurFactor {
         // factored size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), x.raw())) }
     }
+}
+
+/// `f` on the array of the factored Schur matrix of `factor` (n × n), which
+/// stays marked factored, as a Cholesky factor (dpotrs reads it).
+///
+/// The factor must hold a Schur complement that PETSc has factored before
+/// (its dense solve installed) and that nothing has marked unfactored since.
+fn with_factored_schur(factor: sys::Mat, n: usize, f: impl FnOnce(&mut [f64])) -> Result<()> {
+    let mut s: sys::Mat = std::ptr::null_mut();
+    let mut status: sys::MatFactorSchurStatus = 0;
+    // SAFETY: valid factor with a Schur complement of size n, factored by
+    // PETSc before (the caller's promise); the Schur matrix is the factor's
+    // own, borrowed between Get and Restore; its array holds n × n
+    // column-major values, written only between MatDenseGetArray and its
+    // restore.
+    unsafe {
+        petsc_call!(MatFactorGetSchurComplement(factor, &mut s, &mut status))?;
+        let mut arr: *mut f64 = std::ptr::null_mut();
+        petsc_call!(MatDenseGetArray(s, &mut arr))?;
+        f(std::slice::from_raw_parts_mut(arr, n * n));
+        petsc_call!(MatDenseRestoreArray(s, &mut arr))?;
+        petsc_call!(MatSetOption(
+            s,
+            sys::MatOption_MAT_SPD,
+            sys::PetscBool_PETSC_TRUE
+        ))?;
+        petsc_call!(MatFactorRestoreSchurComplement(
+            factor,
+            &mut s,
+            sys::MatFactorSchurStatus_MAT_FACTOR_SCHUR_FACTORED
+        ))?;
+    }
+    Ok(())
 }
 
 /// The Schur complement of an LDLᵀ factorisation may come with one
@@ -307,10 +496,14 @@ pub struct SchurPreconditioner {
     cholesky: bool,
     factor: Option<SchurFactor>,
     wanted: Vec<PetscInt>,
+    key: Vec<(PetscInt, f64)>,
     /// Sparse factorisations of K (the first, and one per growth of C).
     pub bulk_factorisations: usize,
     /// Dense factorisations of the Schur complement (one per set-up).
     pub schur_factorisations: usize,
+    /// How they were made, for the factors dropped when C grew (see
+    /// [`Self::dense_counts`]).
+    dense: DenseCounts,
     /// Times C had to grow.
     pub growths: usize,
     /// The last set-up's failure, for the report.
@@ -331,8 +524,10 @@ impl SchurPreconditioner {
             cholesky,
             factor: None,
             wanted: Vec::new(),
+            key: Vec::new(),
             bulk_factorisations: 0,
             schur_factorisations: 0,
+            dense: DenseCounts::default(),
             growths: 0,
             last_error: None,
         }
@@ -346,9 +541,27 @@ impl SchurPreconditioner {
         self.wanted = dofs;
     }
 
+    /// An order key for the DOFs of C (smallest: most likely to be touched
+    /// by a contact tangent, such as the distance to the other body), used
+    /// when C is next formed.
+    pub fn order_by(&mut self, mut key: Vec<(PetscInt, f64)>) {
+        key.sort_by_key(|e| e.0);
+        key.dedup_by_key(|e| e.0);
+        self.key = key;
+    }
+
     /// |C| of the current factor (0 before the first).
     pub fn schur_size(&self) -> usize {
         self.factor.as_ref().map_or(0, |f| f.dofs().len())
+    }
+
+    /// How the dense Schur complements were factored, over the run.
+    pub fn dense_counts(&self) -> DenseCounts {
+        let mut d = self.dense;
+        if let Some(f) = &self.factor {
+            d.add(f.counts);
+        }
+        d
     }
 
     /// Set-up for the Jacobian K + `kc`, from the contact tangent `kc`
@@ -370,10 +583,18 @@ impl SchurPreconditioner {
                 // No contact coupling yet: any one DOF makes a (trivial) C.
                 c.push(0);
             }
-            self.factor = None;
+            if let Some(old) = self.factor.take() {
+                self.dense.add(old.counts);
+            }
             let mut kd = self.k.duplicate()?;
             kd.zero_rows_columns_identity(&self.constrained)?;
-            self.factor = Some(SchurFactor::new(&kd, c, &self.constrained, self.cholesky)?);
+            self.factor = Some(SchurFactor::new(
+                &kd,
+                c,
+                &self.constrained,
+                self.cholesky,
+                &self.key,
+            )?);
             self.bulk_factorisations += 1;
         }
         let f = self
@@ -396,93 +617,9 @@ impl SchurPreconditioner {
     }
 }
 
+pub(super) use super::schur_shell::install;
+
 /// Both sorted: every entry of `a` is in `b`.
 fn is_subset(a: &[PetscInt], b: &[PetscInt]) -> bool {
     a.iter().all(|x| b.binary_search(x).is_ok())
-}
-
-/// Makes `pc` a shell preconditioner backed by `state`.
-///
-/// # Safety
-/// `pc` must be a valid PC and `state` must stay at its address, alive,
-/// until the PC is destroyed or given another type.
-pub(super) unsafe fn install(pc: sys::PC, state: *mut SchurPreconditioner) -> Result<()> {
-    // SAFETY: as the caller promises; the callbacks below read the context
-    // only while PETSc runs them on this PC.
-    unsafe {
-        petsc_call!(PCSetType(pc, c"shell".as_ptr()))?;
-        petsc_call!(PCShellSetContext(pc, state as *mut c_void))?;
-        petsc_call!(PCShellSetSetUp(pc, Some(set_up_trampoline)))?;
-        petsc_call!(PCShellSetApply(pc, Some(apply_trampoline)))?;
-        petsc_call!(PCShellSetName(
-            pc,
-            c"MUMPS Schur complement on the contact DOFs".as_ptr()
-        ))
-    }
-}
-
-/// The shell's context.
-///
-/// # Safety
-/// `pc` is a shell PC set up by [`install`].
-unsafe fn context<'a>(pc: sys::PC) -> Result<&'a mut SchurPreconditioner> {
-    let mut ctx: *mut c_void = std::ptr::null_mut();
-    // SAFETY: valid shell PC; PCShellGetContext writes the stored pointer
-    // into the out-pointer (passed as void*, as PETSc 3.18 declares it).
-    unsafe {
-        petsc_call!(PCShellGetContext(
-            pc,
-            &mut ctx as *mut *mut c_void as *mut c_void
-        ))?;
-        (ctx as *mut SchurPreconditioner)
-            .as_mut()
-            .ok_or_else(|| error("PCShellGetContext", "no context".into()))
-    }
-}
-
-fn code_of(r: std::thread::Result<Result<()>>, state: Option<&mut SchurPreconditioner>) -> i32 {
-    let message = match r {
-        Ok(Ok(())) => return 0,
-        Ok(Err(e)) => e.to_string(),
-        Err(_) => "panic in the Schur preconditioner".into(),
-    };
-    if let Some(s) = state {
-        s.last_error = Some(message);
-    }
-    sys::PETSC_ERR_LIB
-}
-
-unsafe extern "C" fn set_up_trampoline(pc: sys::PC) -> sys::PetscErrorCode {
-    // SAFETY: PETSc calls this on the shell PC `install` set up.
-    let Ok(state) = (unsafe { context(pc) }) else {
-        return sys::PETSC_ERR_LIB;
-    };
-    let mut a: sys::Mat = std::ptr::null_mut();
-    let mut p: sys::Mat = std::ptr::null_mut();
-    // SAFETY: valid PC; the operators are borrowed for this call only.
-    let got = unsafe { petsc_call!(PCGetOperators(pc, &mut a, &mut p)) };
-    let r = catch_unwind(AssertUnwindSafe(|| {
-        got?;
-        // SAFETY: the preconditioning matrix is valid during the set-up.
-        // On this path it holds the contact tangent alone (see
-        // `solve::mechanics`).
-        let kc = unsafe { Matrix::borrowed(p) };
-        state.set_up(&kc)
-    }));
-    code_of(r, Some(state))
-}
-
-unsafe extern "C" fn apply_trampoline(
-    pc: sys::PC,
-    b: sys::Vec,
-    x: sys::Vec,
-) -> sys::PetscErrorCode {
-    // SAFETY: PETSc calls this on the shell PC `install` set up.
-    let Ok(state) = (unsafe { context(pc) }) else {
-        return sys::PETSC_ERR_LIB;
-    };
-    // SAFETY: PETSc passes valid vectors for the call's duration.
-    let (bv, mut xv) = unsafe { (Vector::borrowed(b), Vector::borrowed(x)) };
-    let r = catch_unwind(AssertUnwindSafe(|| state.apply(&bv, &mut xv)));
-    code_of(r, Some(state))
 }

@@ -349,7 +349,12 @@ impl LoadSteps<'_> {
                         build_jacobian(mech.dofs, mech.bulk, mech.loads, mech.contact, mesh)
                     })?;
                 self.pattern_builds += 1;
-                schur::want(&mut self.snes, self.mech.contact, self.mech.dofs)?;
+                schur::want(
+                    &mut self.snes,
+                    self.mech.contact,
+                    self.mech.dofs,
+                    self.local,
+                )?;
             }
         }
         Ok(())
