@@ -30,6 +30,8 @@ pub(super) struct TangentKind {
     pub(super) linear_bulk: bool,
     /// The model has contact pairs.
     pub(super) contact: bool,
+    /// Some contact pair has friction (a nonsmooth stick/slip switch).
+    pub(super) frictional: bool,
     /// Nothing is ever added to the linear stiffness (linear bodies, no
     /// contact, inertia or follower load): the Jacobian never changes, so
     /// the preconditioner is set up once.
@@ -57,6 +59,7 @@ pub(super) fn tangent_kind(
         symmetric,
         linear_bulk,
         contact: !contact.is_empty(),
+        frictional: contact.iter().any(ContactPair::has_friction),
         constant: linear_bulk && contact.is_empty() && !follower && model.dynamics.is_none(),
     }
 }
@@ -71,6 +74,7 @@ pub(super) fn set_solver_defaults(
         symmetric,
         linear_bulk,
         contact,
+        frictional,
         constant,
     } = tangent;
     petsc::options::clear_defaults()?;
@@ -83,7 +87,19 @@ pub(super) fn set_solver_defaults(
         // It costs two extra residuals per iteration, cheap only when the
         // bulk residual is K u − f (ironing, Neo-Hookean: 1479 → 1406
         // iterations but more time), so nonlinear bodies keep backtracking.
-        petsc::options::set_default("-snes_linesearch_type", "l2")?;
+        //
+        // Not with friction: its return map switches between stick and
+        // slip along a Newton direction, where ‖R‖ has a kink, and l2's
+        // secant step has no decrease test. On the mortar block slide
+        // (scripts/scenes/block-slide-stacked.toml, load 0.35, second Uzawa
+        // iteration) it sampled ‖R‖ = 0.489 / 0.450 at λ = 1 / 0.5 from
+        // 0.249, took λ = 1.07 to 0.498, and from there alternated between
+        // ~0.17–0.27 and ~0.46–0.57 for 30 iterations (a cutback).
+        // Backtracking keeps ‖R‖ decreasing: 4 iterations there, no
+        // cutback (mortar 118 -> 115 Newton over the run, links 160 -> 154;
+        // block-slide unchanged, 60 / 59).
+        let search = if frictional { "bt" } else { "l2" };
+        petsc::options::set_default("-snes_linesearch_type", search)?;
     }
     if dofs <= settings.direct_max_dofs {
         // GMRES around the LU factors: one iteration with fresh factors, a
