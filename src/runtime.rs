@@ -17,6 +17,8 @@ impl Runtime {
     /// `petsc_args` are PETSc options in command-line form (program name not
     /// included), e.g. `["-ksp_type", "cg"]`.
     pub fn start(petsc_args: &[String]) -> Result<Self> {
+        // Before MPI and PETSc allocate (see `petsc::heap`).
+        crate::petsc::heap::restore_malloc_defaults();
         let universe =
             mpi::initialize().ok_or_else(|| Error::Mpi("MPI was already initialised".into()))?;
         let world = universe.world();

@@ -1,6 +1,7 @@
 //! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers the
 //! rest of the program uses. This is the only place with `unsafe` besides MPI
 //! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
+pub mod heap;
 pub mod log;
 pub mod matrix;
 pub mod options;
