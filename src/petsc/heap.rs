@@ -53,18 +53,59 @@ mod tests {
         usable - n
     }
 
+    /// Set in the child process [`slack_in_a_fresh_process`] starts: which
+    /// settings it allocates under.
+    const CHILD_ENV: &str = "CONTACTLINK_HEAP_TEST_CHILD";
+    /// What the child prints before the slack.
+    const SLACK_MARK: &str = "large-block-slack=";
+
+    /// The slack of a large block in a fresh process (this test binary run
+    /// again for [`child_block_slack`]): a heap that other tests' threads
+    /// have used may serve the block from memory freed earlier, mapped or not.
+    fn slack_in_a_fresh_process(mode: &str) -> usize {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "petsc::heap::tests::child_block_slack",
+                "--ignored",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(CHILD_ENV, mode)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        text.lines()
+            .find_map(|l| l.split_once(SLACK_MARK))
+            .and_then(|(_, v)| v.trim().parse().ok())
+            .unwrap_or_else(|| panic!("the child printed no slack: {text}"))
+    }
+
     #[test]
-    fn large_blocks_are_mapped_on_their_own_after_the_restore() {
-        // What libsuperlu_dist's constructor does (whether or not this test
-        // binary loads it).
+    #[ignore = "run in a fresh process by the test below"]
+    fn child_block_slack() {
+        let Ok(mode) = std::env::var(CHILD_ENV) else {
+            return;
+        };
+        // What libsuperlu_dist's constructor does (whether or not this
+        // test binary loads it).
         // SAFETY: as in restore_malloc_defaults.
         unsafe {
             libc::mallopt(libc::M_MMAP_MAX, 0);
+            libc::mallopt(libc::M_TRIM_THRESHOLD, -1);
         }
-        let heap = slack_of_a_large_block();
+        if mode == "restored" {
+            restore_malloc_defaults();
+        }
+        // On a line of its own: libtest prints the test's name before it.
+        println!("\n{SLACK_MARK}{}", slack_of_a_large_block());
+    }
+
+    #[test]
+    fn large_blocks_are_mapped_on_their_own_after_the_restore() {
+        let heap = slack_in_a_fresh_process("superlu");
         assert!(heap < 64, "with M_MMAP_MAX = 0: {heap} bytes of slack");
-        restore_malloc_defaults();
-        let mapped = slack_of_a_large_block();
+        let mapped = slack_in_a_fresh_process("restored");
         assert!(mapped >= 1024, "after the restore: {mapped} bytes of slack");
     }
 }
