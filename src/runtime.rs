@@ -18,6 +18,8 @@ impl Runtime {
     /// included), e.g. `["-ksp_type", "cg"]`.
     pub fn start(petsc_args: &[String]) -> Result<Self> {
         run_alone_without_a_daemon();
+        // Before MPI and PETSc allocate (see `petsc::heap`).
+        crate::petsc::heap::restore_malloc_defaults();
         let universe =
             mpi::initialize().ok_or_else(|| Error::Mpi("MPI was already initialised".into()))?;
         let world = universe.world();
