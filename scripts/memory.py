@@ -43,6 +43,7 @@ def mpi_env():
     # Local defaults only where the caller set nothing (a cluster sets its own).
     for k, v in (("OMPI_MCA_btl", "self,vader"),
                  ("OMPI_MCA_btl_vader_single_copy_mechanism", "none"),
+                 ("OMPI_MCA_pml", "ob1"),
                  ("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
                  ("OMPI_MCA_rmaps_base_oversubscribe", "1")):
         env.setdefault(k, v)
