@@ -2,6 +2,7 @@
 //! rest of the program uses. This is the only place with `unsafe` besides MPI
 //! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
 pub mod log;
+pub mod low_rank;
 pub mod matrix;
 pub mod options;
 pub mod reason;
