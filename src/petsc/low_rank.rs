@@ -157,7 +157,12 @@ pub struct LowRankPreconditioner {
     /// dense set-ups (D, M and its LU).
     pub inverse_cpu_seconds: f64,
     pub dense_cpu_seconds: f64,
-    /// The last set-up's or solve's failure, for the report.
+    /// The last set-up's or solve's numeric failure (a failed
+    /// factorisation, a non-finite update), agreed by every rank: the shell
+    /// reports it as a failed preconditioner, which SNES takes as a failed
+    /// linear solve (a cutback), as it does a failed MUMPS factor.
+    pub failed: Option<String>,
+    /// The last set-up's or solve's error, for the report.
     pub last_error: Option<String>,
 }
 
@@ -205,6 +210,7 @@ impl LowRankPreconditioner {
             growths: 0,
             inverse_cpu_seconds: 0.0,
             dense_cpu_seconds: 0.0,
+            failed: None,
             last_error: None,
         })
     }
@@ -226,8 +232,12 @@ impl LowRankPreconditioner {
     /// alone: K is factored at the first set-up only, G formed again only
     /// when C must grow. Collective.
     pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
+        self.failed = None;
         if self.factor.is_null() {
             self.factor_bulk()?;
+            if self.failed.is_some() {
+                return Ok(());
+            }
         }
         let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
         if (self.any_rank)(grow) {
@@ -288,11 +298,12 @@ impl LowRankPreconditioner {
             petsc_call!(MatFactorGetError(self.factor, &mut err))?;
             let failed = err != sys::MatFactorError_MAT_FACTOR_NOERROR;
             if (self.any_rank)(failed) {
+                // Tried again at the next set-up.
                 sys::MatDestroy(&mut self.factor);
-                return Err(error(
-                    "MatFactorGetError",
-                    format!("the MUMPS factorisation of the bulk stiffness failed (error type {err} on rank 0 or another)"),
+                self.failed = Some(format!(
+                    "the MUMPS factorisation of the bulk stiffness failed (error type {err} here)"
                 ));
+                return Ok(());
             }
         }
         self.bulk_factorisations += 1;
@@ -510,13 +521,12 @@ impl LowRankPreconditioner {
                 Ok(())
             }
         });
-        let failed = (self.any_rank)(local.is_err());
-        local?;
-        if failed {
-            return Err(error(
-                "LowRankPreconditioner::update",
-                "the dense factorisation of I + D G failed on rank 0".into(),
-            ));
+        if (self.any_rank)(local.is_err()) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(()) => "the dense factorisation of I + D G failed on rank 0".into(),
+            });
+            return Ok(());
         }
         self.dense_factorisations += 1;
         Ok(())
@@ -573,6 +583,10 @@ impl LowRankPreconditioner {
 
     /// x = (K + P D Pᵀ)⁻¹ b with the D of the last set-up. Collective.
     pub fn apply(&mut self, b: &Vector, x: &mut Vector) -> Result<()> {
+        if self.failed.is_some() {
+            // As MatSolve does with a failed MUMPS factor.
+            return x.set_all(f64::INFINITY);
+        }
         let (Some(z), Some(t), Some(small), Some(rhs)) =
             (&mut self.z, &mut self.t, &mut self.small, &mut self.rhs)
         else {
@@ -584,9 +598,12 @@ impl LowRankPreconditioner {
         // SAFETY: valid factor and vectors of its size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
         scatter(self.pick, z.raw(), small.raw(), false)?;
-        let local = if self.root {
+        let (d, m, root) = (&self.d, self.m.0, self.root);
+        let local = (|| -> Result<bool> {
+            if !root {
+                return Ok(true);
+            }
             let zc: Vec<f64> = small.with_array(|a| a.to_vec())?;
-            let d = &self.d;
             rhs.with_array_mut(|r| {
                 for (i, v) in r.iter_mut().enumerate() {
                     *v = d.row(i).map(|(k, dv)| dv * zc[k]).sum();
@@ -594,19 +611,15 @@ impl LowRankPreconditioner {
             })?;
             // SAFETY: M is factored (set-up succeeded on every rank before
             // any apply); sequential vectors of its size.
-            unsafe { petsc_call!(MatSolve(self.m.0, rhs.raw(), small.raw()))? };
-            let finite = small.with_array(|y| y.iter().all(|v| v.is_finite()))?;
-            Ok(finite)
-        } else {
-            Ok(true)
-        };
-        let bad = (self.any_rank)(!matches!(local, Ok(true)));
-        local?;
-        if bad {
-            return Err(error(
-                "LowRankPreconditioner::apply",
-                "the low-rank update of the contact solve is not finite".into(),
-            ));
+            unsafe { petsc_call!(MatSolve(m, rhs.raw(), small.raw()))? };
+            small.with_array(|y| y.iter().all(|v| v.is_finite()))
+        })();
+        if (self.any_rank)(!matches!(local, Ok(true))) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(_) => "the low-rank update of the contact solve is not finite".into(),
+            });
+            return x.set_all(f64::INFINITY);
         }
         // t = b − P y, then x = K⁻¹ t.
         small.scale(-1.0)?;

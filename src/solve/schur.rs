@@ -45,20 +45,23 @@ pub struct SchurSummary {
     pub dense_cpu_seconds: f64,
 }
 
-/// Whether the run takes the Schur path (every argument is the same on every
-/// rank, so is the answer).
+/// Whether the run takes the Schur path. Collective: a follower load's
+/// facets may sit on some ranks only, so that is agreed; every other
+/// argument is the same on every rank, so is the answer.
 pub(super) fn applies(
     model: &Model,
     tangent: TangentKind,
     loads: &SurfaceLoads,
     global_dofs: usize,
 ) -> bool {
+    let world = mpi::topology::SimpleCommunicator::world();
+    let follower = parallel::any_rank(&world, loads.has_follower());
     let s = &model.solver;
     s.contact_schur
         && tangent.contact
         && tangent.linear_bulk
         && global_dofs <= s.direct_max_dofs
-        && !loads.has_follower()
+        && !follower
         && model.dynamics.is_none()
         && s.reuse.linear_stiffness
         && user_kept_direct_defaults()

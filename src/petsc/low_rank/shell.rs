@@ -46,9 +46,29 @@ unsafe fn context<'a>(pc: sys::PC) -> Result<&'a mut LowRankPreconditioner> {
     }
 }
 
-fn code_of(r: std::thread::Result<Result<()>>, state: &mut LowRankPreconditioner) -> i32 {
+/// The callback's code; an agreed numeric failure marks the PC failed
+/// (every rank alike) instead, so the KSP reports a failed preconditioner.
+fn code_of(
+    pc: sys::PC,
+    r: std::thread::Result<Result<()>>,
+    state: &mut LowRankPreconditioner,
+) -> i32 {
     let message = match r {
-        Ok(Ok(())) => return 0,
+        Ok(Ok(())) => {
+            // The reason stays on the PC until set again: cleared once a
+            // set-up succeeds.
+            let reason = if state.failed.is_some() {
+                sys::PCFailedReason_PC_FACTOR_OTHER
+            } else {
+                sys::PCFailedReason_PC_NOERROR
+            };
+            // SAFETY: valid PC for the callback's duration.
+            let set = unsafe { petsc_call!(PCSetFailedReason(pc, reason)) };
+            match set {
+                Ok(()) => return 0,
+                Err(e) => e.to_string(),
+            }
+        }
         Ok(Err(e)) => e.to_string(),
         Err(_) => "panic in the low-rank contact preconditioner".into(),
     };
@@ -72,7 +92,7 @@ unsafe extern "C" fn set_up_trampoline(pc: sys::PC) -> sys::PetscErrorCode {
         let kc = unsafe { Matrix::borrowed(p) };
         state.set_up(&kc)
     }));
-    code_of(r, state)
+    code_of(pc, r, state)
 }
 
 unsafe extern "C" fn apply_trampoline(
@@ -87,5 +107,5 @@ unsafe extern "C" fn apply_trampoline(
     // SAFETY: PETSc passes valid vectors for the call's duration.
     let (bv, mut xv) = unsafe { (Vector::borrowed(b), Vector::borrowed(x)) };
     let r = catch_unwind(AssertUnwindSafe(|| state.apply(&bv, &mut xv)));
-    code_of(r, state)
+    code_of(pc, r, state)
 }
