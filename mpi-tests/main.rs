@@ -17,6 +17,7 @@ use mpi::traits::*;
 use std::process::ExitCode;
 
 mod lagging;
+mod low_rank;
 mod manufactured;
 mod mortar_halo;
 mod rank0;
@@ -73,6 +74,10 @@ const CASES: &[Case] = &[
     (
         "the_watch_rebuilds_factors_on_a_change_and_amg_once_worn",
         lagging::the_watch_rebuilds_factors_on_a_change_and_amg_once_worn,
+    ),
+    (
+        "the_contact_schur_path_matches_the_full_factorisation",
+        low_rank::the_contact_schur_path_matches_the_full_factorisation,
     ),
     (
         "a_mortar_pair_holds_only_the_master_near_its_slave_facets",

@@ -253,7 +253,23 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         r.preconditioner_reuses
                     );
                 }
-                if let Some(s) = &r.schur {
+                if let Some(s) = r.schur.as_ref().filter(|s| s.low_rank) {
+                    let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
+                    println!(
+                        "  solver: {} Uzawa iterations, {} linear iterations, contact low-rank update on {} DOFs (MUMPS, {} ranks): bulk stiffness factored {} time(s), G = PᵀK⁻¹P formed {} time(s) (C grew {} time(s); {:.2} CPU s on rank 0), I + D·G factored {} time(s) ({:.2} CPU s on rank 0)",
+                        r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
+                        linear,
+                        s.dofs,
+                        rt.size(),
+                        s.bulk_factorisations,
+                        1 + s.growths,
+                        s.growths,
+                        s.inverse_cpu_seconds,
+                        s.schur_factorisations,
+                        s.dense_cpu_seconds
+                    );
+                }
+                if let Some(s) = r.schur.as_ref().filter(|s| !s.low_rank) {
                     let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
                     println!(
                         "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s) ({} of them on a trailing block alone, of at most {} DOFs, after {} factorisation(s) of S0's leading block)",

@@ -4,6 +4,7 @@
 pub mod dense;
 pub mod heap;
 pub mod log;
+pub mod low_rank;
 pub mod matrix;
 pub mod options;
 pub mod reason;

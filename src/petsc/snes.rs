@@ -1,5 +1,6 @@
 //! Newton's method through PETSc SNES, with residual and Jacobian computed by
 //! Rust code behind the [`NonlinearProblem`] trait.
+use super::low_rank::LowRankPreconditioner;
 use super::reason::{KspReason, SnesReason};
 use super::schur::SchurPreconditioner;
 use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
@@ -69,6 +70,8 @@ pub struct Snes {
     /// its address, which the PC holds, stays fixed; dropped after the SNES
     /// (fields go after `Drop::drop`).
     schur: Option<Box<SchurPreconditioner>>,
+    /// The several-rank counterpart of `schur` (same rules).
+    low_rank: Option<Box<LowRankPreconditioner>>,
     /// The linear solves' floor (`set_linear_floor`), boxed for the same
     /// reason and dropped after the SNES too.
     floor: Option<Box<LinearFloor>>,
@@ -107,6 +110,7 @@ impl Snes {
         let snes = Snes {
             raw,
             schur: None,
+            low_rank: None,
             floor: None,
         };
         Ok(snes)
@@ -242,6 +246,37 @@ impl Snes {
                 None
             ))
         }
+    }
+
+    /// Makes the linear solver's preconditioner the low-rank contact
+    /// update of K's factor (several ranks; as [`Self::install_schur`]).
+    pub fn install_low_rank(&mut self, state: LowRankPreconditioner) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut pc: sys::PC = std::ptr::null_mut();
+        let mut boxed = Box::new(state);
+        let ptr: *mut LowRankPreconditioner = &mut *boxed;
+        self.low_rank = Some(boxed);
+        // SAFETY: as in `install_schur`: the box lives in `self` until after
+        // the SNES is destroyed and is never moved out while it lives.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            petsc_call!(KSPGetPC(ksp, &mut pc))?;
+            super::low_rank::install(pc, ptr)?;
+            // An exact solve, as on the Schur path.
+            if !super::options::user_set("-ksp_type")? {
+                petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
+            }
+            Ok(())
+        }
+    }
+
+    /// The low-rank preconditioner's state, if installed.
+    pub fn low_rank(&self) -> Option<&LowRankPreconditioner> {
+        self.low_rank.as_deref()
+    }
+
+    pub fn low_rank_mut(&mut self) -> Option<&mut LowRankPreconditioner> {
+        self.low_rank.as_deref_mut()
     }
 
     /// The Schur preconditioner's state, if installed.

@@ -157,9 +157,9 @@ impl<'m> Simulation<'m> {
         let reaction = x.duplicate()?;
         let (mut snes, tolerance) = newton_solver(model, local)?;
         let global_dofs = DIM * mech.dofs.num_global_nodes();
-        if schur::applies(model, tangent, mech.loads, rt.size(), global_dofs) {
+        if schur::applies(model, tangent, mech.loads, global_dofs) {
             if let Some(k) = mech.separate_stiffness() {
-                schur::install(&mut snes, k, mech.dirichlet, tangent)?;
+                schur::install(&mut snes, k, mech.dirichlet, tangent, rt.size())?;
                 mech.always_rebuild = true;
             }
         }

@@ -4,8 +4,11 @@
 //! DOFs the contact tangent can touch (`petsc::schur`), and the linear
 //! solver's preconditioner becomes that exact solve of (K + Kc) x = b.
 //!
-//! Chosen once per run when it applies: one rank (PETSc's MUMPS Schur
-//! complement is sequential), the direct path, every body linear-elastic,
+//! On several ranks PETSc's MUMPS Schur complement is not available; there
+//! K gets an ordinary parallel MUMPS factor, once per run, and each
+//! Jacobian a low-rank update of it on C (`petsc::low_rank`).
+//!
+//! Chosen once per run when it applies: the direct path, every body linear-elastic,
 //! contact pairs, no follower load and no inertia (nothing but contact is
 //! added to K), K kept assembled, and `[solver] contact_schur` on. C is the
 //! union of the DOFs of every contact pattern built in the run; a pattern
@@ -19,6 +22,8 @@ use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
 use crate::model::Model;
+use crate::parallel;
+use crate::petsc::low_rank::LowRankPreconditioner;
 use crate::petsc::schur::SchurPreconditioner;
 use crate::petsc::{Matrix, PetscInt, Snes};
 
@@ -38,24 +43,32 @@ pub struct SchurSummary {
     pub trailing_factorisations: usize,
     pub largest_trailing: usize,
     pub leading_factorisations: usize,
+    /// Several ranks: K's factor with a low-rank update (`schur_factorisations`
+    /// counts the dense LUs of I + D G; G is formed 1 + growths times).
+    pub low_rank: bool,
+    /// Low-rank path, rank 0's CPU seconds: forming G, and the dense
+    /// set-ups (D gathered, M formed and factored).
+    pub inverse_cpu_seconds: f64,
+    pub dense_cpu_seconds: f64,
 }
 
-/// Whether the run takes the Schur path (every argument is the same on every
-/// rank, so is the answer).
+/// Whether the run takes the Schur path. Collective: a follower load's
+/// facets may sit on some ranks only, so that is agreed; every other
+/// argument is the same on every rank, so is the answer.
 pub(super) fn applies(
     model: &Model,
     tangent: TangentKind,
     loads: &SurfaceLoads,
-    ranks: usize,
     global_dofs: usize,
 ) -> bool {
+    let world = mpi::topology::SimpleCommunicator::world();
+    let follower = parallel::any_rank(&world, loads.has_follower());
     let s = &model.solver;
     s.contact_schur
-        && ranks == 1
         && tangent.contact
         && tangent.linear_bulk
         && global_dofs <= s.direct_max_dofs
-        && !loads.has_follower()
+        && !follower
         && model.dynamics.is_none()
         && s.reuse.linear_stiffness
         && user_kept_direct_defaults()
@@ -68,15 +81,24 @@ fn user_kept_direct_defaults() -> bool {
         && !crate::petsc::options::user_set("-pc_factor_mat_solver_type").unwrap_or(true)
 }
 
-/// Installs the Schur preconditioner on `snes` from the kept bulk
-/// stiffness `k` (a second handle, no copy) and the Dirichlet rows the
-/// Jacobian replaces by the identity.
+/// Installs the Schur preconditioner (one rank) or the low-rank one
+/// (several) on `snes` from the kept bulk stiffness `k` (a second handle,
+/// no copy) and the Dirichlet rows the Jacobian replaces by the identity.
+/// Collective.
 pub(super) fn install(
     snes: &mut Snes,
     k: &Matrix,
     dirichlet: &Dirichlet,
     tangent: TangentKind,
+    ranks: usize,
 ) -> Result<()> {
+    if ranks > 1 {
+        let world = mpi::topology::SimpleCommunicator::world();
+        let any = Box::new(move |flag| parallel::any_rank(&world, flag));
+        let pc = LowRankPreconditioner::new(k.share()?, &dirichlet.global_rows(), any)?;
+        snes.install_low_rank(pc)?;
+        return Ok(());
+    }
     let pc = SchurPreconditioner::new(k.share()?, dirichlet.global_rows(), tangent.symmetric);
     snes.install_schur(pc)?;
     Ok(())
@@ -126,6 +148,10 @@ pub(super) fn want(
         s.order_by(distance_to_other_body(&c, dofs, mesh));
         s.want(c);
     }
+    if let Some(s) = snes.low_rank_mut() {
+        // Collective: this rank's share, gathered.
+        s.want(&contact_dofs(pairs, dofs)?)?;
+    }
     Ok(())
 }
 
@@ -172,16 +198,29 @@ fn distance_to_other_body(c: &[PetscInt], dofs: &DofMap, mesh: &LocalMesh) -> Ve
 
 /// The run's Schur figures (None: not on the Schur path).
 pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
-    snes.schur().map(|s| {
-        let d = s.dense_counts();
-        SchurSummary {
-            dofs: s.schur_size(),
-            bulk_factorisations: s.bulk_factorisations,
-            schur_factorisations: s.schur_factorisations,
-            growths: s.growths,
-            trailing_factorisations: d.trailing,
-            largest_trailing: d.largest_trailing,
-            leading_factorisations: d.leading,
-        }
-    })
+    let low_rank = snes.low_rank().map(|s| SchurSummary {
+        dofs: s.schur_size(),
+        bulk_factorisations: s.bulk_factorisations,
+        schur_factorisations: s.dense_factorisations,
+        growths: s.growths,
+        low_rank: true,
+        inverse_cpu_seconds: s.inverse_cpu_seconds,
+        dense_cpu_seconds: s.dense_cpu_seconds,
+        ..SchurSummary::default()
+    });
+    snes.schur()
+        .map(|s| {
+            let d = s.dense_counts();
+            SchurSummary {
+                dofs: s.schur_size(),
+                bulk_factorisations: s.bulk_factorisations,
+                schur_factorisations: s.schur_factorisations,
+                growths: s.growths,
+                trailing_factorisations: d.trailing,
+                largest_trailing: d.largest_trailing,
+                leading_factorisations: d.leading,
+                ..SchurSummary::default()
+            }
+        })
+        .or(low_rank)
 }

@@ -1,0 +1,701 @@
+//! The contact solve on several ranks with the bulk stiffness factored
+//! once: the exact inverse of J = K + P D Pᵀ (D the contact tangent on the
+//! contact DOFs C, P the columns of the identity on C) by a low-rank update
+//! of K's factor, which needs no D⁻¹:
+//!
+//!   G = Pᵀ K⁻¹ P (|C| unit right-hand sides, once per C),
+//!   M = I + D G  (dense, LU per Jacobian),
+//!   x = K⁻¹ (b − P M⁻¹ D (K⁻¹ b)_C)  (two solves with K's factor).
+//!
+//! (Woodbury: (K + P D Pᵀ)⁻¹ = K⁻¹ − K⁻¹ P D (I + G D)⁻¹ Pᵀ K⁻¹, and
+//! D (I + G D)⁻¹ = (I + D G)⁻¹ D.) PETSc's MUMPS Schur complement, which
+//! the one-rank path uses, is sequential; this path uses only an ordinary
+//! parallel MUMPS factor. K is parallel; G, D and M live on rank 0.
+//!
+//! Every decision one rank could take alone (C must grow, a factorisation
+//! failed, a non-finite update) goes through the caller's agreement hook
+//! before any rank acts on it, so no rank leaves a collective call the
+//! others are still in.
+mod shell;
+use super::{comm_world, petsc_call, sys, Matrix, PetscError, PetscInt, Result, Vector};
+pub(super) use shell::install;
+
+/// Collective: true on every rank if the flag is true on any (the caller's
+/// parallel module provides it).
+pub type AnyRank = Box<dyn Fn(bool) -> bool>;
+
+fn error(call: &'static str, message: String) -> PetscError {
+    PetscError {
+        call,
+        code: -1,
+        message,
+    }
+}
+
+fn self_comm() -> sys::MPI_Comm {
+    // SAFETY: MPI is initialised while PETSc is; the handle is a constant.
+    unsafe { sys::RSMPI_COMM_SELF }
+}
+
+fn world_rank() -> Result<i32> {
+    let mut r = 0;
+    // SAFETY: valid communicator; out-pointer is a local.
+    let code = unsafe { sys::MPI_Comm_rank(comm_world(), &mut r) };
+    if code != 0 {
+        return Err(error("MPI_Comm_rank", format!("error {code}")));
+    }
+    Ok(r)
+}
+
+/// Every rank's `local` indices on every rank, sorted and distinct.
+/// Collective.
+pub fn gather_sorted(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
+    let mut is: sys::IS = std::ptr::null_mut();
+    let mut all: sys::IS = std::ptr::null_mut();
+    // SAFETY: `local` is valid for its length and copied; both index sets
+    // are destroyed on every path; the gathered indices are read only
+    // between ISGetIndices and its restore.
+    let mut out = unsafe {
+        petsc_call!(ISCreateGeneral(
+            comm_world(),
+            super::to_petsc_int(local.len())?,
+            local.as_ptr(),
+            sys::PetscCopyMode_PETSC_COPY_VALUES,
+            &mut is
+        ))?;
+        let read = (|| -> Result<Vec<PetscInt>> {
+            petsc_call!(ISAllGather(is, &mut all))?;
+            let mut n: PetscInt = 0;
+            petsc_call!(ISGetLocalSize(all, &mut n))?;
+            let mut p: *const PetscInt = std::ptr::null();
+            petsc_call!(ISGetIndices(all, &mut p))?;
+            let v = if n > 0 && !p.is_null() {
+                std::slice::from_raw_parts(p, n as usize).to_vec()
+            } else {
+                Vec::new()
+            };
+            petsc_call!(ISRestoreIndices(all, &mut p))?;
+            Ok(v)
+        })();
+        sys::ISDestroy(&mut all);
+        sys::ISDestroy(&mut is);
+        read?
+    };
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+/// A matrix destroyed when it goes out of scope.
+struct OwnedMat(sys::Mat);
+
+impl Drop for OwnedMat {
+    fn drop(&mut self) {
+        // SAFETY: owned and destroyed once (null is skipped by PETSc).
+        unsafe {
+            sys::MatDestroy(&mut self.0);
+        }
+    }
+}
+
+/// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
+/// start[i]..start[i + 1] (positions in C; constrained rows and columns
+/// dropped).
+#[derive(Default)]
+struct Sparse {
+    start: Vec<usize>,
+    col: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl Sparse {
+    fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.start[i]..self.start[i + 1];
+        self.col[r.clone()]
+            .iter()
+            .copied()
+            .zip(self.val[r].iter().copied())
+    }
+}
+
+/// The shell preconditioner's state (see the module's comment).
+pub struct LowRankPreconditioner {
+    k: Matrix,
+    /// Every rank's constrained DOFs (sorted): K's rows and columns there
+    /// are the identity's, and D drops them.
+    constrained: Vec<PetscInt>,
+    any_rank: AnyRank,
+    root: bool,
+    /// K's MUMPS factor (null before the first set-up).
+    factor: sys::Mat,
+    /// C, the same on every rank.
+    c: Vec<PetscInt>,
+    fixed: Vec<bool>,
+    wanted: Vec<PetscInt>,
+    /// Full vector → its C entries on rank 0 (none elsewhere).
+    pick: sys::VecScatter,
+    /// Sequential, |C| entries on rank 0 and none elsewhere.
+    small: Option<Vector>,
+    rhs: Option<Vector>,
+    /// Work vectors in K's layout.
+    z: Option<Vector>,
+    t: Option<Vector>,
+    /// Rank 0: G column-major |C| × |C|.
+    g: Vec<f64>,
+    d: Sparse,
+    /// Rank 0: the LU factors of M = I + D G.
+    m: OwnedMat,
+    /// Sparse factorisations of K (one per run).
+    pub bulk_factorisations: usize,
+    /// Times G was formed (1 + growths).
+    pub inverse_blocks: usize,
+    /// Dense LU factorisations of M (one per set-up).
+    pub dense_factorisations: usize,
+    /// Times C had to grow.
+    pub growths: usize,
+    /// This rank's CPU seconds in forming G (all of them) and in the
+    /// dense set-ups (D, M and its LU).
+    pub inverse_cpu_seconds: f64,
+    pub dense_cpu_seconds: f64,
+    /// The last set-up's or solve's numeric failure (a failed
+    /// factorisation, a non-finite update), agreed by every rank: the shell
+    /// reports it as a failed preconditioner, which SNES takes as a failed
+    /// linear solve (a cutback), as it does a failed MUMPS factor.
+    pub failed: Option<String>,
+    /// The last set-up's or solve's error, for the report.
+    pub last_error: Option<String>,
+}
+
+/// This process's CPU seconds so far (user + system).
+fn cpu_seconds() -> f64 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: a valid clock id and out-pointer.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) } == 0;
+    if ok {
+        t.tv_sec as f64 + 1e-9 * t.tv_nsec as f64
+    } else {
+        0.0
+    }
+}
+
+impl LowRankPreconditioner {
+    /// `k`: the linear bulk stiffness; `constrained`: this rank's rows and
+    /// columns the Jacobian replaces by the identity (gathered here: K is
+    /// factored with the same replacement, on a copy that lives only while
+    /// it is factored). Collective.
+    pub fn new(k: Matrix, constrained: &[PetscInt], any_rank: AnyRank) -> Result<Self> {
+        Ok(LowRankPreconditioner {
+            k,
+            constrained: gather_sorted(constrained)?,
+            any_rank,
+            root: world_rank()? == 0,
+            factor: std::ptr::null_mut(),
+            c: Vec::new(),
+            fixed: Vec::new(),
+            wanted: Vec::new(),
+            pick: std::ptr::null_mut(),
+            small: None,
+            rhs: None,
+            z: None,
+            t: None,
+            g: Vec::new(),
+            d: Sparse::default(),
+            m: OwnedMat(std::ptr::null_mut()),
+            bulk_factorisations: 0,
+            inverse_blocks: 0,
+            dense_factorisations: 0,
+            growths: 0,
+            inverse_cpu_seconds: 0.0,
+            dense_cpu_seconds: 0.0,
+            failed: None,
+            last_error: None,
+        })
+    }
+
+    /// The DOFs the contact tangent may touch from now on, this rank's
+    /// share (any order, repeats allowed): gathered over the ranks, so C
+    /// is the same everywhere. Collective.
+    pub fn want(&mut self, dofs: &[PetscInt]) -> Result<()> {
+        self.wanted = gather_sorted(dofs)?;
+        Ok(())
+    }
+
+    /// |C| (0 before the first set-up).
+    pub fn schur_size(&self) -> usize {
+        self.c.len()
+    }
+
+    /// Set-up for the Jacobian K + `kc` from the contact tangent `kc`
+    /// alone: K is factored at the first set-up only, G formed again only
+    /// when C must grow. Collective.
+    pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
+        self.failed = None;
+        if self.factor.is_null() {
+            self.factor_bulk()?;
+            if self.failed.is_some() {
+                return Ok(());
+            }
+        }
+        let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
+        if (self.any_rank)(grow) {
+            if !self.c.is_empty() {
+                self.growths += 1;
+            }
+            let mut c = self.wanted.clone();
+            c.extend_from_slice(&self.c);
+            c.sort_unstable();
+            c.dedup();
+            if c.is_empty() {
+                // No contact coupling yet: any one DOF makes a (trivial) C.
+                c.push(0);
+            }
+            let t0 = cpu_seconds();
+            self.form_inverse(c)?;
+            self.inverse_cpu_seconds += cpu_seconds() - t0;
+        }
+        let t0 = cpu_seconds();
+        let r = self.update(kc);
+        self.dense_cpu_seconds += cpu_seconds() - t0;
+        r
+    }
+
+    /// K (with the Dirichlet replacement) factored by MUMPS: LDLᵀ, K being
+    /// symmetric on this path whatever the contact tangent is.
+    fn factor_bulk(&mut self) -> Result<()> {
+        let mut kd = self.k.duplicate()?;
+        kd.zero_rows_columns_identity(&self.constrained)?;
+        let mut right: sys::Vec = std::ptr::null_mut();
+        let mut left: sys::Vec = std::ptr::null_mut();
+        // SAFETY: `kd` is a valid assembled matrix; the factor is owned by
+        // `self` (destroyed in Drop); the work vectors are handed to owning
+        // wrappers at once.
+        unsafe {
+            petsc_call!(MatCreateVecs(kd.raw(), &mut right, &mut left))?;
+            self.z = Some(Vector::owned_from_raw(right));
+            self.t = Some(Vector::owned_from_raw(left));
+            petsc_call!(MatGetFactor(
+                kd.raw(),
+                c"mumps".as_ptr(),
+                sys::MatFactorType_MAT_FACTOR_CHOLESKY,
+                &mut self.factor
+            ))?;
+            let mut info = sys::MatFactorInfo::default();
+            petsc_call!(MatFactorInfoInitialize(&mut info))?;
+            petsc_call!(MatCholeskyFactorSymbolic(
+                self.factor,
+                kd.raw(),
+                std::ptr::null_mut(),
+                &info
+            ))?;
+            petsc_call!(MatCholeskyFactorNumeric(self.factor, kd.raw(), &info))?;
+            // MUMPS reports a failed factorisation through the factor's
+            // error type (from its global INFOG, so alike on every rank);
+            // agreed all the same.
+            let mut err: sys::MatFactorError = 0;
+            petsc_call!(MatFactorGetError(self.factor, &mut err))?;
+            let failed = err != sys::MatFactorError_MAT_FACTOR_NOERROR;
+            if (self.any_rank)(failed) {
+                // Tried again at the next set-up.
+                sys::MatDestroy(&mut self.factor);
+                self.failed = Some(format!(
+                    "the MUMPS factorisation of the bulk stiffness failed (error type {err} here)"
+                ));
+                return Ok(());
+            }
+        }
+        self.bulk_factorisations += 1;
+        Ok(())
+    }
+
+    /// C becomes `c`: the scatter onto rank 0 and G = Pᵀ K⁻¹ P, |C| solves
+    /// with K's factor in blocks of right-hand sides. Collective.
+    fn form_inverse(&mut self, c: Vec<PetscInt>) -> Result<()> {
+        let n = c.len();
+        let here = if self.root { n } else { 0 };
+        self.fixed = c
+            .iter()
+            .map(|d| self.constrained.binary_search(d).is_ok())
+            .collect();
+        self.c = c;
+        self.g = vec![0.0; if self.root { n * n } else { 0 }];
+        let z = self
+            .z
+            .as_ref()
+            .ok_or_else(|| error("form_inverse", "no factor".into()))?;
+        let (mut rows, mut cols): (PetscInt, PetscInt) = (0, 0);
+        let mut small: sys::Vec = std::ptr::null_mut();
+        let mut rhs: sys::Vec = std::ptr::null_mut();
+        let mut from: sys::IS = std::ptr::null_mut();
+        let mut to: sys::IS = std::ptr::null_mut();
+        let positions: Vec<PetscInt> = (0..here as PetscInt).collect();
+        // SAFETY: valid matrices and vectors; the sequential vectors go to
+        // owning wrappers at once; the index slices are copied and their
+        // sets destroyed on every path; the old scatter is destroyed once
+        // and replaced.
+        unsafe {
+            petsc_call!(MatGetSize(self.k.raw(), &mut rows, &mut cols))?;
+            let len = super::to_petsc_int(here)?;
+            petsc_call!(VecCreateSeq(self_comm(), len, &mut small))?;
+            self.small = Some(Vector::owned_from_raw(small));
+            petsc_call!(VecCreateSeq(self_comm(), len, &mut rhs))?;
+            self.rhs = Some(Vector::owned_from_raw(rhs));
+            sys::VecScatterDestroy(&mut self.pick);
+            petsc_call!(ISCreateGeneral(
+                self_comm(),
+                len,
+                self.c.as_ptr(),
+                sys::PetscCopyMode_PETSC_COPY_VALUES,
+                &mut from
+            ))?;
+            let made = petsc_call!(ISCreateGeneral(
+                self_comm(),
+                len,
+                positions.as_ptr(),
+                sys::PetscCopyMode_PETSC_COPY_VALUES,
+                &mut to
+            ))
+            .and_then(|()| petsc_call!(VecScatterCreate(z.raw(), from, small, to, &mut self.pick)));
+            sys::ISDestroy(&mut from);
+            sys::ISDestroy(&mut to);
+            made?;
+        }
+        self.inverse_entries(rows)?;
+        self.inverse_blocks += 1;
+        Ok(())
+    }
+
+    /// G's entries by MUMPS's selected inverse (ICNTL(30)): the pattern
+    /// C × C of K⁻¹ requested on rank 0 as the transpose of a sparse
+    /// right-hand side, so MUMPS prunes its solves to the tree paths of C
+    /// (whole solves with |C| unit right-hand sides cost 1.99e11 flops per
+    /// rank at hertz-cylinder h = 0.2, against 4.9e9 for the 14 solves of
+    /// the run). The request is an N × N matrix held on rank 0 whose row c
+    /// lists C: K⁻¹'s column c at the rows of C.
+    fn inverse_entries(&mut self, rows: PetscInt) -> Result<()> {
+        let n = self.c.len();
+        let here = if self.root { rows } else { 0 };
+        let nn = super::to_petsc_int(n)?;
+        let lengths: Vec<PetscInt> = if self.root {
+            let mut l = vec![0; rows as usize];
+            for &d in &self.c {
+                l[d as usize] = nn;
+            }
+            l
+        } else {
+            Vec::new()
+        };
+        let ones = vec![1.0; n];
+        let mut bt = OwnedMat(std::ptr::null_mut());
+        // SAFETY: the request matrix is owned by its guard; `lengths` holds
+        // one entry per local row and the rows set are local (rank 0 owns
+        // every row and column); MUMPS writes the entries into its values;
+        // each row is read between MatGetRow and its restore. ICNTL(30) and
+        // ICNTL(21) are put back to what MatSolve expects (PETSc leaves the
+        // selected-inverse mode and a centralised solution set).
+        unsafe {
+            petsc_call!(MatCreateAIJ(
+                comm_world(),
+                here,
+                here,
+                rows,
+                rows,
+                0,
+                if self.root {
+                    lengths.as_ptr()
+                } else {
+                    std::ptr::null()
+                },
+                0,
+                std::ptr::null(),
+                &mut bt.0
+            ))?;
+            if self.root {
+                for &d in &self.c {
+                    petsc_call!(MatSetValues(
+                        bt.0,
+                        1,
+                        &d,
+                        nn,
+                        self.c.as_ptr(),
+                        ones.as_ptr(),
+                        sys::InsertMode_INSERT_VALUES
+                    ))?;
+                }
+            }
+            petsc_call!(MatAssemblyBegin(
+                bt.0,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+            ))?;
+            petsc_call!(MatAssemblyEnd(
+                bt.0,
+                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
+            ))?;
+            let got = petsc_call!(MatMumpsGetInverseTranspose(self.factor, bt.0));
+            petsc_call!(MatMumpsSetIcntl(self.factor, 30, 0))?;
+            petsc_call!(MatMumpsSetIcntl(self.factor, 21, 1))?;
+            got?;
+        }
+        let local = (|| -> Result<()> {
+            if !self.root {
+                return Ok(());
+            }
+            // SAFETY: rank 0 reads its own rows of the assembled request,
+            // each between MatGetRow and its restore.
+            unsafe {
+                for (j, &d) in self.c.iter().enumerate() {
+                    let mut nz: PetscInt = 0;
+                    let mut cols: *const PetscInt = std::ptr::null();
+                    let mut vals: *const f64 = std::ptr::null();
+                    petsc_call!(MatGetRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
+                    let ok = nz == nn && !vals.is_null();
+                    if ok {
+                        let vs = std::slice::from_raw_parts(vals, n);
+                        self.g[j * n..(j + 1) * n].copy_from_slice(vs);
+                    }
+                    petsc_call!(MatRestoreRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
+                    if !ok {
+                        return Err(error(
+                            "MatMumpsGetInverseTranspose",
+                            format!("row {d} of the inverse entries has {nz} of {n} entries"),
+                        ));
+                    }
+                }
+            }
+            Ok(())
+        })();
+        let failed = (self.any_rank)(local.is_err());
+        local?;
+        if failed {
+            return Err(error(
+                "MatMumpsGetInverseTranspose",
+                "reading the inverse entries failed on rank 0".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// D from `kc` onto rank 0, then M = I + D G and its LU there; the
+    /// outcome agreed. Collective.
+    fn update(&mut self, kc: &Matrix) -> Result<()> {
+        let n = self.c.len();
+        let here = super::to_petsc_int(if self.root { n } else { 0 })?;
+        let mut is: sys::IS = std::ptr::null_mut();
+        let mut subs: *mut sys::Mat = std::ptr::null_mut();
+        // SAFETY: `kc` is a valid assembled matrix of K's size; the index
+        // set (C on rank 0, empty elsewhere) is copied and destroyed; the
+        // submatrix array is destroyed on every path after its rows are read.
+        let read = unsafe {
+            petsc_call!(ISCreateGeneral(
+                self_comm(),
+                here,
+                self.c.as_ptr(),
+                sys::PetscCopyMode_PETSC_COPY_VALUES,
+                &mut is
+            ))?;
+            let made = petsc_call!(MatCreateSubMatrices(
+                kc.raw(),
+                1,
+                &is,
+                &is,
+                sys::MatReuse_MAT_INITIAL_MATRIX,
+                &mut subs
+            ));
+            sys::ISDestroy(&mut is);
+            made?;
+            let read = if self.root && !subs.is_null() {
+                read_sparse(*subs, &self.fixed)
+            } else {
+                Ok(Sparse::default())
+            };
+            sys::MatDestroySubMatrices(1, &mut subs);
+            read
+        };
+        let local = read.and_then(|d| {
+            self.d = d;
+            if self.root {
+                self.factor_dense()
+            } else {
+                Ok(())
+            }
+        });
+        if (self.any_rank)(local.is_err()) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(()) => "the dense factorisation of I + D G failed on rank 0".into(),
+            });
+            return Ok(());
+        }
+        self.dense_factorisations += 1;
+        Ok(())
+    }
+
+    /// Rank 0: M = I + D G, column by column (D sparse), and its LU.
+    fn factor_dense(&mut self) -> Result<()> {
+        let n = self.c.len();
+        let nn = super::to_petsc_int(n)?;
+        let mut m = OwnedMat(std::ptr::null_mut());
+        // SAFETY: a new sequential dense matrix of n × n, its array
+        // (column-major, leading dimension n as created with no user array)
+        // written only between Get and Restore.
+        unsafe {
+            petsc_call!(MatCreateSeqDense(
+                self_comm(),
+                nn,
+                nn,
+                std::ptr::null_mut(),
+                &mut m.0
+            ))?;
+            let mut a: *mut f64 = std::ptr::null_mut();
+            petsc_call!(MatDenseGetArrayWrite(m.0, &mut a))?;
+            let out = std::slice::from_raw_parts_mut(a, n * n);
+            let mut finite = true;
+            for j in 0..n {
+                let g = &self.g[j * n..(j + 1) * n];
+                let col = &mut out[j * n..(j + 1) * n];
+                for (i, v) in col.iter_mut().enumerate() {
+                    let s: f64 = self.d.row(i).map(|(k, d)| d * g[k]).sum();
+                    *v = s + if i == j { 1.0 } else { 0.0 };
+                    finite &= v.is_finite();
+                }
+            }
+            petsc_call!(MatDenseRestoreArrayWrite(m.0, &mut a))?;
+            if !finite {
+                return Err(error(
+                    "LowRankPreconditioner::update",
+                    "the contact tangent is not finite".into(),
+                ));
+            }
+            let mut info = sys::MatFactorInfo::default();
+            petsc_call!(MatFactorInfoInitialize(&mut info))?;
+            petsc_call!(MatLUFactor(
+                m.0,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+                &info
+            ))?;
+        }
+        self.m = m;
+        Ok(())
+    }
+
+    /// x = (K + P D Pᵀ)⁻¹ b with the D of the last set-up. Collective.
+    pub fn apply(&mut self, b: &Vector, x: &mut Vector) -> Result<()> {
+        if self.failed.is_some() {
+            // As MatSolve does with a failed MUMPS factor.
+            return x.set_all(f64::INFINITY);
+        }
+        let (Some(z), Some(t), Some(small), Some(rhs)) =
+            (&mut self.z, &mut self.t, &mut self.small, &mut self.rhs)
+        else {
+            return Err(error(
+                "LowRankPreconditioner::apply",
+                "applied before its set-up".into(),
+            ));
+        };
+        // SAFETY: valid factor and vectors of its size (PETSc checks).
+        unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
+        scatter(self.pick, z.raw(), small.raw(), false)?;
+        let (d, m, root) = (&self.d, self.m.0, self.root);
+        let local = (|| -> Result<bool> {
+            if !root {
+                return Ok(true);
+            }
+            let zc: Vec<f64> = small.with_array(|a| a.to_vec())?;
+            rhs.with_array_mut(|r| {
+                for (i, v) in r.iter_mut().enumerate() {
+                    *v = d.row(i).map(|(k, dv)| dv * zc[k]).sum();
+                }
+            })?;
+            // SAFETY: M is factored (set-up succeeded on every rank before
+            // any apply); sequential vectors of its size.
+            unsafe { petsc_call!(MatSolve(m, rhs.raw(), small.raw()))? };
+            small.with_array(|y| y.iter().all(|v| v.is_finite()))
+        })();
+        if (self.any_rank)(!matches!(local, Ok(true))) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(_) => "the low-rank update of the contact solve is not finite".into(),
+            });
+            return x.set_all(f64::INFINITY);
+        }
+        // t = b − P y, then x = K⁻¹ t.
+        small.scale(-1.0)?;
+        t.copy_from(b)?;
+        scatter(self.pick, small.raw(), t.raw(), true)?;
+        // SAFETY: as above.
+        unsafe { petsc_call!(MatSolve(self.factor, t.raw(), x.raw())) }
+    }
+}
+
+/// The forward scatter (full → C entries, inserting) or the reverse one
+/// (C entries added into the full vector). Collective.
+fn scatter(s: sys::VecScatter, from: sys::Vec, to: sys::Vec, reverse: bool) -> Result<()> {
+    let (mode, add) = if reverse {
+        (sys::ScatterMode_SCATTER_REVERSE, sys::InsertMode_ADD_VALUES)
+    } else {
+        (
+            sys::ScatterMode_SCATTER_FORWARD,
+            sys::InsertMode_INSERT_VALUES,
+        )
+    };
+    // SAFETY: the caller passes the scatter's own layouts (PETSc checks);
+    // begin and end are paired.
+    unsafe {
+        petsc_call!(VecScatterBegin(s, from, to, add, mode))?;
+        petsc_call!(VecScatterEnd(s, from, to, add, mode))
+    }
+}
+
+/// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
+/// columns.
+fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
+    let mut d = Sparse {
+        start: vec![0],
+        ..Sparse::default()
+    };
+    for (row, &skip) in fixed.iter().enumerate() {
+        if !skip {
+            let mut nz: PetscInt = 0;
+            let mut cols: *const PetscInt = std::ptr::null();
+            let mut vals: *const f64 = std::ptr::null();
+            // SAFETY: `m` is a valid assembled sequential matrix with
+            // fixed.len() rows; the row's pointers are read only between
+            // MatGetRow and the paired MatRestoreRow, `nz` entries each.
+            unsafe {
+                let r = row as PetscInt;
+                petsc_call!(MatGetRow(m, r, &mut nz, &mut cols, &mut vals))?;
+                if nz > 0 && !cols.is_null() && !vals.is_null() {
+                    let cs = std::slice::from_raw_parts(cols, nz as usize);
+                    let vs = std::slice::from_raw_parts(vals, nz as usize);
+                    for (&c, &v) in cs.iter().zip(vs) {
+                        if !fixed[c as usize] && v != 0.0 {
+                            d.col.push(c as usize);
+                            d.val.push(v);
+                        }
+                    }
+                }
+                petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
+            }
+        }
+        d.start.push(d.col.len());
+    }
+    Ok(d)
+}
+
+/// Both sorted: every entry of `a` is in `b`.
+fn is_subset(a: &[PetscInt], b: &[PetscInt]) -> bool {
+    a.iter().all(|x| b.binary_search(x).is_ok())
+}
+
+impl Drop for LowRankPreconditioner {
+    fn drop(&mut self) {
+        // SAFETY: owned and destroyed once (null handles are skipped).
+        unsafe {
+            sys::MatDestroy(&mut self.factor);
+            sys::VecScatterDestroy(&mut self.pick);
+        }
+    }
+}
