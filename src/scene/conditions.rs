@@ -169,9 +169,10 @@ impl Scene {
                 .first_contact_main_tangent
                 .unwrap_or(d.first_contact_main_tangent),
             contact_schur: s.contact_schur.unwrap_or(d.contact_schur),
-            uzawa_acceleration: match s.uzawa_acceleration.unwrap_or(d.uzawa_acceleration) {
-                n if n <= crate::model::MAX_ACCELERATION => n,
-                n => {
+            uzawa_acceleration: match s.uzawa_acceleration {
+                None => d.uzawa_acceleration,
+                Some(n) if n <= crate::model::MAX_ACCELERATION => Some(n),
+                Some(n) => {
                     return Err(Bad::at(
                         &key("uzawa_acceleration"),
                         format!(
