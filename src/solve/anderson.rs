@@ -117,7 +117,7 @@ impl Anderson {
         }
         let total = reduce(local);
         let norm = total[0].sqrt();
-        let grew = m > 0 && !(norm < self.last_norm);
+        let grew = m > 0 && (norm.is_nan() || norm >= self.last_norm);
         self.last_norm = norm;
         self.last = Some((g.to_vec(), f));
         if grew {
@@ -152,6 +152,8 @@ impl Anderson {
 /// γ of the normal equations H γ = b (H_ij = Δf_i·Δf_j, b_i = Δf_i·f) from
 /// the reduced numbers; None with no history, or when H is singular to
 /// working precision (the plain update stands then).
+// Index loops read as the textbook Cholesky factorisation they are.
+#[allow(clippy::needless_range_loop)]
 fn least_squares(m: usize, total: &[f64; REDUCED]) -> Option<Vec<f64>> {
     if m == 0 {
         return None;
@@ -173,7 +175,7 @@ fn least_squares(m: usize, total: &[f64; REDUCED]) -> Option<Vec<f64>> {
         for k in 0..i {
             h[i][i] -= h[i][k] * h[i][k];
         }
-        if !(h[i][i] > 1e-12 * diag) {
+        if h[i][i].is_nan() || h[i][i] <= 1e-12 * diag {
             return None;
         }
         h[i][i] = h[i][i].sqrt();
