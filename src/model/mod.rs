@@ -17,7 +17,7 @@ pub mod wire;
 pub use conditions::{DirichletSpec, FacetLoad};
 pub use contact::{Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature};
 pub use dynamics::{DynamicsSpec, Newmark};
-pub use solver::{Reuse, SolverSettings, DEFAULT_FORCING};
+pub use solver::{Reuse, SolverSettings, DEFAULT_ACCELERATION, DEFAULT_FORCING, MAX_ACCELERATION};
 
 use crate::amplitude::Amplitude;
 use crate::fem::Material;

@@ -5,6 +5,12 @@
 /// at 1e-3 of its starting residual.
 pub const DEFAULT_FORCING: f64 = 1e-3;
 
+/// The default `[solver] uzawa_acceleration` on the Krylov path (Anderson
+/// depth; the direct path's default is 0, off).
+pub const DEFAULT_ACCELERATION: usize = 1;
+/// The largest depth `[solver] uzawa_acceleration` accepts.
+pub const MAX_ACCELERATION: usize = 3;
+
 /// Newton and load-stepping settings.
 #[derive(Debug, Clone)]
 pub struct SolverSettings {
@@ -46,6 +52,10 @@ pub struct SolverSettings {
     /// stiffness once with a Schur complement on the contact DOFs and solve
     /// each contact Jacobian through it (see `solve::schur`).
     pub contact_schur: bool,
+    /// Depth of the Anderson acceleration of the frictionless pairs'
+    /// Uzawa multiplier updates (0: off; see `solve::anderson`); None: the
+    /// default of the linear solver's path (`solve::tolerance`).
+    pub uzawa_acceleration: Option<usize>,
 }
 
 /// Work a run reuses instead of redoing.
@@ -90,6 +100,7 @@ impl Default for SolverSettings {
             first_contact_softening: 1.0,
             first_contact_main_tangent: true,
             contact_schur: true,
+            uzawa_acceleration: None,
         }
     }
 }

@@ -529,6 +529,7 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
         first_contact_softening,
         first_contact_main_tangent,
         contact_schur,
+        uzawa_acceleration,
     } = s;
     w.usize(*max_newton);
     w.f64(*rtol);
@@ -544,6 +545,8 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
     w.f64(*first_contact_softening);
     w.bool(*first_contact_main_tangent);
     w.bool(*contact_schur);
+    w.bool(uzawa_acceleration.is_some());
+    w.usize(uzawa_acceleration.unwrap_or(0));
 }
 
 fn take_solver(r: &mut Reader) -> Result<SolverSettings> {
@@ -565,6 +568,11 @@ fn take_solver(r: &mut Reader) -> Result<SolverSettings> {
         first_contact_softening: r.f64()?,
         first_contact_main_tangent: r.bool()?,
         contact_schur: r.bool()?,
+        uzawa_acceleration: {
+            let set = r.bool()?;
+            let depth = r.usize()?;
+            set.then_some(depth)
+        },
     })
 }
 

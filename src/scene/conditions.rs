@@ -169,6 +169,19 @@ impl Scene {
                 .first_contact_main_tangent
                 .unwrap_or(d.first_contact_main_tangent),
             contact_schur: s.contact_schur.unwrap_or(d.contact_schur),
+            uzawa_acceleration: match s.uzawa_acceleration {
+                None => d.uzawa_acceleration,
+                Some(n) if n <= crate::model::MAX_ACCELERATION => Some(n),
+                Some(n) => {
+                    return Err(Bad::at(
+                        &key("uzawa_acceleration"),
+                        format!(
+                            "[solver] uzawa_acceleration must be 0 (off) to {} (got {n})",
+                            crate::model::MAX_ACCELERATION
+                        ),
+                    ))
+                }
+            },
         })
     }
 }

@@ -8,6 +8,7 @@
 //!
 //! This module sits above `assembly` and `contact`: they know nothing of
 //! SNES, and only this module calls the solver.
+mod anderson;
 pub mod boundary;
 mod driver;
 pub mod dynamics;

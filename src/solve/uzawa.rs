@@ -6,6 +6,7 @@
 //! `penalty::RATE_LIMIT`); a pair still unconverged after `max_uzawa` has
 //! it raised (at most `PENALTY_RAISES` times a step) before the step counts
 //! as failed.
+use super::anderson::Anderson;
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
 use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
@@ -43,6 +44,9 @@ pub(super) struct StepContext<'s> {
     /// Whether a contact-free step's first Uzawa iteration assembles the
     /// links' main-part tangent (see `main_part_tangent`).
     pub(super) main_part_tangent: bool,
+    /// Anderson depth of the frictionless pairs' multiplier updates (0:
+    /// off; see `anderson`).
+    pub(super) acceleration: usize,
 }
 
 /// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
@@ -105,6 +109,7 @@ fn uzawa_rounds(
 ) -> Result<StepResult> {
     let softening = ctx.softening;
     let linear_floor = ctx.linear_floor;
+    let mut accel = Anderson::new(ctx.acceleration);
     let StepContext {
         snes,
         x,
@@ -162,6 +167,7 @@ fn uzawa_rounds(
         if mech.contact.is_empty() {
             return Ok(Ok((outcome, 0, Vec::new())));
         }
+        let before = accel.is_on().then(|| normal_multipliers(mech.contact));
         let stats = update_multipliers(world, stages, times, mech, x, factor)?;
         if std::mem::take(main_part) {
             // The multipliers carry the contact from here: the full tangent.
@@ -175,6 +181,7 @@ fn uzawa_rounds(
             restore_penalties(mech, softened, softening);
             k = 0;
             progress.iter_mut().for_each(Progress::forget);
+            accel.forget();
         }
         let pair_ok: Vec<bool> = mech
             .contact
@@ -194,13 +201,20 @@ fn uzawa_rounds(
                 solve_tight = true;
                 continue;
             }
-            tolerance::RoundEnd::Continue => {}
+            tolerance::RoundEnd::Continue => {
+                // Only an update that failed the test is extrapolated: a
+                // passing one stands, so the step ends on a plain update.
+                if let Some(before) = before {
+                    accelerate(world, &mut accel, before, mech.contact)?;
+                }
+            }
         }
         if rate_raises < RATE_RAISES
             && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
         {
             rate_raises += 1;
             refactor = true;
+            accel.forget();
             if let Some(lag) = mech.lag.as_mut() {
                 lag.reset();
             }
@@ -213,6 +227,7 @@ fn uzawa_rounds(
             raises += 1;
             raise_slow_penalties(mech.contact, &stats);
             progress.iter_mut().for_each(Progress::forget);
+            accel.forget();
             k = 0;
             continue;
         }
@@ -338,6 +353,44 @@ fn update_multipliers(
     let local = parallel::agree(world, updated)?;
     mark.book(Phase::UzawaUpdate, times, &mech.times, mech.contact);
     Ok(reduce_stats(world, &local))
+}
+
+/// The accelerated pairs' normal multipliers, concatenated, and whether
+/// each enters global sums.
+fn normal_multipliers(pairs: &[ContactPair]) -> (Vec<f64>, Vec<bool>) {
+    let mut values = Vec::new();
+    let mut counted = Vec::new();
+    for (v, c) in pairs.iter().filter_map(ContactPair::normal_multipliers) {
+        values.extend(v);
+        counted.extend(c);
+    }
+    (values, counted)
+}
+
+/// Collective: the Anderson step after a multiplier update that failed the
+/// test (`before` the multipliers the Newton solve used); the accelerated
+/// multipliers replace the plain update's, or it stands.
+fn accelerate(
+    world: &impl Communicator,
+    accel: &mut Anderson,
+    (before, counted): (Vec<f64>, Vec<bool>),
+    pairs: &mut [ContactPair],
+) -> Result<()> {
+    let (after, _) = normal_multipliers(pairs);
+    let Some(next) = accel.next(&before, &after, &counted, &mut |local| {
+        parallel::sum(world, local)
+    }) else {
+        return Ok(());
+    };
+    let mut rest = &next[..];
+    for p in pairs.iter_mut() {
+        if let Some((v, _)) = p.normal_multipliers() {
+            let (mine, tail) = rest.split_at(v.len());
+            p.set_normal_multipliers(mine)?;
+            rest = tail;
+        }
+    }
+    Ok(())
 }
 
 /// The penalty policy: raise the penalty of every pair still outside its

@@ -26,6 +26,11 @@ fn absurd_counts_are_refused_with_the_limit() {
             "[solver] first_contact_softening must be at least 1 (got 0.5)",
         ),
         (
+            GOOD.to_string() + "\n[solver]\nuzawa_acceleration = 4\n",
+            "uzawa_acceleration",
+            "[solver] uzawa_acceleration must be 0 (off) to 3 (got 4)",
+        ),
+        (
             stacked(&format!("{CONTACT}max_uzawa = 5000000000")),
             "max_uzawa",
             "[[contact]] 'c' max_uzawa = 5000000000 is above the limit of 10000",

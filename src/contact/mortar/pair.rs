@@ -498,6 +498,27 @@ impl MortarPair {
         stats
     }
 
+    /// λ of the nodes this rank updates (complete here; the others are
+    /// kept at 0 by the setter) and whether this rank owns them.
+    pub fn normal_multipliers(&self) -> (Vec<f64>, Vec<bool>) {
+        let counted = self
+            .complete
+            .iter()
+            .zip(&self.owned)
+            .map(|(c, o)| *c && *o)
+            .collect();
+        (self.nodal.lambda.clone(), counted)
+    }
+
+    /// Sets λ at the nodes this rank updates (the others keep theirs).
+    pub fn set_normal_multipliers(&mut self, lambda: &[f64]) {
+        for (j, l) in lambda.iter().enumerate().take(self.complete.len()) {
+            if self.complete[j] {
+                self.nodal.lambda[j] = *l;
+            }
+        }
+    }
+
     /// A converged step is final: the next one measures slip from here.
     pub fn commit(&mut self) {
         self.pending_origins = None;

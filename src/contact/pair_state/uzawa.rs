@@ -74,6 +74,41 @@ impl ContactPair {
         }
     }
 
+    /// The normal multipliers an accelerated Uzawa update works on (see
+    /// `solve::anderson`): λN of every point (links: the owned points) or
+    /// node (mortar: every node this rank updates) and whether it is owned
+    /// here (enters global sums); None with friction, whose update also
+    /// classifies stick and slip from the solved state.
+    pub fn normal_multipliers(&self) -> Option<(Vec<f64>, Vec<bool>)> {
+        if self.has_friction() {
+            return None;
+        }
+        if let Some(m) = &self.mortar {
+            return Some(m.normal_multipliers());
+        }
+        let lambda = self.multipliers.lambda.clone();
+        let owned = vec![true; lambda.len()];
+        Some((lambda, owned))
+    }
+
+    /// Replaces the normal multipliers `normal_multipliers` gave (same
+    /// length, non-negative), then refreshes the ghosts.
+    pub fn set_normal_multipliers(&mut self, lambda: &[f64]) -> Result<()> {
+        if let Some(m) = &mut self.mortar {
+            m.set_normal_multipliers(lambda);
+            return Ok(());
+        }
+        if lambda.len() != self.multipliers.lambda.len() {
+            return Err(crate::error::Error::Internal(format!(
+                "accelerated multipliers: {} values for {} points",
+                lambda.len(),
+                self.multipliers.lambda.len()
+            )));
+        }
+        self.multipliers.lambda.copy_from_slice(lambda);
+        self.multipliers.exchange()
+    }
+
     /// This rank's points in contact (λN > 0) and, of those, sliding.
     pub fn multiplier_states(&self) -> (usize, usize) {
         if let Some(m) = &self.mortar {
