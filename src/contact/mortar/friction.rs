@@ -23,7 +23,7 @@
 //! segments' `Dual<24>` gives `∂tT_j/∂x`: the slip branch, the coupling to
 //! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
 use super::system::{
-    emit_local, for_each_slave_node, merged, segment_nodes, Interface, NodalData, NodeDof,
+    emit_local, for_each_slave_node, segment_nodes, Interface, Merger, NodalData, NodeDof,
     NodeState, Seed, Segment, SEGMENT_DOFS,
 };
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
@@ -351,13 +351,14 @@ pub(super) fn emit_outer(
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
     let nn = coef.len();
+    let mut merger = Merger::new();
     for j in 0..nn {
         if coef[j].is_empty() {
             continue;
         }
-        let rows = merged(std::mem::take(&mut coef[j]));
-        for (i, g) in std::mem::take(&mut grad[j]).into_iter().enumerate() {
-            let g = merged(g);
+        let rows = merger.merged(&std::mem::take(&mut coef[j]));
+        for (i, g) in std::mem::take(&mut grad[j]).iter().enumerate() {
+            let g = merger.merged(g);
             for ((id, _), c) in &rows {
                 for (col, dt) in &g {
                     let v = c * dt;

@@ -19,6 +19,21 @@ pub(super) struct Rows {
     rows: Vec<Vec<(u32, f64)>>,
 }
 
+thread_local! {
+    /// The last tangent's row vectors, emptied, kept for the next one: their
+    /// growth was 3 % of a frictional mortar run's instructions.
+    static SPARE: std::cell::RefCell<Vec<Vec<(u32, f64)>>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+impl Drop for Rows {
+    fn drop(&mut self) {
+        let mut rows = std::mem::take(&mut self.rows);
+        rows.iter_mut().for_each(Vec::clear);
+        SPARE.with(|s| *s.borrow_mut() = rows);
+    }
+}
+
 fn pair_dof(d: NodeDof) -> usize {
     DIM * d.0 as usize + d.1
 }
@@ -26,9 +41,9 @@ fn pair_dof(d: NodeDof) -> usize {
 impl Rows {
     /// For node ids `0..nodes`.
     pub(super) fn new(nodes: usize) -> Self {
-        Rows {
-            rows: vec![Vec::new(); DIM * nodes],
-        }
+        let mut rows = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        rows.resize_with(DIM * nodes, Vec::new);
+        Rows { rows }
     }
 
     pub(super) fn add(&mut self, row: NodeDof, col: NodeDof, value: f64) {
