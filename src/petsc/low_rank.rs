@@ -16,21 +16,15 @@
 //! failed, a non-finite update) goes through the caller's agreement hook
 //! before any rank acts on it, so no rank leaves a collective call the
 //! others are still in.
-mod shell;
-use super::{comm_world, petsc_call, sys, Matrix, PetscError, PetscInt, Result, Vector};
-pub(super) use shell::install;
+pub(super) use super::shell::install;
+mod gather;
+use super::shell::{error, ShellState};
+use super::{comm_world, petsc_call, sys, Matrix, PetscInt, Result, Vector};
+use gather::gather_sorted;
 
 /// Collective: true on every rank if the flag is true on any (the caller's
 /// parallel module provides it).
 pub type AnyRank = Box<dyn Fn(bool) -> bool>;
-
-fn error(call: &'static str, message: String) -> PetscError {
-    PetscError {
-        call,
-        code: -1,
-        message,
-    }
-}
 
 fn self_comm() -> sys::MPI_Comm {
     // SAFETY: MPI is initialised while PETSc is; the handle is a constant.
@@ -45,45 +39,6 @@ fn world_rank() -> Result<i32> {
         return Err(error("MPI_Comm_rank", format!("error {code}")));
     }
     Ok(r)
-}
-
-/// Every rank's `local` indices on every rank, sorted and distinct.
-/// Collective.
-pub fn gather_sorted(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
-    let mut is: sys::IS = std::ptr::null_mut();
-    let mut all: sys::IS = std::ptr::null_mut();
-    // SAFETY: `local` is valid for its length and copied; both index sets
-    // are destroyed on every path; the gathered indices are read only
-    // between ISGetIndices and its restore.
-    let mut out = unsafe {
-        petsc_call!(ISCreateGeneral(
-            comm_world(),
-            super::to_petsc_int(local.len())?,
-            local.as_ptr(),
-            sys::PetscCopyMode_PETSC_COPY_VALUES,
-            &mut is
-        ))?;
-        let read = (|| -> Result<Vec<PetscInt>> {
-            petsc_call!(ISAllGather(is, &mut all))?;
-            let mut n: PetscInt = 0;
-            petsc_call!(ISGetLocalSize(all, &mut n))?;
-            let mut p: *const PetscInt = std::ptr::null();
-            petsc_call!(ISGetIndices(all, &mut p))?;
-            let v = if n > 0 && !p.is_null() {
-                std::slice::from_raw_parts(p, n as usize).to_vec()
-            } else {
-                Vec::new()
-            };
-            petsc_call!(ISRestoreIndices(all, &mut p))?;
-            Ok(v)
-        })();
-        sys::ISDestroy(&mut all);
-        sys::ISDestroy(&mut is);
-        read?
-    };
-    out.sort_unstable();
-    out.dedup();
-    Ok(out)
 }
 
 /// A matrix destroyed when it goes out of scope.
@@ -697,5 +652,22 @@ impl Drop for LowRankPreconditioner {
             sys::MatDestroy(&mut self.factor);
             sys::VecScatterDestroy(&mut self.pick);
         }
+    }
+}
+
+impl ShellState for LowRankPreconditioner {
+    const NAME: &'static std::ffi::CStr =
+        c"MUMPS factor of the bulk stiffness with a low-rank contact update";
+    fn set_up(&mut self, kc: &Matrix) -> Result<()> {
+        LowRankPreconditioner::set_up(self, kc)
+    }
+    fn apply(&mut self, b: &Vector, x: &mut Vector) -> Result<()> {
+        LowRankPreconditioner::apply(self, b, x)
+    }
+    fn failed(&self) -> Option<bool> {
+        Some(self.failed.is_some())
+    }
+    fn record_error(&mut self, message: String) {
+        self.last_error = Some(message);
     }
 }

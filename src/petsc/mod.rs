@@ -10,7 +10,7 @@ pub mod options;
 pub mod reason;
 pub mod scatter;
 pub mod schur;
-mod schur_shell;
+mod shell;
 pub mod signals;
 pub mod snes;
 pub mod sys;

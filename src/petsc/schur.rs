@@ -22,7 +22,8 @@
 //! tangent that makes S indefinite falls back to LDLᵀ of the whole S
 //! (LAPACK's dsytrf, as every factorisation did before; the first one too).
 use super::dense::PartialCholesky;
-use super::{petsc_call, sys, Matrix, PetscError, PetscInt, Result, Vector};
+use super::shell::{error, ShellState};
+use super::{petsc_call, sys, Matrix, PetscInt, Result, Vector};
 
 /// K factored with a dense Schur complement on the DOFs `c`.
 pub struct SchurFactor {
@@ -100,14 +101,6 @@ fn for_rows(
         }
     }
     Ok(())
-}
-
-fn error(call: &'static str, message: String) -> PetscError {
-    PetscError {
-        call,
-        code: -1,
-        message,
-    }
 }
 
 /// The Schur order of the sorted DOFs `c` by decreasing `key` (DOFs
@@ -617,7 +610,23 @@ impl SchurPreconditioner {
     }
 }
 
-pub(super) use super::schur_shell::install;
+pub(super) use super::shell::install;
+
+impl ShellState for SchurPreconditioner {
+    const NAME: &'static std::ffi::CStr = c"MUMPS Schur complement on the contact DOFs";
+    fn set_up(&mut self, kc: &Matrix) -> Result<()> {
+        SchurPreconditioner::set_up(self, kc)
+    }
+    fn apply(&mut self, b: &Vector, x: &mut Vector) -> Result<()> {
+        SchurPreconditioner::apply(self, b, x)
+    }
+    fn failed(&self) -> Option<bool> {
+        None
+    }
+    fn record_error(&mut self, message: String) {
+        self.last_error = Some(message);
+    }
+}
 
 /// Both sorted: every entry of `a` is in `b`.
 fn is_subset(a: &[PetscInt], b: &[PetscInt]) -> bool {
