@@ -272,7 +272,7 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                 if let Some(s) = r.schur.as_ref().filter(|s| !s.low_rank) {
                     let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
                     println!(
-                        "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s) ({} of them on a trailing block alone, of at most {} DOFs, after {} factorisation(s) of S0's leading block)",
+                        "  solver: {} Uzawa iterations, {} linear iterations, contact Schur complement on {} DOFs (MUMPS, 1 rank): bulk stiffness factored {} time(s) (C grew {} time(s)), Schur complement factored {} time(s) ({} of them on a trailing block alone, of at most {} DOFs, after {} factorisation(s) of S0's leading block); {} solve(s) with the sparse factor, {} with the dense Schur complement alone",
                         r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
                         linear,
                         s.dofs,
@@ -281,7 +281,9 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         s.schur_factorisations,
                         s.trailing_factorisations,
                         s.largest_trailing,
-                        s.leading_factorisations
+                        s.leading_factorisations,
+                        s.sparse_solves,
+                        s.dense_solves
                     );
                 }
                 if rt.size() > 1 {

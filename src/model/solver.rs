@@ -52,6 +52,10 @@ pub struct SolverSettings {
     /// stiffness once with a Schur complement on the contact DOFs and solve
     /// each contact Jacobian through it (see `solve::schur`).
     pub contact_schur: bool,
+    /// On the one-rank contact Schur path, Newton on the condensed contact
+    /// system (the same iterates; the interior formed once per step, see
+    /// `petsc::condensed`).
+    pub condensed_newton: bool,
     /// Depth of the Anderson acceleration of the frictionless pairs'
     /// Uzawa multiplier updates (0: off; see `solve::anderson`); None: the
     /// default of the linear solver's path (`solve::tolerance`).
@@ -100,6 +104,7 @@ impl Default for SolverSettings {
             first_contact_softening: 1.0,
             first_contact_main_tangent: true,
             contact_schur: true,
+            condensed_newton: true,
             uzawa_acceleration: None,
         }
     }

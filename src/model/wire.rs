@@ -529,6 +529,7 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
         first_contact_softening,
         first_contact_main_tangent,
         contact_schur,
+        condensed_newton,
         uzawa_acceleration,
     } = s;
     w.usize(*max_newton);
@@ -545,6 +546,7 @@ fn put_solver(w: &mut Writer, s: &SolverSettings) {
     w.f64(*first_contact_softening);
     w.bool(*first_contact_main_tangent);
     w.bool(*contact_schur);
+    w.bool(*condensed_newton);
     w.bool(uzawa_acceleration.is_some());
     w.usize(uzawa_acceleration.unwrap_or(0));
 }
@@ -568,6 +570,7 @@ fn take_solver(r: &mut Reader) -> Result<SolverSettings> {
         first_contact_softening: r.f64()?,
         first_contact_main_tangent: r.bool()?,
         contact_schur: r.bool()?,
+        condensed_newton: r.bool()?,
         uzawa_acceleration: {
             let set = r.bool()?;
             let depth = r.usize()?;

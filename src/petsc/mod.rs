@@ -1,6 +1,7 @@
 //! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers the
 //! rest of the program uses. This is the only place with `unsafe` besides MPI
 //! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
+pub mod condensed;
 pub mod dense;
 pub mod heap;
 pub mod log;
@@ -10,6 +11,7 @@ pub mod options;
 pub mod reason;
 pub mod scatter;
 pub mod schur;
+mod schur_preconditioner;
 mod shell;
 pub mod signals;
 pub mod snes;

@@ -21,25 +21,21 @@
 //! trailing block alone, in place in the Schur matrix PETSc solves with. A
 //! tangent that makes S indefinite falls back to LDLᵀ of the whole S
 //! (LAPACK's dsytrf, as every factorisation did before; the first one too).
+use super::condensed::Layout;
 use super::dense::PartialCholesky;
-use super::shell::{error, ShellState};
+use super::shell::error;
 use super::{petsc_call, sys, Matrix, PetscInt, Result, Vector};
+use std::rc::Rc;
 
 /// K factored with a dense Schur complement on the DOFs `c`.
 pub struct SchurFactor {
     factor: sys::Mat,
     is: sys::IS,
-    /// The Schur DOFs, sorted.
-    c: Vec<PetscInt>,
-    /// The position in the Schur complement (the index set's order) of
-    /// each entry of `c`.
-    pos: Vec<usize>,
-    /// Whether the DOF at each position is constrained (its row and column
-    /// are the identity's in the factored K).
-    fixed: Vec<bool>,
+    /// C, its Schur order and S0 (shared with the condensed Newton state).
+    layout: Rc<Layout>,
     cholesky: bool,
-    /// S0, column-major |C| × |C|, both triangles.
-    base: Vec<f64>,
+    /// The entries of the last tangent (Schur positions): S = S0 + these.
+    tangent: Vec<(usize, usize, f64)>,
     /// Symmetric only: S0's leading block factored, once per split.
     partial: Option<PartialCholesky>,
     /// S0's leading block was not positive definite: LDLᵀ from now on.
@@ -68,7 +64,7 @@ pub struct DenseCounts {
 }
 
 impl DenseCounts {
-    fn add(&mut self, o: DenseCounts) {
+    pub(super) fn add(&mut self, o: DenseCounts) {
         self.trailing += o.trailing;
         self.largest_trailing = self.largest_trailing.max(o.largest_trailing);
         self.leading += o.leading;
@@ -150,14 +146,18 @@ impl SchurFactor {
             pos[i] = p;
             fixed[p] = fixed_sorted[i];
         }
+        let mut base = vec![0.0; n * n];
         let mut me = SchurFactor {
             factor: std::ptr::null_mut(),
             is: std::ptr::null_mut(),
-            c,
-            pos,
-            fixed,
+            layout: Rc::new(Layout {
+                c,
+                pos,
+                fixed,
+                base: Vec::new(),
+            }),
             cholesky,
-            base: vec![0.0; n * n],
+            tangent: Vec::new(),
             partial: None,
             partial_refused: false,
             in_array: None,
@@ -220,16 +220,18 @@ impl SchurFactor {
             let read = (|| -> Result<()> {
                 let mut arr: *const f64 = std::ptr::null();
                 petsc_call!(MatDenseGetArrayRead(s0, &mut arr))?;
-                me.base
-                    .copy_from_slice(std::slice::from_raw_parts(arr, n * n));
+                base.copy_from_slice(std::slice::from_raw_parts(arr, n * n));
                 petsc_call!(MatDenseRestoreArrayRead(s0, &mut arr))?;
                 if cholesky {
-                    symmetrise(&mut me.base, n);
+                    symmetrise(&mut base, n);
                 }
                 Ok(())
             })();
             sys::MatDestroy(&mut s0);
             read?;
+        }
+        if let Some(layout) = Rc::get_mut(&mut me.layout) {
+            layout.base = base;
         }
         Ok(me)
     }
@@ -243,7 +245,7 @@ impl SchurFactor {
         if err != sys::MatFactorError_MAT_FACTOR_NOERROR {
             return Err(error(
                 "MatFactorGetError",
-                format!("the MUMPS factorisation of the bulk stiffness with a Schur complement on {} contact DOFs failed (error type {err})", self.c.len()),
+                format!("the MUMPS factorisation of the bulk stiffness with a Schur complement on {} contact DOFs failed (error type {err})", self.layout.c.len()),
             ));
         }
         Ok(())
@@ -251,14 +253,44 @@ impl SchurFactor {
 
     /// The Schur DOFs (sorted).
     pub fn dofs(&self) -> &[PetscInt] {
-        &self.c
+        &self.layout.c
+    }
+
+    /// C, its Schur order and S0.
+    pub fn layout(&self) -> &Rc<Layout> {
+        &self.layout
+    }
+
+    /// `(S0 + D) v` for `v` in Schur positions, D the last tangent.
+    pub fn times_schur(&self, v: &[f64]) -> Vec<f64> {
+        let mut out = self.layout.times_base(v);
+        for &(r, c, d) in &self.tangent {
+            out[r] += d * v[c];
+        }
+        out
+    }
+
+    /// Solves with the factored dense Schur complement alone: `rhs` and
+    /// `sol` in Schur positions (vectors of |C| entries).
+    pub fn solve_schur(&self, rhs: &Vector, sol: &mut Vector) -> Result<()> {
+        // SAFETY: valid factor whose Schur complement the last `update`
+        // factored (PETSc factors it first otherwise); vectors of the
+        // Schur size (PETSc checks).
+        unsafe {
+            petsc_call!(MatFactorSolveSchurComplement(
+                self.factor,
+                rhs.raw(),
+                sol.raw()
+            ))
+        }
     }
 
     /// The contact tangent's entries in C × C as (row, column, value) in
     /// Schur positions, without constrained rows and columns and zeros.
     fn tangent_entries(&self, kc: &Matrix) -> Result<Vec<(usize, usize, f64)>> {
         let mut out = Vec::new();
-        let (c, pos, fixed) = (&self.c, &self.pos, &self.fixed);
+        let l = &*self.layout;
+        let (c, pos, fixed) = (&l.c, &l.pos, &l.fixed);
         for_rows(kc.raw(), c.iter().copied(), |row, cols, vals| {
             let Ok(i) = c.binary_search(&row) else { return };
             let r = pos[i];
@@ -286,16 +318,18 @@ impl SchurFactor {
     pub fn update(&mut self, kc: &Matrix) -> Result<()> {
         let d = self.tangent_entries(kc)?;
         if self.cholesky && self.trailing_update(&d)? {
+            self.tangent = d;
             return Ok(());
         }
-        let n = self.c.len();
-        let mut dense = self.base.clone();
+        let n = self.layout.c.len();
+        let mut dense = self.layout.base.clone();
         for &(r, c, v) in &d {
             dense[c * n + r] += v;
         }
         // Not known to be definite: LDLᵀ (or LU) of the whole matrix.
         self.factor_whole(&dense)?;
         self.counts.whole += 1;
+        self.tangent = d;
         Ok(())
     }
 
@@ -306,7 +340,7 @@ impl SchurFactor {
     /// its solve yet), a tangent without entries, or an S that is not
     /// positive definite.
     fn trailing_update(&mut self, d: &[(usize, usize, f64)]) -> Result<bool> {
-        let n = self.c.len();
+        let n = self.layout.c.len();
         // The first factorisation is PETSc's own (it installs the dense
         // solve); the first contact tangent is often a first touch, smaller
         // than the zone the later ones settle on, so the split waits for
@@ -323,7 +357,7 @@ impl SchurFactor {
             // whole (6 % at t = n/5).
             let split = first.saturating_sub(n - first);
             self.in_array = None;
-            self.partial = PartialCholesky::new(&self.base, n, split);
+            self.partial = PartialCholesky::new(&self.layout.base, n, split);
             self.partial_refused = self.partial.is_none();
             self.counts.leading += 1;
         }
@@ -349,7 +383,7 @@ impl SchurFactor {
     /// PETSc's factorisation of the whole dense S = `dense`: LDLᵀ (dsytrf,
     /// S need not be definite) or LU (dgetrf).
     fn factor_whole(&mut self, dense: &[f64]) -> Result<()> {
-        let n = self.c.len();
+        let n = self.layout.c.len();
         let mut s: sys::Mat = std::ptr::null_mut();
         let mut status: sys::MatFactorSchurStatus = 0;
         self.in_array = None;
@@ -480,155 +514,5 @@ impl Drop for SchurFactor {
     }
 }
 
-/// What the shell preconditioner keeps: a handle on the bulk stiffness and
-/// the constrained rows, its Schur factor for the current contact DOFs, the DOFs the
-/// contact tangent may touch now, and counters.
-pub struct SchurPreconditioner {
-    k: Matrix,
-    constrained: Vec<PetscInt>,
-    cholesky: bool,
-    factor: Option<SchurFactor>,
-    wanted: Vec<PetscInt>,
-    key: Vec<(PetscInt, f64)>,
-    /// Sparse factorisations of K (the first, and one per growth of C).
-    pub bulk_factorisations: usize,
-    /// Dense factorisations of the Schur complement (one per set-up).
-    pub schur_factorisations: usize,
-    /// How they were made, for the factors dropped when C grew (see
-    /// [`Self::dense_counts`]).
-    dense: DenseCounts,
-    /// Times C had to grow.
-    pub growths: usize,
-    /// The last set-up's failure, for the report.
-    pub last_error: Option<String>,
-}
-
-impl SchurPreconditioner {
-    /// `k`: the linear bulk stiffness; `constrained`: the rows and columns
-    /// the Jacobian replaces by the identity (K is factored with the same
-    /// replacement, made on a copy that lives only while it is factored,
-    /// and the contact tangent's entries there are dropped).
-    pub fn new(k: Matrix, mut constrained: Vec<PetscInt>, cholesky: bool) -> Self {
-        constrained.sort_unstable();
-        constrained.dedup();
-        SchurPreconditioner {
-            k,
-            constrained,
-            cholesky,
-            factor: None,
-            wanted: Vec::new(),
-            key: Vec::new(),
-            bulk_factorisations: 0,
-            schur_factorisations: 0,
-            dense: DenseCounts::default(),
-            growths: 0,
-            last_error: None,
-        }
-    }
-
-    /// The DOFs the contact tangent may touch from now on (any order,
-    /// repeats allowed): C grows at the next set-up if they are not in it.
-    pub fn want(&mut self, mut dofs: Vec<PetscInt>) {
-        dofs.sort_unstable();
-        dofs.dedup();
-        self.wanted = dofs;
-    }
-
-    /// An order key for the DOFs of C (smallest: most likely to be touched
-    /// by a contact tangent, such as the distance to the other body), used
-    /// when C is next formed.
-    pub fn order_by(&mut self, mut key: Vec<(PetscInt, f64)>) {
-        key.sort_by_key(|e| e.0);
-        key.dedup_by_key(|e| e.0);
-        self.key = key;
-    }
-
-    /// |C| of the current factor (0 before the first).
-    pub fn schur_size(&self) -> usize {
-        self.factor.as_ref().map_or(0, |f| f.dofs().len())
-    }
-
-    /// How the dense Schur complements were factored, over the run.
-    pub fn dense_counts(&self) -> DenseCounts {
-        let mut d = self.dense;
-        if let Some(f) = &self.factor {
-            d.add(f.counts);
-        }
-        d
-    }
-
-    /// Set-up for the Jacobian K + `kc`, from the contact tangent `kc`
-    /// alone: K factored again only when C must grow.
-    pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
-        let grow = match &self.factor {
-            None => true,
-            Some(f) => !is_subset(&self.wanted, f.dofs()),
-        };
-        if grow {
-            let mut c: Vec<PetscInt> = self.wanted.clone();
-            if let Some(f) = &self.factor {
-                c.extend_from_slice(f.dofs());
-                self.growths += 1;
-            }
-            c.sort_unstable();
-            c.dedup();
-            if c.is_empty() {
-                // No contact coupling yet: any one DOF makes a (trivial) C.
-                c.push(0);
-            }
-            if let Some(old) = self.factor.take() {
-                self.dense.add(old.counts);
-            }
-            let mut kd = self.k.duplicate()?;
-            kd.zero_rows_columns_identity(&self.constrained)?;
-            self.factor = Some(SchurFactor::new(
-                &kd,
-                c,
-                &self.constrained,
-                self.cholesky,
-                &self.key,
-            )?);
-            self.bulk_factorisations += 1;
-        }
-        let f = self
-            .factor
-            .as_mut()
-            .ok_or_else(|| error("SchurPreconditioner::set_up", "no factor".into()))?;
-        f.update(kc)?;
-        self.schur_factorisations += 1;
-        Ok(())
-    }
-
-    pub fn apply(&self, b: &Vector, x: &mut Vector) -> Result<()> {
-        match &self.factor {
-            Some(f) => f.solve(b, x),
-            None => Err(error(
-                "SchurPreconditioner::apply",
-                "applied before its set-up".into(),
-            )),
-        }
-    }
-}
-
+pub use super::schur_preconditioner::SchurPreconditioner;
 pub(super) use super::shell::install;
-
-impl ShellState for SchurPreconditioner {
-    const NAME: &'static std::ffi::CStr = c"MUMPS Schur complement on the contact DOFs";
-    fn set_up(&mut self, kc: &Matrix) -> Result<()> {
-        SchurPreconditioner::set_up(self, kc)
-    }
-    fn apply(&mut self, b: &Vector, x: &mut Vector) -> Result<()> {
-        SchurPreconditioner::apply(self, b, x)
-    }
-    fn failed(&self) -> Option<bool> {
-        None
-    }
-    fn record_error(&mut self, message: String) {
-        self.last_error = Some(message);
-    }
-}
-
-/// Both sorted: every entry of `a` is in `b`.
-fn is_subset(a: &[PetscInt], b: &[PetscInt]) -> bool {
-    a.iter().all(|x| b.binary_search(x).is_ok())
-}

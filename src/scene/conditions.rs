@@ -169,6 +169,7 @@ impl Scene {
                 .first_contact_main_tangent
                 .unwrap_or(d.first_contact_main_tangent),
             contact_schur: s.contact_schur.unwrap_or(d.contact_schur),
+            condensed_newton: s.condensed_newton.unwrap_or(d.condensed_newton),
             uzawa_acceleration: match s.uzawa_acceleration {
                 None => d.uzawa_acceleration,
                 Some(n) if n <= crate::model::MAX_ACCELERATION => Some(n),

@@ -320,6 +320,8 @@ pub struct SolverSection {
     pub first_contact_main_tangent: Option<bool>,
     /// Bulk factored once, contact solved on its Schur complement (default true).
     pub contact_schur: Option<bool>,
+    /// Newton on the condensed contact system on the Schur path (default true).
+    pub condensed_newton: Option<bool>,
     /// Anderson depth of the frictionless Uzawa updates (0: off).
     pub uzawa_acceleration: Option<usize>,
 }

@@ -161,6 +161,9 @@ impl<'m> Simulation<'m> {
             if let Some(k) = mech.separate_stiffness() {
                 schur::install(&mut snes, k, mech.dirichlet, tangent, rt.size())?;
                 mech.always_rebuild = true;
+                if model.solver.condensed_newton {
+                    mech.condensed = snes.schur_mut().map(|s| s.condense());
+                }
             }
         }
         let base = 1.0 / model.steps.max(1) as f64;

@@ -44,6 +44,11 @@ pub struct SchurSummary {
     pub trailing_factorisations: usize,
     pub largest_trailing: usize,
     pub leading_factorisations: usize,
+    /// One rank: solves with the sparse factor (condensation and
+    /// expansion), and with the dense Schur complement alone (the
+    /// condensed Newton steps).
+    pub sparse_solves: usize,
+    pub dense_solves: usize,
     /// Several ranks: K's factor with a low-rank update (`schur_factorisations`
     /// counts the dense LUs of I + D G; G is formed 1 + growths times).
     pub low_rank: bool,
@@ -230,6 +235,8 @@ pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
                 trailing_factorisations: d.trailing,
                 largest_trailing: d.largest_trailing,
                 leading_factorisations: d.leading,
+                sparse_solves: s.sparse_solves,
+                dense_solves: s.dense_solves,
                 ..SchurSummary::default()
             }
         })

@@ -78,7 +78,15 @@ pub(super) fn uzawa_loop(
         softening > 1.0 && !frictional && soften_first_contact(world, mech.contact, softening);
     let mut main_part =
         ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
-    let result = uzawa_rounds(
+    // The condensed Newton iterates are the whole vector's only with no
+    // step-length test (stol compares norms of the whole x and step).
+    let condensed = stol == 0.0 && ctx.snes.schur().is_some();
+    if condensed {
+        if let Some(s) = ctx.snes.schur_mut() {
+            s.arm(ctx.x)?;
+        }
+    }
+    let mut result = uzawa_rounds(
         world,
         ctx,
         mech,
@@ -87,6 +95,17 @@ pub(super) fn uzawa_loop(
         (stol, max_it),
         (&mut softened, &mut main_part),
     );
+    if let Some(s) = ctx.snes.schur_mut() {
+        // The converged step's interior, formed once (a failed one is
+        // dropped: the step starts again from the last converged state).
+        if matches!(result, Ok(Ok(_))) {
+            let expanded = s.expand(ctx.x);
+            if let Err(e) = expanded {
+                result = Err(e.into());
+            }
+        }
+        s.disarm();
+    }
     restore_penalties(mech, &mut softened, softening);
     if main_part {
         main_part_tangent(world, mech.contact, false);
