@@ -217,6 +217,13 @@ fn same_run(rt: &Runtime, scene: &str, overrides: &[&str]) {
         "{scene}: contact_schur = false ignored"
     );
     assert_eq!(s.bulk_factorisations, 1 + s.growths, "{scene}: {s:?}");
+    // Newton on the condensed system (the default): per step one sparse
+    // solve for its first Newton iteration and one forming the interior,
+    // every other Newton iteration a dense solve on C.
+    let steps = on.steps.len();
+    let newton_on: usize = on.steps.iter().map(|s| s.newton_iterations).sum();
+    assert_eq!(s.sparse_solves, 2 * steps, "{scene}: {s:?}");
+    assert_eq!(s.dense_solves, newton_on - steps, "{scene}: {s:?}");
     let e = rel_err(&on.displacement, &off.displacement);
     assert!(e < 1e-9, "{scene}: displacement differs by {e:.3e}");
     let (a, b) = (on.steps.last().unwrap(), off.steps.last().unwrap());
@@ -262,6 +269,7 @@ fn schur_path() {
     small_matrices();
     partial_factorisations();
     same_run(&rt, "hertz-cylinder", &["mesh.fine_size=0.4"]);
+    whole_newton_same_iterates(&rt);
     // Coulomb friction (LU), two load steps (a second search and pattern).
     same_run(
         &rt,
@@ -272,4 +280,39 @@ fn schur_path() {
             "steps.count=2",
         ],
     );
+}
+
+/// The Schur path with Newton on the whole vector (`condensed_newton =
+/// false`) takes the iterates of the condensed one: the same Newton
+/// residuals to roundoff (the last ones are at its floor, about 1e-14 of
+/// the first) and the same displacement.
+fn whole_newton_same_iterates(rt: &Runtime) {
+    let run = |condensed: bool| {
+        let o = vec![
+            "mesh.fine_size=0.4".to_string(),
+            format!("solver.condensed_newton={condensed}"),
+        ];
+        let model = pipeline::load_model("hertz-cylinder", &o).unwrap().0;
+        pipeline::run_model(rt, &model, None, false).unwrap().report
+    };
+    let (on, off) = (run(true), run(false));
+    let (a, b) = (on.schur.unwrap(), off.schur.unwrap());
+    assert_eq!(b.dense_solves, 0, "{b:?}");
+    assert!(
+        a.dense_solves > 0 && a.sparse_solves < b.sparse_solves,
+        "{a:?} {b:?}"
+    );
+    let e = rel_err(&on.displacement, &off.displacement);
+    assert!(e < 1e-9, "displacement differs by {e:.3e}");
+    let (ha, hb) = (
+        &on.steps[0].residual_history,
+        &off.steps[0].residual_history,
+    );
+    assert_eq!(ha.len(), hb.len());
+    for (x, y) in ha.iter().zip(hb) {
+        assert!(
+            (x - y).abs() <= 1e-6 * y.abs() + 1e-12 * hb[0],
+            "{ha:?}\n{hb:?}"
+        );
+    }
 }
