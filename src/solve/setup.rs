@@ -248,7 +248,7 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
     // the local mesh stays for the near-null space, the dynamics and the
     // output.
     local.slaves = Vec::new();
-    let jac = build_jacobian(&dofs, &bulk, &loads, &[], &local)?;
+    let jac = build_jacobian(&dofs, Some((&bulk, &loads)), &[], &local)?;
     crate::footprint::checkpoint("Jacobian allocation");
     crate::footprint::setup_finished();
     Ok(SetUp {
@@ -267,14 +267,15 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
 /// follower loads and every link's candidate master patch.
 pub(super) fn build_jacobian(
     dofs: &DofMap,
-    bulk: &BulkAssembler,
-    loads: &SurfaceLoads,
+    bulk: Option<(&BulkAssembler, &SurfaceLoads)>,
     contact: &[ContactPair],
     mesh: &LocalMesh,
 ) -> Result<Matrix> {
     let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
-    bulk.add_pattern(&mut pattern)?;
-    loads.add_pattern(&mut pattern)?;
+    if let Some((bulk, loads)) = bulk {
+        bulk.add_pattern(&mut pattern)?;
+        loads.add_pattern(&mut pattern)?;
+    }
     for pair in contact {
         pair.add_pattern(dofs, &mut pattern)?;
     }
