@@ -124,6 +124,12 @@ impl<'a> Mechanics<'a> {
                     me.bulk_tangent_assemblies += 1;
                     Some(LinearStiffness::Separate(stiffness::separate(dofs, bulk)?))
                 }
+                KeepStiffness::SeparateIn(fresh) => {
+                    me.bulk_tangent_assemblies += 1;
+                    Some(LinearStiffness::Separate(stiffness::separate_in(
+                        fresh, dofs, bulk,
+                    )?))
+                }
             };
         }
         Ok(me)

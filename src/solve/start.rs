@@ -49,6 +49,11 @@ pub(super) fn mechanics<'a>(
     let constant = contact.is_empty() && model.dynamics.is_none() && !loads.has_follower();
     let keep = match (model.solver.reuse.linear_stiffness, constant) {
         (false, _) => KeepStiffness::No,
+        // The first contact search builds the Jacobian its own pattern, so
+        // set-up's, of the bulk pattern and still without values, can hold
+        // K (line b/10: 1.1e8 of 1.95e9 instructions in the solve were
+        // K's own pattern).
+        (true, false) if !contact.is_empty() => KeepStiffness::SeparateIn(jac),
         (true, false) => KeepStiffness::Separate,
         (true, true) => KeepStiffness::InJacobian(jac),
     };

@@ -20,6 +20,10 @@ pub enum KeepStiffness<'j> {
     No,
     /// In a matrix of its own.
     Separate,
+    /// In this fresh matrix of the bulk pattern (set-up's Jacobian, which
+    /// the first contact search replaces before any Jacobian is formed),
+    /// which becomes K's own.
+    SeparateIn(&'j Matrix),
     /// In this Jacobian matrix, which nothing else is ever added to.
     InJacobian(&'j Matrix),
 }
@@ -47,6 +51,15 @@ pub(super) fn separate(dofs: &DofMap, bulk: &BulkAssembler) -> Result<Matrix> {
     let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
     bulk.add_pattern(&mut pattern)?;
     let mut k = pattern.build()?;
+    add_at_rest(dofs, bulk, &mut k)?;
+    k.assemble()?;
+    Ok(k)
+}
+
+/// K assembled into `fresh` (a handle on it is kept): a matrix of the bulk
+/// pattern with no values yet and no other user, so no pattern is built.
+pub(super) fn separate_in(fresh: &Matrix, dofs: &DofMap, bulk: &BulkAssembler) -> Result<Matrix> {
+    let mut k = fresh.share()?;
     add_at_rest(dofs, bulk, &mut k)?;
     k.assemble()?;
     Ok(k)
