@@ -12,15 +12,23 @@
 //! the one-rank path uses, is sequential; this path uses only an ordinary
 //! parallel MUMPS factor. K is parallel; G, D and M live on rank 0.
 //!
+//! K stands for K + A throughout, A a diagonal shift on the first C, with
+//! D for D − A (the same J; see `bulk`): K alone is singular when a body is
+//! held by contact only.
+//!
 //! Every decision one rank could take alone (C must grow, a factorisation
 //! failed, a non-finite update) goes through the caller's agreement hook
 //! before any rank acts on it, so no rank leaves a collective call the
 //! others are still in.
 pub(super) use super::shell::install;
+mod bulk;
 mod gather;
+mod inverse;
+mod sparse;
 use super::shell::{error, ShellState};
 use super::{comm_world, petsc_call, sys, Matrix, PetscInt, Result, Vector};
 use gather::gather_sorted;
+use sparse::{read_sparse, Sparse};
 
 /// Collective: true on every rank if the flag is true on any (the caller's
 /// parallel module provides it).
@@ -53,26 +61,6 @@ impl Drop for OwnedMat {
     }
 }
 
-/// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
-/// start[i]..start[i + 1] (positions in C; constrained rows and columns
-/// dropped).
-#[derive(Default)]
-struct Sparse {
-    start: Vec<usize>,
-    col: Vec<usize>,
-    val: Vec<f64>,
-}
-
-impl Sparse {
-    fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let r = self.start[i]..self.start[i + 1];
-        self.col[r.clone()]
-            .iter()
-            .copied()
-            .zip(self.val[r].iter().copied())
-    }
-}
-
 /// The shell preconditioner's state (see the module's comment).
 pub struct LowRankPreconditioner {
     k: Matrix,
@@ -92,6 +80,10 @@ pub struct LowRankPreconditioner {
     /// Sequential, |C| entries on rank 0 and none elsewhere.
     small: Option<Vector>,
     rhs: Option<Vector>,
+    /// A, the diagonal shift of K's factor (K' = K + A; see `bulk`), in
+    /// K's layout, and on rank 0 at C's positions (D's update carries −A).
+    shift: Option<Vector>,
+    shift_c: Vec<f64>,
     /// Work vectors in K's layout.
     z: Option<Vector>,
     t: Option<Vector>,
@@ -154,6 +146,8 @@ impl LowRankPreconditioner {
             pick: std::ptr::null_mut(),
             small: None,
             rhs: None,
+            shift: None,
+            shift_c: Vec::new(),
             z: None,
             t: None,
             g: Vec::new(),
@@ -188,24 +182,19 @@ impl LowRankPreconditioner {
     /// when C must grow. Collective.
     pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
         self.failed = None;
+        let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
+        let grown = (self.any_rank)(grow).then(|| self.grown_c());
         if self.factor.is_null() {
-            self.factor_bulk()?;
+            // K' is shifted on the first C (see `bulk`).
+            let first = grown.clone().unwrap_or_else(|| self.c.clone());
+            self.factor_bulk(&first)?;
             if self.failed.is_some() {
                 return Ok(());
             }
         }
-        let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
-        if (self.any_rank)(grow) {
+        if let Some(c) = grown {
             if !self.c.is_empty() {
                 self.growths += 1;
-            }
-            let mut c = self.wanted.clone();
-            c.extend_from_slice(&self.c);
-            c.sort_unstable();
-            c.dedup();
-            if c.is_empty() {
-                // No contact coupling yet: any one DOF makes a (trivial) C.
-                c.push(0);
             }
             let t0 = cpu_seconds();
             self.form_inverse(c)?;
@@ -217,52 +206,17 @@ impl LowRankPreconditioner {
         r
     }
 
-    /// K (with the Dirichlet replacement) factored by MUMPS: LDLᵀ, K being
-    /// symmetric on this path whatever the contact tangent is.
-    fn factor_bulk(&mut self) -> Result<()> {
-        let mut kd = self.k.duplicate()?;
-        kd.zero_rows_columns_identity(&self.constrained)?;
-        let mut right: sys::Vec = std::ptr::null_mut();
-        let mut left: sys::Vec = std::ptr::null_mut();
-        // SAFETY: `kd` is a valid assembled matrix; the factor is owned by
-        // `self` (destroyed in Drop); the work vectors are handed to owning
-        // wrappers at once.
-        unsafe {
-            petsc_call!(MatCreateVecs(kd.raw(), &mut right, &mut left))?;
-            self.z = Some(Vector::owned_from_raw(right));
-            self.t = Some(Vector::owned_from_raw(left));
-            petsc_call!(MatGetFactor(
-                kd.raw(),
-                c"mumps".as_ptr(),
-                sys::MatFactorType_MAT_FACTOR_CHOLESKY,
-                &mut self.factor
-            ))?;
-            let mut info = sys::MatFactorInfo::default();
-            petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            petsc_call!(MatCholeskyFactorSymbolic(
-                self.factor,
-                kd.raw(),
-                std::ptr::null_mut(),
-                &info
-            ))?;
-            petsc_call!(MatCholeskyFactorNumeric(self.factor, kd.raw(), &info))?;
-            // MUMPS reports a failed factorisation through the factor's
-            // error type (from its global INFOG, so alike on every rank);
-            // agreed all the same.
-            let mut err: sys::MatFactorError = 0;
-            petsc_call!(MatFactorGetError(self.factor, &mut err))?;
-            let failed = err != sys::MatFactorError_MAT_FACTOR_NOERROR;
-            if (self.any_rank)(failed) {
-                // Tried again at the next set-up.
-                sys::MatDestroy(&mut self.factor);
-                self.failed = Some(format!(
-                    "the MUMPS factorisation of the bulk stiffness failed (error type {err} here)"
-                ));
-                return Ok(());
-            }
+    /// C with the wanted DOFs added (the same on every rank).
+    fn grown_c(&self) -> Vec<PetscInt> {
+        let mut c = self.wanted.clone();
+        c.extend_from_slice(&self.c);
+        c.sort_unstable();
+        c.dedup();
+        if c.is_empty() {
+            // No contact coupling yet: any one DOF makes a (trivial) C.
+            c.push(0);
         }
-        self.bulk_factorisations += 1;
-        Ok(())
+        c
     }
 
     /// C becomes `c`: the scatter onto rank 0 and G = Pᵀ K⁻¹ P, |C| solves
@@ -317,118 +271,12 @@ impl LowRankPreconditioner {
             sys::ISDestroy(&mut to);
             made?;
         }
+        self.shift_c = match (&self.shift, &mut self.small) {
+            (Some(v), Some(small)) => at_c(self.pick, v, small)?,
+            _ => Vec::new(),
+        };
         self.inverse_entries(rows)?;
         self.inverse_blocks += 1;
-        Ok(())
-    }
-
-    /// G's entries by MUMPS's selected inverse (ICNTL(30)): the pattern
-    /// C × C of K⁻¹ requested on rank 0 as the transpose of a sparse
-    /// right-hand side, so MUMPS prunes its solves to the tree paths of C
-    /// (whole solves with |C| unit right-hand sides cost 1.99e11 flops per
-    /// rank at hertz-cylinder h = 0.2, against 4.9e9 for the 14 solves of
-    /// the run). The request is an N × N matrix held on rank 0 whose row c
-    /// lists C: K⁻¹'s column c at the rows of C.
-    fn inverse_entries(&mut self, rows: PetscInt) -> Result<()> {
-        let n = self.c.len();
-        let here = if self.root { rows } else { 0 };
-        let nn = super::to_petsc_int(n)?;
-        let lengths: Vec<PetscInt> = if self.root {
-            let mut l = vec![0; rows as usize];
-            for &d in &self.c {
-                l[d as usize] = nn;
-            }
-            l
-        } else {
-            Vec::new()
-        };
-        let ones = vec![1.0; n];
-        let mut bt = OwnedMat(std::ptr::null_mut());
-        // SAFETY: the request matrix is owned by its guard; `lengths` holds
-        // one entry per local row and the rows set are local (rank 0 owns
-        // every row and column); MUMPS writes the entries into its values;
-        // each row is read between MatGetRow and its restore. ICNTL(30) and
-        // ICNTL(21) are put back to what MatSolve expects (PETSc leaves the
-        // selected-inverse mode and a centralised solution set).
-        unsafe {
-            petsc_call!(MatCreateAIJ(
-                comm_world(),
-                here,
-                here,
-                rows,
-                rows,
-                0,
-                if self.root {
-                    lengths.as_ptr()
-                } else {
-                    std::ptr::null()
-                },
-                0,
-                std::ptr::null(),
-                &mut bt.0
-            ))?;
-            if self.root {
-                for &d in &self.c {
-                    petsc_call!(MatSetValues(
-                        bt.0,
-                        1,
-                        &d,
-                        nn,
-                        self.c.as_ptr(),
-                        ones.as_ptr(),
-                        sys::InsertMode_INSERT_VALUES
-                    ))?;
-                }
-            }
-            petsc_call!(MatAssemblyBegin(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            let got = petsc_call!(MatMumpsGetInverseTranspose(self.factor, bt.0));
-            petsc_call!(MatMumpsSetIcntl(self.factor, 30, 0))?;
-            petsc_call!(MatMumpsSetIcntl(self.factor, 21, 1))?;
-            got?;
-        }
-        let local = (|| -> Result<()> {
-            if !self.root {
-                return Ok(());
-            }
-            // SAFETY: rank 0 reads its own rows of the assembled request,
-            // each between MatGetRow and its restore.
-            unsafe {
-                for (j, &d) in self.c.iter().enumerate() {
-                    let mut nz: PetscInt = 0;
-                    let mut cols: *const PetscInt = std::ptr::null();
-                    let mut vals: *const f64 = std::ptr::null();
-                    petsc_call!(MatGetRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
-                    let ok = nz == nn && !vals.is_null();
-                    if ok {
-                        let vs = std::slice::from_raw_parts(vals, n);
-                        self.g[j * n..(j + 1) * n].copy_from_slice(vs);
-                    }
-                    petsc_call!(MatRestoreRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
-                    if !ok {
-                        return Err(error(
-                            "MatMumpsGetInverseTranspose",
-                            format!("row {d} of the inverse entries has {nz} of {n} entries"),
-                        ));
-                    }
-                }
-            }
-            Ok(())
-        })();
-        let failed = (self.any_rank)(local.is_err());
-        local?;
-        if failed {
-            return Err(error(
-                "MatMumpsGetInverseTranspose",
-                "reading the inverse entries failed on rank 0".into(),
-            ));
-        }
         Ok(())
     }
 
@@ -461,7 +309,7 @@ impl LowRankPreconditioner {
             sys::ISDestroy(&mut is);
             made?;
             let read = if self.root && !subs.is_null() {
-                read_sparse(*subs, &self.fixed)
+                read_sparse(*subs, &self.fixed, &self.shift_c)
             } else {
                 Ok(Sparse::default())
             };
@@ -585,6 +433,13 @@ impl LowRankPreconditioner {
     }
 }
 
+/// `v` (K's layout) at C's positions on rank 0 (empty elsewhere), through
+/// `small`. Collective.
+fn at_c(pick: sys::VecScatter, v: &Vector, small: &mut Vector) -> Result<Vec<f64>> {
+    scatter(pick, v.raw(), small.raw(), false)?;
+    small.with_array(|a| a.to_vec())
+}
+
 /// The forward scatter (full → C entries, inserting) or the reverse one
 /// (C entries added into the full vector). Collective.
 fn scatter(s: sys::VecScatter, from: sys::Vec, to: sys::Vec, reverse: bool) -> Result<()> {
@@ -602,42 +457,6 @@ fn scatter(s: sys::VecScatter, from: sys::Vec, to: sys::Vec, reverse: bool) -> R
         petsc_call!(VecScatterBegin(s, from, to, add, mode))?;
         petsc_call!(VecScatterEnd(s, from, to, add, mode))
     }
-}
-
-/// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
-/// columns.
-fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
-    let mut d = Sparse {
-        start: vec![0],
-        ..Sparse::default()
-    };
-    for (row, &skip) in fixed.iter().enumerate() {
-        if !skip {
-            let mut nz: PetscInt = 0;
-            let mut cols: *const PetscInt = std::ptr::null();
-            let mut vals: *const f64 = std::ptr::null();
-            // SAFETY: `m` is a valid assembled sequential matrix with
-            // fixed.len() rows; the row's pointers are read only between
-            // MatGetRow and the paired MatRestoreRow, `nz` entries each.
-            unsafe {
-                let r = row as PetscInt;
-                petsc_call!(MatGetRow(m, r, &mut nz, &mut cols, &mut vals))?;
-                if nz > 0 && !cols.is_null() && !vals.is_null() {
-                    let cs = std::slice::from_raw_parts(cols, nz as usize);
-                    let vs = std::slice::from_raw_parts(vals, nz as usize);
-                    for (&c, &v) in cs.iter().zip(vs) {
-                        if !fixed[c as usize] && v != 0.0 {
-                            d.col.push(c as usize);
-                            d.val.push(v);
-                        }
-                    }
-                }
-                petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
-            }
-        }
-        d.start.push(d.col.len());
-    }
-    Ok(d)
 }
 
 /// Both sorted: every entry of `a` is in `b`.

@@ -21,7 +21,6 @@ use crate::contact::ContactPair;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
-use crate::model::contact::Formulation;
 use crate::model::Model;
 use crate::parallel;
 use crate::petsc::low_rank::LowRankPreconditioner;
@@ -65,17 +64,7 @@ pub(super) fn applies(
     let world = mpi::topology::SimpleCommunicator::world();
     let follower = parallel::any_rank(&world, loads.has_follower());
     let s = &model.solver;
-    // The several-rank path (a low-rank update of K's factor) is checked
-    // against the full factorisation with contact links only; with a mortar
-    // pair on 2 ranks its first solve diverged (tests/mortar.rs), not yet
-    // understood, so mortar pairs keep the full factorisation there.
-    let mortar = model
-        .contact
-        .iter()
-        .any(|p| p.formulation == Formulation::Mortar);
-    let several = mpi::traits::Communicator::size(&world) > 1;
     s.contact_schur
-        && !(several && mortar)
         && tangent.contact
         && tangent.linear_bulk
         && global_dofs <= s.direct_max_dofs

@@ -1,0 +1,75 @@
+//! The contact tangent D on C, on rank 0, as compressed rows.
+use super::super::{petsc_call, sys, PetscInt, Result};
+
+/// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
+/// start[i]..start[i + 1] (positions in C; constrained rows and columns
+/// dropped).
+#[derive(Default)]
+pub(super) struct Sparse {
+    pub(super) start: Vec<usize>,
+    pub(super) col: Vec<usize>,
+    pub(super) val: Vec<f64>,
+}
+
+impl Sparse {
+    pub(super) fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.start[i]..self.start[i + 1];
+        self.col[r.clone()]
+            .iter()
+            .copied()
+            .zip(self.val[r].iter().copied())
+    }
+
+    /// Adds `v` at column `col` of the row being read (after its last
+    /// `start`).
+    fn add_to_last_row(&mut self, col: usize, v: f64) {
+        let from = self.start.last().copied().unwrap_or(0);
+        match self.col[from..].iter().position(|&c| c == col) {
+            Some(k) => self.val[from + k] += v,
+            None => {
+                self.col.push(col);
+                self.val.push(v);
+            }
+        }
+    }
+}
+
+/// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
+/// columns, minus `shift` on the diagonal (none when empty).
+pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool], shift: &[f64]) -> Result<Sparse> {
+    let mut d = Sparse {
+        start: vec![0],
+        ..Sparse::default()
+    };
+    for (row, &skip) in fixed.iter().enumerate() {
+        if !skip {
+            let mut nz: PetscInt = 0;
+            let mut cols: *const PetscInt = std::ptr::null();
+            let mut vals: *const f64 = std::ptr::null();
+            // SAFETY: `m` is a valid assembled sequential matrix with
+            // fixed.len() rows; the row's pointers are read only between
+            // MatGetRow and the paired MatRestoreRow, `nz` entries each.
+            unsafe {
+                let r = row as PetscInt;
+                petsc_call!(MatGetRow(m, r, &mut nz, &mut cols, &mut vals))?;
+                if nz > 0 && !cols.is_null() && !vals.is_null() {
+                    let cs = std::slice::from_raw_parts(cols, nz as usize);
+                    let vs = std::slice::from_raw_parts(vals, nz as usize);
+                    for (&c, &v) in cs.iter().zip(vs) {
+                        if !fixed[c as usize] && v != 0.0 {
+                            d.col.push(c as usize);
+                            d.val.push(v);
+                        }
+                    }
+                }
+                petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
+            }
+            let s = shift.get(row).copied().unwrap_or(0.0);
+            if s != 0.0 {
+                d.add_to_last_row(row, -s);
+            }
+        }
+        d.start.push(d.col.len());
+    }
+    Ok(d)
+}
