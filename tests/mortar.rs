@@ -227,6 +227,21 @@ fn deviation(p: &[f64]) -> (f64, f64) {
     (mean, dev)
 }
 
+/// Where `try_case` writes a run's results (its scene beside them).
+fn output_path(
+    dir: &Path,
+    case: &Case,
+    formulation: &str,
+    ranks: usize,
+    extra: &[&str],
+) -> std::path::PathBuf {
+    dir.join(format!(
+        "{}-{formulation}-{ranks}{}.h5",
+        case.name.replace([' ', ','], "_"),
+        extra.concat().replace(['.', '='], "_")
+    ))
+}
+
 /// The slave's nodal pressures, the pair's force and the run's output
 /// text, or the error text. `extra`: the run's further arguments.
 fn try_case(
@@ -236,13 +251,10 @@ fn try_case(
     ranks: usize,
     extra: &[&str],
 ) -> Result<(Vec<f64>, Vec<f64>, String), String> {
-    let tag = format!(
-        "{}-{formulation}-{ranks}{}",
-        case.name.replace([' ', ','], "_"),
-        extra.concat().replace(['.', '='], "_")
-    );
-    let scene = write(dir, &format!("{tag}.toml"), &case.scene(formulation));
-    let out = dir.join(format!("{tag}.h5"));
+    let out = output_path(dir, case, formulation, ranks, extra);
+    let name = out.with_extension("toml");
+    let name = name.file_name().expect("a file name").to_string_lossy();
+    let scene = write(dir, &name, &case.scene(formulation));
     let o = mpirun(
         ranks,
         &[
@@ -331,8 +343,10 @@ fn mortar_writes_nodal_multipliers_weighted_gaps_and_tractions() {
     let dir = scratch("mortar-output");
     let case = &CASES[0];
     let (p, _) = run_case(&dir, case, "mortar", 2);
-    let tag = format!("{}-mortar-2", case.name.replace([' ', ','], "_"));
-    let fields = mortar_fields(&dir.join(format!("{tag}.h5")), case.slave().0);
+    let fields = mortar_fields(
+        &output_path(&dir, case, "mortar", 2, &["-q"]),
+        case.slave().0,
+    );
     assert_eq!(fields.len(), p.len());
     for ((lambda, gap, t), p) in fields.iter().zip(&p) {
         // λ is the nodal contact pressure; the upper block's bottom is

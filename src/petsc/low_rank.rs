@@ -3,7 +3,7 @@
 //! contact DOFs C, P the columns of the identity on C) by a low-rank update
 //! of K's factor, which needs no D⁻¹:
 //!
-//!   G = Pᵀ K⁻¹ P (|C| unit right-hand sides, once per C),
+//!   G = Pᵀ K⁻¹ P (selected entries of K⁻¹),
 //!   M = I + D G  (dense, LU per Jacobian),
 //!   x = K⁻¹ (b − P M⁻¹ D (K⁻¹ b)_C)  (two solves with K's factor).
 //!
@@ -12,9 +12,15 @@
 //! the one-rank path uses, is sequential; this path uses only an ordinary
 //! parallel MUMPS factor. K is parallel; G, D and M live on rank 0.
 //!
-//! K stands for K + A throughout, A a diagonal shift on the first C, with
-//! D for D − A (the same J; see `bulk`): K alone is singular when a body is
-//! held by contact only.
+//! Only the DOFs U that D touches matter: a row of M outside U is the
+//! identity's and its right-hand side zero, so M⁻¹ D z_C is M_UU⁻¹ (D z_C)_U
+//! and needs G on U × U alone. The contact zone is a part of C (hertz-
+//! cylinder h = 0.1: 200 of |C| = 972 DOFs over the run), so G's columns are computed as U first
+//! takes them (`inverse`) and each set-up factors M_UU only (`update`).
+//!
+//! K stands for K + A throughout, A a diagonal shift on the DOFs the first
+//! tangent touches, with D for D − A (the same J; see `bulk`): K alone is
+//! singular when a body is held by contact only.
 //!
 //! Every decision one rank could take alone (C must grow, a factorisation
 //! failed, a non-finite update) goes through the caller's agreement hook
@@ -25,10 +31,11 @@ mod bulk;
 mod gather;
 mod inverse;
 mod sparse;
+mod update;
 use super::shell::{error, ShellState};
-use super::{comm_world, petsc_call, sys, Matrix, PetscInt, Result, Vector};
+use super::{comm_world, petsc_call, sys, LogStage, Matrix, PetscInt, Result, Vector};
 use gather::gather_sorted;
-use sparse::{read_sparse, Sparse};
+use sparse::Sparse;
 
 /// Collective: true on every rank if the flag is true on any (the caller's
 /// parallel module provides it).
@@ -79,7 +86,6 @@ pub struct LowRankPreconditioner {
     pick: sys::VecScatter,
     /// Sequential, |C| entries on rank 0 and none elsewhere.
     small: Option<Vector>,
-    rhs: Option<Vector>,
     /// A, the diagonal shift of K's factor (K' = K + A; see `bulk`), in
     /// K's layout, and on rank 0 at C's positions (D's update carries −A).
     shift: Option<Vector>,
@@ -87,15 +93,27 @@ pub struct LowRankPreconditioner {
     /// Work vectors in K's layout.
     z: Option<Vector>,
     t: Option<Vector>,
-    /// Rank 0: G column-major |C| × |C|.
+    /// Rank 0: G column-major |C| × |C|, valid at the rows and columns of
+    /// the positions in C marked `known`.
     g: Vec<f64>,
+    known: Vec<bool>,
+    /// Rank 0: D (less A) at C's positions, and U, the positions it
+    /// touches (sorted).
     d: Sparse,
-    /// Rank 0: the LU factors of M = I + D G.
+    u: Vec<usize>,
+    /// Rank 0: the LU factors of M_UU = I + D_UU G_UU (null when U is
+    /// empty), and sequential work vectors of |U| entries.
     m: OwnedMat,
+    m_rhs: Option<Vector>,
+    m_sol: Option<Vector>,
+    /// `-log_view` stages of G's columns and of the dense set-ups.
+    stages: [LogStage; 2],
     /// Sparse factorisations of K (one per run).
     pub bulk_factorisations: usize,
-    /// Times G was formed (1 + growths).
+    /// Requests for selected entries of K⁻¹, and the columns of G they
+    /// brought.
     pub inverse_blocks: usize,
+    pub inverse_columns: usize,
     /// Dense LU factorisations of M (one per set-up).
     pub dense_factorisations: usize,
     /// Times C had to grow.
@@ -145,16 +163,24 @@ impl LowRankPreconditioner {
             wanted: Vec::new(),
             pick: std::ptr::null_mut(),
             small: None,
-            rhs: None,
             shift: None,
             shift_c: Vec::new(),
             z: None,
             t: None,
             g: Vec::new(),
+            known: Vec::new(),
             d: Sparse::default(),
+            u: Vec::new(),
             m: OwnedMat(std::ptr::null_mut()),
+            m_rhs: None,
+            m_sol: None,
+            stages: [
+                LogStage::register("low-rank G")?,
+                LogStage::register("low-rank dense")?,
+            ],
             bulk_factorisations: 0,
             inverse_blocks: 0,
+            inverse_columns: 0,
             dense_factorisations: 0,
             growths: 0,
             inverse_cpu_seconds: 0.0,
@@ -178,32 +204,60 @@ impl LowRankPreconditioner {
     }
 
     /// Set-up for the Jacobian K + `kc` from the contact tangent `kc`
-    /// alone: K is factored at the first set-up only, G formed again only
-    /// when C must grow. Collective.
+    /// alone: K is factored at the first set-up only, C grown when the
+    /// pattern reaches outside it, G given the columns U newly touches.
+    /// Collective.
     pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
         self.failed = None;
         let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
-        let grown = (self.any_rank)(grow).then(|| self.grown_c());
+        if (self.any_rank)(grow) {
+            if !self.c.is_empty() {
+                self.growths += 1;
+            }
+            self.set_c(self.grown_c())?;
+        }
+        let [g_stage, dense_stage] = self.stages;
+        let t0 = cpu_seconds();
+        let read = dense_stage.scope(|| self.read_tangent(kc));
+        self.dense_cpu_seconds += cpu_seconds() - t0;
+        let Some(d) = self.agreed(read)? else {
+            return Ok(());
+        };
         if self.factor.is_null() {
-            // K' is shifted on the first C (see `bulk`).
-            let first = grown.clone().unwrap_or_else(|| self.c.clone());
-            self.factor_bulk(&first)?;
+            // K' is shifted where the first tangent acts (see `bulk`).
+            self.factor_bulk(&d.touched())?;
             if self.failed.is_some() {
                 return Ok(());
             }
         }
-        if let Some(c) = grown {
-            if !self.c.is_empty() {
-                self.growths += 1;
-            }
-            let t0 = cpu_seconds();
-            self.form_inverse(c)?;
-            self.inverse_cpu_seconds += cpu_seconds() - t0;
-        }
+        self.d = d.shifted(&self.shift_c);
+        self.u = self.d.touched();
         let t0 = cpu_seconds();
-        let r = self.update(kc);
+        g_stage.scope(|| self.complete_inverse())?;
+        self.inverse_cpu_seconds += cpu_seconds() - t0;
+        let t0 = cpu_seconds();
+        let local = dense_stage.scope(|| match self.root {
+            true => self.factor_dense(),
+            false => Ok(()),
+        });
         self.dense_cpu_seconds += cpu_seconds() - t0;
-        r
+        if self.agreed(local)?.is_some() {
+            self.dense_factorisations += 1;
+        }
+        Ok(())
+    }
+
+    /// A step of the set-up that may fail on some ranks only: its outcome
+    /// agreed, a failure kept as the set-up's (None then). Collective.
+    fn agreed<T>(&mut self, local: Result<T>) -> Result<Option<T>> {
+        if (self.any_rank)(local.is_err()) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(_) => "the contact update's set-up failed on another rank".into(),
+            });
+            return Ok(None);
+        }
+        local.map(Some)
     }
 
     /// C with the wanted DOFs added (the same on every rank).
@@ -219,9 +273,9 @@ impl LowRankPreconditioner {
         c
     }
 
-    /// C becomes `c`: the scatter onto rank 0 and G = Pᵀ K⁻¹ P, |C| solves
-    /// with K's factor in blocks of right-hand sides. Collective.
-    fn form_inverse(&mut self, c: Vec<PetscInt>) -> Result<()> {
+    /// C becomes `c`: the scatter onto rank 0, G's entries forgotten (its
+    /// positions change). Collective.
+    fn set_c(&mut self, c: Vec<PetscInt>) -> Result<()> {
         let n = c.len();
         let here = if self.root { n } else { 0 };
         self.fixed = c
@@ -230,27 +284,24 @@ impl LowRankPreconditioner {
             .collect();
         self.c = c;
         self.g = vec![0.0; if self.root { n * n } else { 0 }];
+        self.known = vec![false; here];
+        self.ensure_work_vectors()?;
         let z = self
             .z
             .as_ref()
-            .ok_or_else(|| error("form_inverse", "no factor".into()))?;
-        let (mut rows, mut cols): (PetscInt, PetscInt) = (0, 0);
+            .ok_or_else(|| error("set_c", "no work vector".into()))?;
         let mut small: sys::Vec = std::ptr::null_mut();
-        let mut rhs: sys::Vec = std::ptr::null_mut();
         let mut from: sys::IS = std::ptr::null_mut();
         let mut to: sys::IS = std::ptr::null_mut();
         let positions: Vec<PetscInt> = (0..here as PetscInt).collect();
-        // SAFETY: valid matrices and vectors; the sequential vectors go to
-        // owning wrappers at once; the index slices are copied and their
+        // SAFETY: valid matrices and vectors; the sequential vector goes to
+        // an owning wrapper at once; the index slices are copied and their
         // sets destroyed on every path; the old scatter is destroyed once
         // and replaced.
         unsafe {
-            petsc_call!(MatGetSize(self.k.raw(), &mut rows, &mut cols))?;
             let len = super::to_petsc_int(here)?;
             petsc_call!(VecCreateSeq(self_comm(), len, &mut small))?;
             self.small = Some(Vector::owned_from_raw(small));
-            petsc_call!(VecCreateSeq(self_comm(), len, &mut rhs))?;
-            self.rhs = Some(Vector::owned_from_raw(rhs));
             sys::VecScatterDestroy(&mut self.pick);
             petsc_call!(ISCreateGeneral(
                 self_comm(),
@@ -275,112 +326,23 @@ impl LowRankPreconditioner {
             (Some(v), Some(small)) => at_c(self.pick, v, small)?,
             _ => Vec::new(),
         };
-        self.inverse_entries(rows)?;
-        self.inverse_blocks += 1;
         Ok(())
     }
 
-    /// D from `kc` onto rank 0, then M = I + D G and its LU there; the
-    /// outcome agreed. Collective.
-    fn update(&mut self, kc: &Matrix) -> Result<()> {
-        let n = self.c.len();
-        let here = super::to_petsc_int(if self.root { n } else { 0 })?;
-        let mut is: sys::IS = std::ptr::null_mut();
-        let mut subs: *mut sys::Mat = std::ptr::null_mut();
-        // SAFETY: `kc` is a valid assembled matrix of K's size; the index
-        // set (C on rank 0, empty elsewhere) is copied and destroyed; the
-        // submatrix array is destroyed on every path after its rows are read.
-        let read = unsafe {
-            petsc_call!(ISCreateGeneral(
-                self_comm(),
-                here,
-                self.c.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut is
-            ))?;
-            let made = petsc_call!(MatCreateSubMatrices(
-                kc.raw(),
-                1,
-                &is,
-                &is,
-                sys::MatReuse_MAT_INITIAL_MATRIX,
-                &mut subs
-            ));
-            sys::ISDestroy(&mut is);
-            made?;
-            let read = if self.root && !subs.is_null() {
-                read_sparse(*subs, &self.fixed, &self.shift_c)
-            } else {
-                Ok(Sparse::default())
-            };
-            sys::MatDestroySubMatrices(1, &mut subs);
-            read
-        };
-        let local = read.and_then(|d| {
-            self.d = d;
-            if self.root {
-                self.factor_dense()
-            } else {
-                Ok(())
-            }
-        });
-        if (self.any_rank)(local.is_err()) {
-            self.failed = Some(match local {
-                Err(e) => e.to_string(),
-                Ok(()) => "the dense factorisation of I + D G failed on rank 0".into(),
-            });
+    /// The work vectors z and t in K's layout (once). Collective.
+    fn ensure_work_vectors(&mut self) -> Result<()> {
+        if self.z.is_some() {
             return Ok(());
         }
-        self.dense_factorisations += 1;
-        Ok(())
-    }
-
-    /// Rank 0: M = I + D G, column by column (D sparse), and its LU.
-    fn factor_dense(&mut self) -> Result<()> {
-        let n = self.c.len();
-        let nn = super::to_petsc_int(n)?;
-        let mut m = OwnedMat(std::ptr::null_mut());
-        // SAFETY: a new sequential dense matrix of n × n, its array
-        // (column-major, leading dimension n as created with no user array)
-        // written only between Get and Restore.
+        let mut right: sys::Vec = std::ptr::null_mut();
+        let mut left: sys::Vec = std::ptr::null_mut();
+        // SAFETY: `k` is a valid matrix; the vectors go to owning wrappers
+        // at once.
         unsafe {
-            petsc_call!(MatCreateSeqDense(
-                self_comm(),
-                nn,
-                nn,
-                std::ptr::null_mut(),
-                &mut m.0
-            ))?;
-            let mut a: *mut f64 = std::ptr::null_mut();
-            petsc_call!(MatDenseGetArrayWrite(m.0, &mut a))?;
-            let out = std::slice::from_raw_parts_mut(a, n * n);
-            let mut finite = true;
-            for j in 0..n {
-                let g = &self.g[j * n..(j + 1) * n];
-                let col = &mut out[j * n..(j + 1) * n];
-                for (i, v) in col.iter_mut().enumerate() {
-                    let s: f64 = self.d.row(i).map(|(k, d)| d * g[k]).sum();
-                    *v = s + if i == j { 1.0 } else { 0.0 };
-                    finite &= v.is_finite();
-                }
-            }
-            petsc_call!(MatDenseRestoreArrayWrite(m.0, &mut a))?;
-            if !finite {
-                return Err(error(
-                    "LowRankPreconditioner::update",
-                    "the contact tangent is not finite".into(),
-                ));
-            }
-            let mut info = sys::MatFactorInfo::default();
-            petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            petsc_call!(MatLUFactor(
-                m.0,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                &info
-            ))?;
+            petsc_call!(MatCreateVecs(self.k.raw(), &mut right, &mut left))?;
+            self.z = Some(Vector::owned_from_raw(right));
+            self.t = Some(Vector::owned_from_raw(left));
         }
-        self.m = m;
         Ok(())
     }
 
@@ -390,9 +352,7 @@ impl LowRankPreconditioner {
             // As MatSolve does with a failed MUMPS factor.
             return x.set_all(f64::INFINITY);
         }
-        let (Some(z), Some(t), Some(small), Some(rhs)) =
-            (&mut self.z, &mut self.t, &mut self.small, &mut self.rhs)
-        else {
+        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
             return Err(error(
                 "LowRankPreconditioner::apply",
                 "applied before its set-up".into(),
@@ -401,22 +361,17 @@ impl LowRankPreconditioner {
         // SAFETY: valid factor and vectors of its size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
         scatter(self.pick, z.raw(), small.raw(), false)?;
-        let (d, m, root) = (&self.d, self.m.0, self.root);
-        let local = (|| -> Result<bool> {
-            if !root {
-                return Ok(true);
-            }
-            let zc: Vec<f64> = small.with_array(|a| a.to_vec())?;
-            rhs.with_array_mut(|r| {
-                for (i, v) in r.iter_mut().enumerate() {
-                    *v = d.row(i).map(|(k, dv)| dv * zc[k]).sum();
-                }
-            })?;
-            // SAFETY: M is factored (set-up succeeded on every rank before
-            // any apply); sequential vectors of its size.
-            unsafe { petsc_call!(MatSolve(m, rhs.raw(), small.raw()))? };
-            small.with_array(|y| y.iter().all(|v| v.is_finite()))
-        })();
+        let update = update::Update {
+            d: &self.d,
+            u: &self.u,
+            m: self.m.0,
+            rhs: self.m_rhs.as_mut(),
+            sol: self.m_sol.as_mut(),
+        };
+        let local = match self.root {
+            true => update.solve(small),
+            false => Ok(true),
+        };
         if (self.any_rank)(!matches!(local, Ok(true))) {
             self.failed = Some(match local {
                 Err(e) => e.to_string(),

@@ -44,8 +44,11 @@ pub struct SchurSummary {
     pub largest_trailing: usize,
     pub leading_factorisations: usize,
     /// Several ranks: K's factor with a low-rank update (`schur_factorisations`
-    /// counts the dense LUs of I + D G; G is formed 1 + growths times).
+    /// counts the dense LUs of I + D G; G's columns come in
+    /// `inverse_blocks` requests, `inverse_columns` in all).
     pub low_rank: bool,
+    pub inverse_blocks: usize,
+    pub inverse_columns: usize,
     /// Low-rank path, rank 0's CPU seconds: forming G, and the dense
     /// set-ups (D gathered, M formed and factored).
     pub inverse_cpu_seconds: f64,
@@ -204,6 +207,8 @@ pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
         schur_factorisations: s.dense_factorisations,
         growths: s.growths,
         low_rank: true,
+        inverse_blocks: s.inverse_blocks,
+        inverse_columns: s.inverse_columns,
         inverse_cpu_seconds: s.inverse_cpu_seconds,
         dense_cpu_seconds: s.dense_cpu_seconds,
         ..SchurSummary::default()

@@ -6,39 +6,28 @@
 //! holds it (the mortar patch test's upper block, pressed by a traction:
 //! its z translation). MUMPS then factors K with a pivot of rounding size
 //! and the update loses every digit (the first solve of tests/mortar.rs on
-//! 2 ranks diverged). So the factor is of K' = K + A, A diagonal on C's
-//! unconstrained DOFs at the first set-up (K's own diagonal there, so the
-//! shift has K's scale), and the update carries −A: J = K' + P (D − A) Pᵀ,
-//! the same J. Any body the contact can hold has a DOF in C, so K' is
-//! positive definite wherever J is.
-use super::super::{petsc_call, sys, PetscInt, Result, Vector};
+//! 2 ranks diverged). So the factor is of K' = K + A, A diagonal on the
+//! DOFs the first contact tangent D0 touches (K's own diagonal there, so
+//! the shift has K's scale), and the update carries −A: J = K' + P (D − A)
+//! Pᵀ, the same J. K' is nonsingular whenever the first Jacobian is: a null
+//! vector v of K with v = 0 where D0 acts has D0 v_C = 0 too, so it is one
+//! of K + P D0 Pᵀ. Shifting those DOFs only (not all of C) keeps U, where
+//! D − A acts, the contact zone.
+use super::super::shell::error;
+use super::super::{petsc_call, sys, Matrix, Result, Vector};
 use super::LowRankPreconditioner;
 
 impl LowRankPreconditioner {
     /// K' = K + A (with the Dirichlet replacement) factored by MUMPS: LDLᵀ,
-    /// K being symmetric on this path whatever the contact tangent is. `c`:
-    /// the DOFs A shifts (sorted). Collective.
-    pub(super) fn factor_bulk(&mut self, c: &[PetscInt]) -> Result<()> {
+    /// K being symmetric on this path whatever the contact tangent is.
+    /// `touched`: rank 0's positions in C that A shifts (sorted; empty
+    /// elsewhere). Collective.
+    pub(super) fn factor_bulk(&mut self, touched: &[usize]) -> Result<()> {
         let mut kd = self.k.duplicate()?;
         kd.zero_rows_columns_identity(&self.constrained)?;
-        let mut right: sys::Vec = std::ptr::null_mut();
-        let mut left: sys::Vec = std::ptr::null_mut();
-        let mut shift: sys::Vec = std::ptr::null_mut();
-        // SAFETY: `kd` is a valid assembled matrix; the factor is owned by
-        // `self` (destroyed in Drop); the work vectors are handed to owning
-        // wrappers at once.
-        unsafe {
-            petsc_call!(MatCreateVecs(kd.raw(), &mut right, &mut left))?;
-            self.z = Some(Vector::owned_from_raw(right));
-            self.t = Some(Vector::owned_from_raw(left));
-            petsc_call!(MatCreateVecs(kd.raw(), &mut shift, std::ptr::null_mut()))?;
-        }
-        // SAFETY: a new vector of K's column layout, owned from here on.
-        let mut shift = unsafe { Vector::owned_from_raw(shift) };
-        // SAFETY: `kd` and `shift` are valid, of matching layouts.
-        unsafe { petsc_call!(MatGetDiagonal(kd.raw(), shift.raw()))? };
-        self.keep_shift_on(&mut shift, c)?;
-        // SAFETY: as above; the factor is owned by `self` (destroyed in Drop).
+        let shift = self.shift_on(&kd, touched)?;
+        // SAFETY: `kd` and `shift` are valid, of matching layouts; the
+        // factor is owned by `self` (destroyed in Drop).
         unsafe {
             petsc_call!(MatDiagonalSet(
                 kd.raw(),
@@ -75,22 +64,39 @@ impl LowRankPreconditioner {
                 return Ok(());
             }
         }
+        if let Some(small) = self.small.as_mut() {
+            self.shift_c = super::at_c(self.pick, &shift, small)?;
+        }
         self.shift = Some(shift);
         self.bulk_factorisations += 1;
         Ok(())
     }
 
-    /// `diagonal` (K's, this rank's rows) becomes A: |K_ii| on the
-    /// unconstrained DOFs of `c`, zero elsewhere.
-    fn keep_shift_on(&self, diagonal: &mut Vector, c: &[PetscInt]) -> Result<()> {
-        let (lo, _) = diagonal.ownership_range()?;
-        let constrained = &self.constrained;
-        diagonal.with_array_mut(|a| {
-            for (i, v) in a.iter_mut().enumerate() {
-                let g = (lo + i) as PetscInt;
-                let shifted = c.binary_search(&g).is_ok() && constrained.binary_search(&g).is_err();
-                *v = if shifted { v.abs() } else { 0.0 };
+    /// A in K's layout: |K_ii| at the DOFs of `touched`, zero elsewhere
+    /// (the positions sent from rank 0 back through C's scatter).
+    /// Collective.
+    fn shift_on(&mut self, kd: &Matrix, touched: &[usize]) -> Result<Vector> {
+        let (Some(z), Some(small)) = (self.z.as_ref(), self.small.as_mut()) else {
+            return Err(error("factor_bulk", "no C yet".into()));
+        };
+        let mut shift = z.duplicate()?;
+        let diagonal = z.duplicate()?;
+        shift.set_all(0.0)?;
+        small.with_array_mut(|a| {
+            a.fill(0.0);
+            for &i in touched {
+                a[i] = 1.0;
             }
-        })
+        })?;
+        super::scatter(self.pick, small.raw(), shift.raw(), true)?;
+        // SAFETY: `kd` and `diagonal` are valid, of matching layouts.
+        unsafe { petsc_call!(MatGetDiagonal(kd.raw(), diagonal.raw()))? };
+        let k_ii = diagonal.with_array(|a| a.to_vec())?;
+        shift.with_array_mut(|a| {
+            for (v, k) in a.iter_mut().zip(&k_ii) {
+                *v *= k.abs();
+            }
+        })?;
+        Ok(shift)
     }
 }

@@ -6,9 +6,9 @@ use super::super::{petsc_call, sys, PetscInt, Result};
 /// dropped).
 #[derive(Default)]
 pub(super) struct Sparse {
-    pub(super) start: Vec<usize>,
-    pub(super) col: Vec<usize>,
-    pub(super) val: Vec<f64>,
+    start: Vec<usize>,
+    col: Vec<usize>,
+    val: Vec<f64>,
 }
 
 impl Sparse {
@@ -20,7 +20,38 @@ impl Sparse {
             .zip(self.val[r].iter().copied())
     }
 
-    /// Adds `v` at column `col` of the row being read (after its last
+    /// The positions with an entry in their row or column (sorted).
+    pub(super) fn touched(&self) -> Vec<usize> {
+        let rows = self.start.len().saturating_sub(1);
+        let mut t: Vec<usize> = (0..rows)
+            .filter(|&i| self.start[i + 1] > self.start[i])
+            .chain(self.col.iter().copied())
+            .collect();
+        t.sort_unstable();
+        t.dedup();
+        t
+    }
+
+    /// D − diag(`shift`) (`shift` empty: D).
+    pub(super) fn shifted(&self, shift: &[f64]) -> Sparse {
+        let rows = self.start.len().saturating_sub(1);
+        let mut out = Sparse {
+            start: vec![0],
+            ..Sparse::default()
+        };
+        for i in 0..rows {
+            out.col.extend(self.row(i).map(|(k, _)| k));
+            out.val.extend(self.row(i).map(|(_, v)| v));
+            let s = shift.get(i).copied().unwrap_or(0.0);
+            if s != 0.0 {
+                out.add_to_last_row(i, -s);
+            }
+            out.start.push(out.col.len());
+        }
+        out
+    }
+
+    /// Adds `v` at column `col` of the row being built (after its last
     /// `start`).
     fn add_to_last_row(&mut self, col: usize, v: f64) {
         let from = self.start.last().copied().unwrap_or(0);
@@ -35,8 +66,8 @@ impl Sparse {
 }
 
 /// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
-/// columns, minus `shift` on the diagonal (none when empty).
-pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool], shift: &[f64]) -> Result<Sparse> {
+/// columns.
+pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
     let mut d = Sparse {
         start: vec![0],
         ..Sparse::default()
@@ -63,10 +94,6 @@ pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool], shift: &[f64]) -> Result<
                     }
                 }
                 petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
-            }
-            let s = shift.get(row).copied().unwrap_or(0.0);
-            if s != 0.0 {
-                d.add_to_last_row(row, -s);
             }
         }
         d.start.push(d.col.len());
