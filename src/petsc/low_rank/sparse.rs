@@ -100,3 +100,50 @@ pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
     }
     Ok(d)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Sparse;
+
+    /// Rows 0 and 2 of a 4 × 4 D: (0, 0) = 2, (0, 3) = 1, (2, 1) = −1.
+    fn d() -> Sparse {
+        Sparse {
+            start: vec![0, 2, 2, 3, 3],
+            col: vec![0, 3, 1],
+            val: vec![2.0, 1.0, -1.0],
+        }
+    }
+
+    fn dense(s: &Sparse, n: usize) -> Vec<f64> {
+        let mut out = vec![0.0; n * n];
+        for i in 0..n {
+            for (k, v) in s.row(i) {
+                out[i * n + k] += v;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn touched_takes_rows_and_columns_with_an_entry() {
+        assert_eq!(d().touched(), vec![0, 1, 2, 3]);
+        let one = Sparse {
+            start: vec![0, 0, 1, 1],
+            col: vec![1],
+            val: vec![5.0],
+        };
+        assert_eq!(one.touched(), vec![1]);
+    }
+
+    #[test]
+    fn shifted_subtracts_on_the_diagonal_whether_or_not_it_had_an_entry() {
+        let s = d().shifted(&[0.5, 0.0, 0.25, 3.0]);
+        let mut want = dense(&d(), 4);
+        for (i, a) in [0.5, 0.0, 0.25, 3.0].iter().enumerate() {
+            want[i * 4 + i] -= a;
+        }
+        assert_eq!(dense(&s, 4), want);
+        assert_eq!(s.touched(), vec![0, 1, 2, 3]);
+        assert_eq!(dense(&d().shifted(&[]), 4), dense(&d(), 4));
+    }
+}
