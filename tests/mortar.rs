@@ -227,28 +227,41 @@ fn deviation(p: &[f64]) -> (f64, f64) {
     (mean, dev)
 }
 
-/// The slave's nodal pressures and the pair's force, or the error text.
+/// Where `try_case` writes a run's results (its scene beside them).
+fn output_path(
+    dir: &Path,
+    case: &Case,
+    formulation: &str,
+    ranks: usize,
+    extra: &[&str],
+) -> std::path::PathBuf {
+    dir.join(format!(
+        "{}-{formulation}-{ranks}{}.h5",
+        case.name.replace([' ', ','], "_"),
+        extra.concat().replace(['.', '='], "_")
+    ))
+}
+
+/// The slave's nodal pressures, the pair's force and the run's output
+/// text, or the error text. `extra`: the run's further arguments.
 fn try_case(
     dir: &Path,
     case: &Case,
     formulation: &str,
     ranks: usize,
-) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let tag = format!(
-        "{}-{formulation}-{ranks}",
-        case.name.replace([' ', ','], "_")
-    );
-    let scene = write(dir, &format!("{tag}.toml"), &case.scene(formulation));
-    let out = dir.join(format!("{tag}.h5"));
+    extra: &[&str],
+) -> Result<(Vec<f64>, Vec<f64>, String), String> {
+    let out = output_path(dir, case, formulation, ranks, extra);
+    let name = out.with_extension("toml");
+    let name = name.file_name().expect("a file name").to_string_lossy();
+    let scene = write(dir, &name, &case.scene(formulation));
     let o = mpirun(
         ranks,
         &[
-            "run",
-            scene.to_str().unwrap(),
-            "-q",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+            &["run", scene.to_str().unwrap(), "-o", out.to_str().unwrap()],
+            extra,
+        ]
+        .concat(),
     );
     if !o.status.success() {
         return Err(text(&o));
@@ -260,7 +273,7 @@ fn try_case(
     )
     .expect("force")
     .0;
-    Ok((slave_pressures(&out, case.slave().0), force))
+    Ok((slave_pressures(&out, case.slave().0), force, text(&o)))
 }
 
 /// The mortar pair's nodal datasets at the slave nodes: λ, g̃ and the traction.
@@ -291,7 +304,9 @@ fn mortar_fields(path: &Path, node_set: &str) -> Vec<(f64, f64, [f64; 3])> {
 }
 
 fn run_case(dir: &Path, case: &Case, formulation: &str, ranks: usize) -> (Vec<f64>, Vec<f64>) {
-    try_case(dir, case, formulation, ranks).unwrap_or_else(|t| panic!("{}: {t}", case.name))
+    let (p, f, _) = try_case(dir, case, formulation, ranks, &["-q"])
+        .unwrap_or_else(|t| panic!("{}: {t}", case.name));
+    (p, f)
 }
 
 #[test]
@@ -303,8 +318,8 @@ fn mortar_passes_the_patch_test_where_the_links_do_not() {
         let (mean, dev) = deviation(&p);
         // The links on the same case, for comparison (their Uzawa loop may
         // not reach 1e-9 at all: then the figure is their failure).
-        let links = match try_case(&dir, case, "links", 1) {
-            Ok((pl, _)) => format!("{:.2e}", deviation(&pl).1),
+        let links = match try_case(&dir, case, "links", 1, &["-q"]) {
+            Ok((pl, _, _)) => format!("{:.2e}", deviation(&pl).1),
             Err(t) => format!("failed ({})", t.lines().last().unwrap_or("")),
         };
         println!(
@@ -328,8 +343,10 @@ fn mortar_writes_nodal_multipliers_weighted_gaps_and_tractions() {
     let dir = scratch("mortar-output");
     let case = &CASES[0];
     let (p, _) = run_case(&dir, case, "mortar", 2);
-    let tag = format!("{}-mortar-2", case.name.replace([' ', ','], "_"));
-    let fields = mortar_fields(&dir.join(format!("{tag}.h5")), case.slave().0);
+    let fields = mortar_fields(
+        &output_path(&dir, case, "mortar", 2, &["-q"]),
+        case.slave().0,
+    );
     assert_eq!(fields.len(), p.len());
     for ((lambda, gap, t), p) in fields.iter().zip(&p) {
         // λ is the nodal contact pressure; the upper block's bottom is
@@ -360,6 +377,43 @@ fn mortar_answers_agree_on_one_two_and_three_ranks() {
             assert!(
                 dp < 1e-10 && df < 1e-10,
                 "{}: {ranks} ranks differ",
+                case.name
+            );
+        }
+    }
+}
+
+/// On 2 ranks a mortar pair takes the several-rank contact Schur path (K's
+/// factor with a low-rank update, `petsc::low_rank`) and answers as the
+/// full factorisation and the 1-rank run do, to 1e-10. In these cases the
+/// upper block is held by the contact alone, so K is singular: the path's
+/// shifted factor is what makes it work (its first solve diverged before).
+#[test]
+fn mortar_on_two_ranks_takes_the_low_rank_path_with_the_same_answer() {
+    let dir = scratch("mortar-low-rank");
+    for case in [&CASES[0], &CASES[5]] {
+        let run = |ranks, extra: &[&str]| {
+            try_case(&dir, case, "mortar", ranks, extra)
+                .unwrap_or_else(|t| panic!("{}: {t}", case.name))
+        };
+        let (p1, f1, _) = run(1, &["-q"]);
+        let (p, f, log) = run(2, &["-v"]);
+        let (pf, ff, full) = run(2, &["-v", "--set", "solver.contact_schur=false"]);
+        assert!(
+            log.contains("contact low-rank update on") && !full.contains("contact low-rank update"),
+            "{}: the low-rank path was not taken, or not only when on:\n{log}\n{full}",
+            case.name
+        );
+        for (what, q, fq) in [("full factorisation", &pf, &ff), ("1 rank", &p1, &f1)] {
+            let dp = relative_difference(q, &p);
+            let df = relative_difference(fq, &f);
+            println!(
+                "{}: low-rank vs {what}: pressure {dp:.2e}, force {df:.2e}",
+                case.name
+            );
+            assert!(
+                dp < 1e-10 && df < 1e-10,
+                "{}: differs from the {what}",
                 case.name
             );
         }

@@ -3,7 +3,7 @@
 //! contact DOFs C, P the columns of the identity on C) by a low-rank update
 //! of K's factor, which needs no D⁻¹:
 //!
-//!   G = Pᵀ K⁻¹ P (|C| unit right-hand sides, once per C),
+//!   G = Pᵀ K⁻¹ P (selected entries of K⁻¹),
 //!   M = I + D G  (dense, LU per Jacobian),
 //!   x = K⁻¹ (b − P M⁻¹ D (K⁻¹ b)_C)  (two solves with K's factor).
 //!
@@ -12,15 +12,30 @@
 //! the one-rank path uses, is sequential; this path uses only an ordinary
 //! parallel MUMPS factor. K is parallel; G, D and M live on rank 0.
 //!
+//! Only the DOFs U that D touches matter: a row of M outside U is the
+//! identity's and its right-hand side zero, so M⁻¹ D z_C is M_UU⁻¹ (D z_C)_U
+//! and needs G on U × U alone. The contact zone is a part of C (hertz-
+//! cylinder h = 0.1: 200 of |C| = 972 DOFs over the run), so G's columns are computed as U first
+//! takes them (`inverse`) and each set-up factors M_UU only (`update`).
+//!
+//! K stands for K + A throughout, A a diagonal shift on the DOFs the first
+//! tangent touches, with D for D − A (the same J; see `bulk`): K alone is
+//! singular when a body is held by contact only.
+//!
 //! Every decision one rank could take alone (C must grow, a factorisation
 //! failed, a non-finite update) goes through the caller's agreement hook
 //! before any rank acts on it, so no rank leaves a collective call the
 //! others are still in.
 pub(super) use super::shell::install;
+mod bulk;
 mod gather;
+mod inverse;
+mod sparse;
+mod update;
 use super::shell::{error, ShellState};
-use super::{comm_world, petsc_call, sys, Matrix, PetscInt, Result, Vector};
+use super::{comm_world, petsc_call, sys, LogStage, Matrix, PetscInt, Result, Vector};
 use gather::gather_sorted;
+use sparse::Sparse;
 
 /// Collective: true on every rank if the flag is true on any (the caller's
 /// parallel module provides it).
@@ -53,26 +68,6 @@ impl Drop for OwnedMat {
     }
 }
 
-/// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
-/// start[i]..start[i + 1] (positions in C; constrained rows and columns
-/// dropped).
-#[derive(Default)]
-struct Sparse {
-    start: Vec<usize>,
-    col: Vec<usize>,
-    val: Vec<f64>,
-}
-
-impl Sparse {
-    fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let r = self.start[i]..self.start[i + 1];
-        self.col[r.clone()]
-            .iter()
-            .copied()
-            .zip(self.val[r].iter().copied())
-    }
-}
-
 /// The shell preconditioner's state (see the module's comment).
 pub struct LowRankPreconditioner {
     k: Matrix,
@@ -91,19 +86,34 @@ pub struct LowRankPreconditioner {
     pick: sys::VecScatter,
     /// Sequential, |C| entries on rank 0 and none elsewhere.
     small: Option<Vector>,
-    rhs: Option<Vector>,
+    /// A, the diagonal shift of K's factor (K' = K + A; see `bulk`), in
+    /// K's layout, and on rank 0 at C's positions (D's update carries −A).
+    shift: Option<Vector>,
+    shift_c: Vec<f64>,
     /// Work vectors in K's layout.
     z: Option<Vector>,
     t: Option<Vector>,
-    /// Rank 0: G column-major |C| × |C|.
+    /// Rank 0: G column-major |C| × |C|, valid at the rows and columns of
+    /// the positions in C marked `known`.
     g: Vec<f64>,
+    known: Vec<bool>,
+    /// Rank 0: D (less A) at C's positions, and U, the positions it
+    /// touches (sorted).
     d: Sparse,
-    /// Rank 0: the LU factors of M = I + D G.
+    u: Vec<usize>,
+    /// Rank 0: the LU factors of M_UU = I + D_UU G_UU (null when U is
+    /// empty), and sequential work vectors of |U| entries.
     m: OwnedMat,
+    m_rhs: Option<Vector>,
+    m_sol: Option<Vector>,
+    /// `-log_view` stages of G's columns and of the dense set-ups.
+    stages: [LogStage; 2],
     /// Sparse factorisations of K (one per run).
     pub bulk_factorisations: usize,
-    /// Times G was formed (1 + growths).
+    /// Requests for selected entries of K⁻¹, and the columns of G they
+    /// brought.
     pub inverse_blocks: usize,
+    pub inverse_columns: usize,
     /// Dense LU factorisations of M (one per set-up).
     pub dense_factorisations: usize,
     /// Times C had to grow.
@@ -153,14 +163,24 @@ impl LowRankPreconditioner {
             wanted: Vec::new(),
             pick: std::ptr::null_mut(),
             small: None,
-            rhs: None,
+            shift: None,
+            shift_c: Vec::new(),
             z: None,
             t: None,
             g: Vec::new(),
+            known: Vec::new(),
             d: Sparse::default(),
+            u: Vec::new(),
             m: OwnedMat(std::ptr::null_mut()),
+            m_rhs: None,
+            m_sol: None,
+            stages: [
+                LogStage::register("low-rank G")?,
+                LogStage::register("low-rank dense")?,
+            ],
             bulk_factorisations: 0,
             inverse_blocks: 0,
+            inverse_columns: 0,
             dense_factorisations: 0,
             growths: 0,
             inverse_cpu_seconds: 0.0,
@@ -184,90 +204,78 @@ impl LowRankPreconditioner {
     }
 
     /// Set-up for the Jacobian K + `kc` from the contact tangent `kc`
-    /// alone: K is factored at the first set-up only, G formed again only
-    /// when C must grow. Collective.
+    /// alone: K is factored at the first set-up only, C grown when the
+    /// pattern reaches outside it, G given the columns U newly touches.
+    /// Collective.
     pub fn set_up(&mut self, kc: &Matrix) -> Result<()> {
         self.failed = None;
-        if self.factor.is_null() {
-            self.factor_bulk()?;
-            if self.failed.is_some() {
-                return Ok(());
-            }
-        }
         let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
         if (self.any_rank)(grow) {
             if !self.c.is_empty() {
                 self.growths += 1;
             }
-            let mut c = self.wanted.clone();
-            c.extend_from_slice(&self.c);
-            c.sort_unstable();
-            c.dedup();
-            if c.is_empty() {
-                // No contact coupling yet: any one DOF makes a (trivial) C.
-                c.push(0);
-            }
-            let t0 = cpu_seconds();
-            self.form_inverse(c)?;
-            self.inverse_cpu_seconds += cpu_seconds() - t0;
+            self.set_c(self.grown_c())?;
         }
+        let [g_stage, dense_stage] = self.stages;
         let t0 = cpu_seconds();
-        let r = self.update(kc);
+        let read = dense_stage.scope(|| self.read_tangent(kc));
         self.dense_cpu_seconds += cpu_seconds() - t0;
-        r
-    }
-
-    /// K (with the Dirichlet replacement) factored by MUMPS: LDLᵀ, K being
-    /// symmetric on this path whatever the contact tangent is.
-    fn factor_bulk(&mut self) -> Result<()> {
-        let mut kd = self.k.duplicate()?;
-        kd.zero_rows_columns_identity(&self.constrained)?;
-        let mut right: sys::Vec = std::ptr::null_mut();
-        let mut left: sys::Vec = std::ptr::null_mut();
-        // SAFETY: `kd` is a valid assembled matrix; the factor is owned by
-        // `self` (destroyed in Drop); the work vectors are handed to owning
-        // wrappers at once.
-        unsafe {
-            petsc_call!(MatCreateVecs(kd.raw(), &mut right, &mut left))?;
-            self.z = Some(Vector::owned_from_raw(right));
-            self.t = Some(Vector::owned_from_raw(left));
-            petsc_call!(MatGetFactor(
-                kd.raw(),
-                c"mumps".as_ptr(),
-                sys::MatFactorType_MAT_FACTOR_CHOLESKY,
-                &mut self.factor
-            ))?;
-            let mut info = sys::MatFactorInfo::default();
-            petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            petsc_call!(MatCholeskyFactorSymbolic(
-                self.factor,
-                kd.raw(),
-                std::ptr::null_mut(),
-                &info
-            ))?;
-            petsc_call!(MatCholeskyFactorNumeric(self.factor, kd.raw(), &info))?;
-            // MUMPS reports a failed factorisation through the factor's
-            // error type (from its global INFOG, so alike on every rank);
-            // agreed all the same.
-            let mut err: sys::MatFactorError = 0;
-            petsc_call!(MatFactorGetError(self.factor, &mut err))?;
-            let failed = err != sys::MatFactorError_MAT_FACTOR_NOERROR;
-            if (self.any_rank)(failed) {
-                // Tried again at the next set-up.
-                sys::MatDestroy(&mut self.factor);
-                self.failed = Some(format!(
-                    "the MUMPS factorisation of the bulk stiffness failed (error type {err} here)"
-                ));
+        let Some(d) = self.agreed(read)? else {
+            return Ok(());
+        };
+        if self.factor.is_null() {
+            // K' is shifted where the first tangent acts (see `bulk`).
+            self.factor_bulk(&d.touched())?;
+            if self.failed.is_some() {
                 return Ok(());
             }
         }
-        self.bulk_factorisations += 1;
+        self.d = d.shifted(&self.shift_c);
+        self.u = self.d.touched();
+        let t0 = cpu_seconds();
+        g_stage.scope(|| self.complete_inverse())?;
+        self.inverse_cpu_seconds += cpu_seconds() - t0;
+        let t0 = cpu_seconds();
+        let local = dense_stage.scope(|| match self.root {
+            true => self.factor_dense(),
+            false => Ok(()),
+        });
+        self.dense_cpu_seconds += cpu_seconds() - t0;
+        if self.agreed(local)?.is_some() {
+            self.dense_factorisations += 1;
+        }
         Ok(())
     }
 
-    /// C becomes `c`: the scatter onto rank 0 and G = Pᵀ K⁻¹ P, |C| solves
-    /// with K's factor in blocks of right-hand sides. Collective.
-    fn form_inverse(&mut self, c: Vec<PetscInt>) -> Result<()> {
+    /// A step of the set-up that may fail on some ranks only: its outcome
+    /// agreed, a failure kept as the set-up's (None then). Collective.
+    fn agreed<T>(&mut self, local: Result<T>) -> Result<Option<T>> {
+        if (self.any_rank)(local.is_err()) {
+            self.failed = Some(match local {
+                Err(e) => e.to_string(),
+                Ok(_) => "the contact update's set-up failed on another rank".into(),
+            });
+            return Ok(None);
+        }
+        local.map(Some)
+    }
+
+    /// C with the wanted DOFs added (the same on every rank).
+    fn grown_c(&self) -> Vec<PetscInt> {
+        let mut c = self.wanted.clone();
+        c.extend_from_slice(&self.c);
+        c.sort_unstable();
+        c.dedup();
+        if c.is_empty() {
+            // No contact coupling yet: any one DOF makes a (trivial) C.
+            c.push(0);
+        }
+        c
+    }
+
+    /// C becomes `c`: the scatter onto rank 0, G's entries forgotten (its
+    /// positions change). Collective.
+    fn set_c(&mut self, c: Vec<PetscInt>) -> Result<()> {
         let n = c.len();
         let here = if self.root { n } else { 0 };
         self.fixed = c
@@ -276,27 +284,24 @@ impl LowRankPreconditioner {
             .collect();
         self.c = c;
         self.g = vec![0.0; if self.root { n * n } else { 0 }];
+        self.known = vec![false; here];
+        self.ensure_work_vectors()?;
         let z = self
             .z
             .as_ref()
-            .ok_or_else(|| error("form_inverse", "no factor".into()))?;
-        let (mut rows, mut cols): (PetscInt, PetscInt) = (0, 0);
+            .ok_or_else(|| error("set_c", "no work vector".into()))?;
         let mut small: sys::Vec = std::ptr::null_mut();
-        let mut rhs: sys::Vec = std::ptr::null_mut();
         let mut from: sys::IS = std::ptr::null_mut();
         let mut to: sys::IS = std::ptr::null_mut();
         let positions: Vec<PetscInt> = (0..here as PetscInt).collect();
-        // SAFETY: valid matrices and vectors; the sequential vectors go to
-        // owning wrappers at once; the index slices are copied and their
+        // SAFETY: valid matrices and vectors; the sequential vector goes to
+        // an owning wrapper at once; the index slices are copied and their
         // sets destroyed on every path; the old scatter is destroyed once
         // and replaced.
         unsafe {
-            petsc_call!(MatGetSize(self.k.raw(), &mut rows, &mut cols))?;
             let len = super::to_petsc_int(here)?;
             petsc_call!(VecCreateSeq(self_comm(), len, &mut small))?;
             self.small = Some(Vector::owned_from_raw(small));
-            petsc_call!(VecCreateSeq(self_comm(), len, &mut rhs))?;
-            self.rhs = Some(Vector::owned_from_raw(rhs));
             sys::VecScatterDestroy(&mut self.pick);
             petsc_call!(ISCreateGeneral(
                 self_comm(),
@@ -317,222 +322,27 @@ impl LowRankPreconditioner {
             sys::ISDestroy(&mut to);
             made?;
         }
-        self.inverse_entries(rows)?;
-        self.inverse_blocks += 1;
+        self.shift_c = match (&self.shift, &mut self.small) {
+            (Some(v), Some(small)) => at_c(self.pick, v, small)?,
+            _ => Vec::new(),
+        };
         Ok(())
     }
 
-    /// G's entries by MUMPS's selected inverse (ICNTL(30)): the pattern
-    /// C × C of K⁻¹ requested on rank 0 as the transpose of a sparse
-    /// right-hand side, so MUMPS prunes its solves to the tree paths of C
-    /// (whole solves with |C| unit right-hand sides cost 1.99e11 flops per
-    /// rank at hertz-cylinder h = 0.2, against 4.9e9 for the 14 solves of
-    /// the run). The request is an N × N matrix held on rank 0 whose row c
-    /// lists C: K⁻¹'s column c at the rows of C.
-    fn inverse_entries(&mut self, rows: PetscInt) -> Result<()> {
-        let n = self.c.len();
-        let here = if self.root { rows } else { 0 };
-        let nn = super::to_petsc_int(n)?;
-        let lengths: Vec<PetscInt> = if self.root {
-            let mut l = vec![0; rows as usize];
-            for &d in &self.c {
-                l[d as usize] = nn;
-            }
-            l
-        } else {
-            Vec::new()
-        };
-        let ones = vec![1.0; n];
-        let mut bt = OwnedMat(std::ptr::null_mut());
-        // SAFETY: the request matrix is owned by its guard; `lengths` holds
-        // one entry per local row and the rows set are local (rank 0 owns
-        // every row and column); MUMPS writes the entries into its values;
-        // each row is read between MatGetRow and its restore. ICNTL(30) and
-        // ICNTL(21) are put back to what MatSolve expects (PETSc leaves the
-        // selected-inverse mode and a centralised solution set).
-        unsafe {
-            petsc_call!(MatCreateAIJ(
-                comm_world(),
-                here,
-                here,
-                rows,
-                rows,
-                0,
-                if self.root {
-                    lengths.as_ptr()
-                } else {
-                    std::ptr::null()
-                },
-                0,
-                std::ptr::null(),
-                &mut bt.0
-            ))?;
-            if self.root {
-                for &d in &self.c {
-                    petsc_call!(MatSetValues(
-                        bt.0,
-                        1,
-                        &d,
-                        nn,
-                        self.c.as_ptr(),
-                        ones.as_ptr(),
-                        sys::InsertMode_INSERT_VALUES
-                    ))?;
-                }
-            }
-            petsc_call!(MatAssemblyBegin(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            let got = petsc_call!(MatMumpsGetInverseTranspose(self.factor, bt.0));
-            petsc_call!(MatMumpsSetIcntl(self.factor, 30, 0))?;
-            petsc_call!(MatMumpsSetIcntl(self.factor, 21, 1))?;
-            got?;
-        }
-        let local = (|| -> Result<()> {
-            if !self.root {
-                return Ok(());
-            }
-            // SAFETY: rank 0 reads its own rows of the assembled request,
-            // each between MatGetRow and its restore.
-            unsafe {
-                for (j, &d) in self.c.iter().enumerate() {
-                    let mut nz: PetscInt = 0;
-                    let mut cols: *const PetscInt = std::ptr::null();
-                    let mut vals: *const f64 = std::ptr::null();
-                    petsc_call!(MatGetRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
-                    let ok = nz == nn && !vals.is_null();
-                    if ok {
-                        let vs = std::slice::from_raw_parts(vals, n);
-                        self.g[j * n..(j + 1) * n].copy_from_slice(vs);
-                    }
-                    petsc_call!(MatRestoreRow(bt.0, d, &mut nz, &mut cols, &mut vals))?;
-                    if !ok {
-                        return Err(error(
-                            "MatMumpsGetInverseTranspose",
-                            format!("row {d} of the inverse entries has {nz} of {n} entries"),
-                        ));
-                    }
-                }
-            }
-            Ok(())
-        })();
-        let failed = (self.any_rank)(local.is_err());
-        local?;
-        if failed {
-            return Err(error(
-                "MatMumpsGetInverseTranspose",
-                "reading the inverse entries failed on rank 0".into(),
-            ));
-        }
-        Ok(())
-    }
-
-    /// D from `kc` onto rank 0, then M = I + D G and its LU there; the
-    /// outcome agreed. Collective.
-    fn update(&mut self, kc: &Matrix) -> Result<()> {
-        let n = self.c.len();
-        let here = super::to_petsc_int(if self.root { n } else { 0 })?;
-        let mut is: sys::IS = std::ptr::null_mut();
-        let mut subs: *mut sys::Mat = std::ptr::null_mut();
-        // SAFETY: `kc` is a valid assembled matrix of K's size; the index
-        // set (C on rank 0, empty elsewhere) is copied and destroyed; the
-        // submatrix array is destroyed on every path after its rows are read.
-        let read = unsafe {
-            petsc_call!(ISCreateGeneral(
-                self_comm(),
-                here,
-                self.c.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut is
-            ))?;
-            let made = petsc_call!(MatCreateSubMatrices(
-                kc.raw(),
-                1,
-                &is,
-                &is,
-                sys::MatReuse_MAT_INITIAL_MATRIX,
-                &mut subs
-            ));
-            sys::ISDestroy(&mut is);
-            made?;
-            let read = if self.root && !subs.is_null() {
-                read_sparse(*subs, &self.fixed)
-            } else {
-                Ok(Sparse::default())
-            };
-            sys::MatDestroySubMatrices(1, &mut subs);
-            read
-        };
-        let local = read.and_then(|d| {
-            self.d = d;
-            if self.root {
-                self.factor_dense()
-            } else {
-                Ok(())
-            }
-        });
-        if (self.any_rank)(local.is_err()) {
-            self.failed = Some(match local {
-                Err(e) => e.to_string(),
-                Ok(()) => "the dense factorisation of I + D G failed on rank 0".into(),
-            });
+    /// The work vectors z and t in K's layout (once). Collective.
+    fn ensure_work_vectors(&mut self) -> Result<()> {
+        if self.z.is_some() {
             return Ok(());
         }
-        self.dense_factorisations += 1;
-        Ok(())
-    }
-
-    /// Rank 0: M = I + D G, column by column (D sparse), and its LU.
-    fn factor_dense(&mut self) -> Result<()> {
-        let n = self.c.len();
-        let nn = super::to_petsc_int(n)?;
-        let mut m = OwnedMat(std::ptr::null_mut());
-        // SAFETY: a new sequential dense matrix of n × n, its array
-        // (column-major, leading dimension n as created with no user array)
-        // written only between Get and Restore.
+        let mut right: sys::Vec = std::ptr::null_mut();
+        let mut left: sys::Vec = std::ptr::null_mut();
+        // SAFETY: `k` is a valid matrix; the vectors go to owning wrappers
+        // at once.
         unsafe {
-            petsc_call!(MatCreateSeqDense(
-                self_comm(),
-                nn,
-                nn,
-                std::ptr::null_mut(),
-                &mut m.0
-            ))?;
-            let mut a: *mut f64 = std::ptr::null_mut();
-            petsc_call!(MatDenseGetArrayWrite(m.0, &mut a))?;
-            let out = std::slice::from_raw_parts_mut(a, n * n);
-            let mut finite = true;
-            for j in 0..n {
-                let g = &self.g[j * n..(j + 1) * n];
-                let col = &mut out[j * n..(j + 1) * n];
-                for (i, v) in col.iter_mut().enumerate() {
-                    let s: f64 = self.d.row(i).map(|(k, d)| d * g[k]).sum();
-                    *v = s + if i == j { 1.0 } else { 0.0 };
-                    finite &= v.is_finite();
-                }
-            }
-            petsc_call!(MatDenseRestoreArrayWrite(m.0, &mut a))?;
-            if !finite {
-                return Err(error(
-                    "LowRankPreconditioner::update",
-                    "the contact tangent is not finite".into(),
-                ));
-            }
-            let mut info = sys::MatFactorInfo::default();
-            petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            petsc_call!(MatLUFactor(
-                m.0,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                &info
-            ))?;
+            petsc_call!(MatCreateVecs(self.k.raw(), &mut right, &mut left))?;
+            self.z = Some(Vector::owned_from_raw(right));
+            self.t = Some(Vector::owned_from_raw(left));
         }
-        self.m = m;
         Ok(())
     }
 
@@ -542,9 +352,7 @@ impl LowRankPreconditioner {
             // As MatSolve does with a failed MUMPS factor.
             return x.set_all(f64::INFINITY);
         }
-        let (Some(z), Some(t), Some(small), Some(rhs)) =
-            (&mut self.z, &mut self.t, &mut self.small, &mut self.rhs)
-        else {
+        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
             return Err(error(
                 "LowRankPreconditioner::apply",
                 "applied before its set-up".into(),
@@ -553,22 +361,17 @@ impl LowRankPreconditioner {
         // SAFETY: valid factor and vectors of its size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
         scatter(self.pick, z.raw(), small.raw(), false)?;
-        let (d, m, root) = (&self.d, self.m.0, self.root);
-        let local = (|| -> Result<bool> {
-            if !root {
-                return Ok(true);
-            }
-            let zc: Vec<f64> = small.with_array(|a| a.to_vec())?;
-            rhs.with_array_mut(|r| {
-                for (i, v) in r.iter_mut().enumerate() {
-                    *v = d.row(i).map(|(k, dv)| dv * zc[k]).sum();
-                }
-            })?;
-            // SAFETY: M is factored (set-up succeeded on every rank before
-            // any apply); sequential vectors of its size.
-            unsafe { petsc_call!(MatSolve(m, rhs.raw(), small.raw()))? };
-            small.with_array(|y| y.iter().all(|v| v.is_finite()))
-        })();
+        let update = update::Update {
+            d: &self.d,
+            u: &self.u,
+            m: self.m.0,
+            rhs: self.m_rhs.as_mut(),
+            sol: self.m_sol.as_mut(),
+        };
+        let local = match self.root {
+            true => update.solve(small),
+            false => Ok(true),
+        };
         if (self.any_rank)(!matches!(local, Ok(true))) {
             self.failed = Some(match local {
                 Err(e) => e.to_string(),
@@ -583,6 +386,13 @@ impl LowRankPreconditioner {
         // SAFETY: as above.
         unsafe { petsc_call!(MatSolve(self.factor, t.raw(), x.raw())) }
     }
+}
+
+/// `v` (K's layout) at C's positions on rank 0 (empty elsewhere), through
+/// `small`. Collective.
+fn at_c(pick: sys::VecScatter, v: &Vector, small: &mut Vector) -> Result<Vec<f64>> {
+    scatter(pick, v.raw(), small.raw(), false)?;
+    small.with_array(|a| a.to_vec())
 }
 
 /// The forward scatter (full → C entries, inserting) or the reverse one
@@ -602,42 +412,6 @@ fn scatter(s: sys::VecScatter, from: sys::Vec, to: sys::Vec, reverse: bool) -> R
         petsc_call!(VecScatterBegin(s, from, to, add, mode))?;
         petsc_call!(VecScatterEnd(s, from, to, add, mode))
     }
-}
-
-/// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
-/// columns.
-fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
-    let mut d = Sparse {
-        start: vec![0],
-        ..Sparse::default()
-    };
-    for (row, &skip) in fixed.iter().enumerate() {
-        if !skip {
-            let mut nz: PetscInt = 0;
-            let mut cols: *const PetscInt = std::ptr::null();
-            let mut vals: *const f64 = std::ptr::null();
-            // SAFETY: `m` is a valid assembled sequential matrix with
-            // fixed.len() rows; the row's pointers are read only between
-            // MatGetRow and the paired MatRestoreRow, `nz` entries each.
-            unsafe {
-                let r = row as PetscInt;
-                petsc_call!(MatGetRow(m, r, &mut nz, &mut cols, &mut vals))?;
-                if nz > 0 && !cols.is_null() && !vals.is_null() {
-                    let cs = std::slice::from_raw_parts(cols, nz as usize);
-                    let vs = std::slice::from_raw_parts(vals, nz as usize);
-                    for (&c, &v) in cs.iter().zip(vs) {
-                        if !fixed[c as usize] && v != 0.0 {
-                            d.col.push(c as usize);
-                            d.val.push(v);
-                        }
-                    }
-                }
-                petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
-            }
-        }
-        d.start.push(d.col.len());
-    }
-    Ok(d)
 }
 
 /// Both sorted: every entry of `a` is in `b`.

@@ -21,7 +21,6 @@ use crate::contact::ContactPair;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
-use crate::model::contact::Formulation;
 use crate::model::Model;
 use crate::parallel;
 use crate::petsc::low_rank::LowRankPreconditioner;
@@ -50,8 +49,11 @@ pub struct SchurSummary {
     pub sparse_solves: usize,
     pub dense_solves: usize,
     /// Several ranks: K's factor with a low-rank update (`schur_factorisations`
-    /// counts the dense LUs of I + D G; G is formed 1 + growths times).
+    /// counts the dense LUs of I + D G; G's columns come in
+    /// `inverse_blocks` requests, `inverse_columns` in all).
     pub low_rank: bool,
+    pub inverse_blocks: usize,
+    pub inverse_columns: usize,
     /// Low-rank path, rank 0's CPU seconds: forming G, and the dense
     /// set-ups (D gathered, M formed and factored).
     pub inverse_cpu_seconds: f64,
@@ -70,17 +72,7 @@ pub(super) fn applies(
     let world = mpi::topology::SimpleCommunicator::world();
     let follower = parallel::any_rank(&world, loads.has_follower());
     let s = &model.solver;
-    // The several-rank path (a low-rank update of K's factor) is checked
-    // against the full factorisation with contact links only; with a mortar
-    // pair on 2 ranks its first solve diverged (tests/mortar.rs), not yet
-    // understood, so mortar pairs keep the full factorisation there.
-    let mortar = model
-        .contact
-        .iter()
-        .any(|p| p.formulation == Formulation::Mortar);
-    let several = mpi::traits::Communicator::size(&world) > 1;
     s.contact_schur
-        && !(several && mortar)
         && tangent.contact
         && tangent.linear_bulk
         && global_dofs <= s.direct_max_dofs
@@ -220,6 +212,8 @@ pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
         schur_factorisations: s.dense_factorisations,
         growths: s.growths,
         low_rank: true,
+        inverse_blocks: s.inverse_blocks,
+        inverse_columns: s.inverse_columns,
         inverse_cpu_seconds: s.inverse_cpu_seconds,
         dense_cpu_seconds: s.dense_cpu_seconds,
         ..SchurSummary::default()
