@@ -253,6 +253,11 @@ pub trait Scalar:
     fn add_product(&mut self, a: Self, b: Self) {
         *self = *self + a * b;
     }
+    /// `self += a s` in place (sums of nodal values times shape values).
+    #[inline]
+    fn add_scaled(&mut self, a: &Self, s: f64) {
+        *self = *self + *a * s;
+    }
 }
 
 impl Scalar for f64 {
@@ -302,6 +307,13 @@ impl<const N: usize> Scalar for Dual<N> {
             out.eps[i] = grad[0] * at[0].eps[i] + grad[1] * at[1].eps[i];
         }
         out
+    }
+    #[inline]
+    fn add_scaled(&mut self, a: &Self, s: f64) {
+        self.re += a.re * s;
+        for i in 0..N {
+            self.eps[i] += a.eps[i] * s;
+        }
     }
     #[inline]
     fn add_product(&mut self, a: Self, b: Self) {

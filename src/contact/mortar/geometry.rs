@@ -448,12 +448,14 @@ fn implicit_step<T: Scalar>(
     let n = shape_values(facet, &zeta);
     let mut r = *p;
     for (na, v) in n.iter().zip(nodes).take(facet.nodes()) {
-        r = [r[0] - v[0] * *na, r[1] - v[1] * *na];
+        r[0].add_scaled(&v[0], -na);
+        r[1].add_scaled(&v[1], -na);
     }
-    [
-        r[0] * inverse[0][0] + r[1] * inverse[0][1] + zeta[0],
-        r[0] * inverse[1][0] + r[1] * inverse[1][1] + zeta[1],
-    ]
+    [0, 1].map(|k| {
+        let mut z = r[0] * inverse[k][0];
+        z.add_scaled(&r[1], inverse[k][1]);
+        z + zeta[k]
+    })
 }
 
 /// The f64 values of projected nodes.

@@ -243,7 +243,7 @@ fn point_on<T: Scalar>(s: &FacetShape, x: &[Vec3<T>], zeta: &[T; 2]) -> Vec3<T> 
         }
         let mut p = T::linearised(0.0, t, zeta);
         for (na, xa) in s.n.iter().zip(x).take(s.nodes) {
-            p = p + xa[i] * *na;
+            p.add_scaled(&xa[i], *na);
         }
         p
     })
@@ -279,8 +279,8 @@ fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: [f64; 2])
     let mut j = [[T::from_f64(0.0); 2]; 2];
     for (d, p) in dn.iter().zip(nodes).take(facet.nodes()) {
         for (row, pr) in j.iter_mut().zip(p) {
-            row[0] = row[0] + *pr * d[0];
-            row[1] = row[1] + *pr * d[1];
+            row[0].add_scaled(pr, d[0]);
+            row[1].add_scaled(pr, d[1]);
         }
     }
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
