@@ -55,11 +55,14 @@ impl<const N: usize> Dual<N> {
 
     /// `f(self)` given `f = value` and `f' = slope` at `self.re`.
     #[inline]
-    fn chain(self, value: f64, slope: f64) -> Self {
-        Dual {
-            re: value,
-            eps: self.eps.map(|e| slope * e),
+    fn chain(mut self, value: f64, slope: f64) -> Self {
+        // In place: `array::map` built a second array (an eighth of the
+        // dual-number instructions of a frictional mortar run).
+        self.re = value;
+        for e in &mut self.eps {
+            *e *= slope;
         }
+        self
     }
 }
 
@@ -239,6 +242,22 @@ pub trait Scalar:
     fn re(&self) -> f64;
     fn sqrt(self) -> Self;
     fn recip(self) -> Self;
+    /// `f(at)` given `f`'s value and gradient at `at`'s values: `value`
+    /// with the derivative `grad · ∂at`. What a function of two
+    /// parametric coordinates costs in `Dual<N>` is then one pass over the
+    /// gradient, however many operations `f` takes in f64.
+    fn linearised(value: f64, grad: [f64; 2], at: &[Self; 2]) -> Self;
+    /// `self += a b` in place (the accumulation of the segment integrals:
+    /// no temporaries of the product).
+    #[inline]
+    fn add_product(&mut self, a: Self, b: Self) {
+        *self = *self + a * b;
+    }
+    /// `self += a s` in place (sums of nodal values times shape values).
+    #[inline]
+    fn add_scaled(&mut self, a: &Self, s: f64) {
+        *self = *self + *a * s;
+    }
 }
 
 impl Scalar for f64 {
@@ -258,6 +277,10 @@ impl Scalar for f64 {
     fn recip(self) -> Self {
         1.0 / self
     }
+    #[inline]
+    fn linearised(value: f64, _: [f64; 2], _: &[f64; 2]) -> Self {
+        value
+    }
 }
 
 impl<const N: usize> Scalar for Dual<N> {
@@ -276,6 +299,28 @@ impl<const N: usize> Scalar for Dual<N> {
     #[inline]
     fn recip(self) -> Self {
         Dual::recip(self)
+    }
+    #[inline]
+    fn linearised(value: f64, grad: [f64; 2], at: &[Self; 2]) -> Self {
+        let mut out = Self::constant(value);
+        for i in 0..N {
+            out.eps[i] = grad[0] * at[0].eps[i] + grad[1] * at[1].eps[i];
+        }
+        out
+    }
+    #[inline]
+    fn add_scaled(&mut self, a: &Self, s: f64) {
+        self.re += a.re * s;
+        for i in 0..N {
+            self.eps[i] += a.eps[i] * s;
+        }
+    }
+    #[inline]
+    fn add_product(&mut self, a: Self, b: Self) {
+        self.re += a.re * b.re;
+        for i in 0..N {
+            self.eps[i] += a.eps[i] * b.re + a.re * b.eps[i];
+        }
     }
 }
 

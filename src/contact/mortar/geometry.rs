@@ -298,8 +298,8 @@ pub fn triangulate_from_vertex<T: Scalar>(
 pub const AFFINE_TOL: f64 = 1e-9;
 
 /// Relative size of the bilinear term under which the map is affine to
-/// rounding: one Newton step from anywhere is its inverse, value and
-/// derivative (the error is that term times the step squared).
+/// rounding: one Newton step from anywhere is its inverse (the error is
+/// that term times the step squared).
 pub const EXACTLY_AFFINE_TOL: f64 = 1e-13;
 
 /// The relative size of a projected facet's bilinear term (zero for a
@@ -320,15 +320,6 @@ fn bilinear_term<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>]) -> f64 {
     }
 }
 
-/// [`inverse_map`] of a facet whose map is affine to rounding: one Newton
-/// step in `T` from the facet centre.
-fn affine_inverse<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
-    let c = crate::contact::projection::reference_centre(facet);
-    let zeta = [T::from_f64(c[0]), T::from_f64(c[1])];
-    let step = newton_step(facet, nodes, p, zeta)?;
-    Some([zeta[0] + step[0], zeta[1] + step[1]])
-}
-
 /// Facet shape functions at a parametric point in `T` (bilinear quad,
 /// linear triangle), so a dual-valued point carries its derivative.
 pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
@@ -346,86 +337,183 @@ pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACE
     }
 }
 
+/// A facet's map from parametric coordinates onto the auxiliary plane,
+/// inverted point by point ([`PlanarMap::invert`]). A facet affine to
+/// rounding keeps its constant inverse Jacobian and the image of its centre,
+/// so a point costs a matrix-vector product instead of Newton iterations.
+pub struct PlanarMap<'a, T> {
+    facet: FacetType,
+    nodes: &'a [Vec2<T>],
+    nodes_f: [Vec2<f64>; MAX_FACET_NODES],
+    affine: Option<AffineMap>,
+}
+
+/// `ζ = centre + inverse (p − image)`.
+struct AffineMap {
+    centre: Vec2<f64>,
+    image: Vec2<f64>,
+    inverse: [[f64; 2]; 2],
+}
+
+impl<'a, T: Scalar> PlanarMap<'a, T> {
+    /// The map of the projected nodes `nodes` whose relative bilinear term
+    /// is `bilinear`; `None` if it is affine and singular.
+    pub fn new(facet: FacetType, nodes: &'a [Vec2<T>], bilinear: f64) -> Option<Self> {
+        let nodes_f = values2(nodes);
+        let affine = if bilinear <= EXACTLY_AFFINE_TOL {
+            let centre = crate::contact::projection::reference_centre(facet);
+            Some(AffineMap {
+                centre,
+                image: interpolate(facet, &nodes_f, &centre),
+                inverse: inverse_jacobian(facet, &nodes_f, centre)?,
+            })
+        } else {
+            None
+        };
+        Some(PlanarMap {
+            facet,
+            nodes,
+            nodes_f,
+            affine,
+        })
+    }
+
+    /// Parametric coordinates of the facet point whose projection is `p`:
+    /// in f64 (the affine map, or Newton from the facet centre), then
+    /// [`implicit_step`] in `T`. `None` if Newton fails (folded projection).
+    pub fn invert(&self, p: &Vec2<T>) -> Option<Vec2<T>> {
+        let target = [p[0].re(), p[1].re()];
+        let (zeta, inverse) = match &self.affine {
+            Some(a) => {
+                let r = sub2(&target, &a.image);
+                let zeta = [
+                    a.centre[0] + a.inverse[0][0] * r[0] + a.inverse[0][1] * r[1],
+                    a.centre[1] + a.inverse[1][0] * r[0] + a.inverse[1][1] * r[1],
+                ];
+                (zeta, a.inverse)
+            }
+            None => {
+                let zeta = newton(self.facet, &self.nodes_f, target)?;
+                (zeta, inverse_jacobian(self.facet, &self.nodes_f, zeta)?)
+            }
+        };
+        Some(implicit_step(self.facet, &inverse, self.nodes, p, zeta))
+    }
+}
+
 /// Parametric coordinates of the facet point whose projection is `p`, given
-/// the projected nodes `nodes`: Newton in f64 from the facet centre, then one
-/// more step in `T` from the converged point, whose derivative is the
-/// implicit-function derivative. `None` if Newton fails (folded projection).
+/// the projected nodes `nodes` (Newton however the facet maps).
 pub fn inverse_map<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
-    let nodes_f: [Vec2<f64>; MAX_FACET_NODES] = {
-        let mut out = [[0.0; 2]; MAX_FACET_NODES];
-        for (o, v) in out.iter_mut().zip(nodes) {
-            *o = [v[0].re(), v[1].re()];
-        }
-        out
-    };
-    let target = [p[0].re(), p[1].re()];
+    PlanarMap::new(facet, nodes, f64::INFINITY)?.invert(p)
+}
+
+/// Newton in f64 from the facet centre for the point mapped onto `target`.
+fn newton(facet: FacetType, nodes_f: &[Vec2<f64>], target: Vec2<f64>) -> Option<Vec2<f64>> {
     let mut zeta = crate::contact::projection::reference_centre(facet);
-    let scale = nodes_f[..facet.nodes()]
-        .iter()
-        .map(|v| v[0].abs().max(v[1].abs()))
-        .fold(0.0, f64::max)
-        .max(f64::MIN_POSITIVE);
-    let mut converged = false;
     for _ in 0..30 {
-        let step = newton_step(facet, &nodes_f, &target, [zeta[0], zeta[1]])?;
+        let step = newton_step(facet, nodes_f, &target, zeta)?;
         zeta = [zeta[0] + step[0], zeta[1] + step[1]];
         if step[0].abs().max(step[1].abs()) < 1e-14 {
-            converged = true;
-            break;
+            return Some(zeta);
         }
         if !(zeta[0].abs() < 10.0 && zeta[1].abs() < 10.0) {
             return None;
         }
     }
-    if !converged {
-        // Accept a residual at rounding level (bilinear Newton stalls there).
-        let x = interpolate(facet, &nodes_f, &[zeta[0], zeta[1]]);
-        if (x[0] - target[0]).hypot(x[1] - target[1]) > 1e-12 * scale {
-            return None;
-        }
-    }
-    let zeta_t = [T::from_f64(zeta[0]), T::from_f64(zeta[1])];
-    let step = newton_step(facet, nodes, p, zeta_t)?;
-    Some([zeta_t[0] + step[0], zeta_t[1] + step[1]])
+    // Accept a residual at rounding level (bilinear Newton stalls there).
+    let scale = nodes_f[..facet.nodes()]
+        .iter()
+        .map(|v| v[0].abs().max(v[1].abs()))
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let x = interpolate(facet, nodes_f, &zeta);
+    ((x[0] - target[0]).hypot(x[1] - target[1]) <= 1e-12 * scale).then_some(zeta)
 }
 
-fn interpolate<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], zeta: &Vec2<T>) -> Vec2<T> {
-    let n = shape_values(facet, zeta);
-    let mut x = [T::from_f64(0.0); 2];
+/// One more Newton step from the solution `ζ₀` (f64), in `T` with the shape
+/// values and the inverse Jacobian `J⁻¹` in f64: `ζ₀ + J⁻¹ (p − Σ_a N_a(ζ₀)
+/// v_a)`. Its derivative is the implicit function's, `J⁻¹ (dp − Σ_a N_a(ζ₀)
+/// dv_a)`, exactly: that of `J` multiplies the residual, zero at `ζ₀`. A
+/// step with `J` in `T` (what this replaces) cost six times the dual
+/// operations; the affine case's single step from the centre in `T` (also
+/// replaced) missed the `N_a(ζ₀)` of a facet that is a parallelogram now
+/// but not under a perturbation (its bilinear term's derivative).
+fn implicit_step<T: Scalar>(
+    facet: FacetType,
+    inverse: &[[f64; 2]; 2],
+    nodes: &[Vec2<T>],
+    p: &Vec2<T>,
+    zeta: Vec2<f64>,
+) -> Vec2<T> {
+    let n = shape_values(facet, &zeta);
+    let mut r = *p;
     for (na, v) in n.iter().zip(nodes).take(facet.nodes()) {
-        x = [x[0] + *na * v[0], x[1] + *na * v[1]];
+        r[0].add_scaled(&v[0], -na);
+        r[1].add_scaled(&v[1], -na);
+    }
+    [0, 1].map(|k| {
+        let mut z = r[0] * inverse[k][0];
+        z.add_scaled(&r[1], inverse[k][1]);
+        z + zeta[k]
+    })
+}
+
+/// The f64 values of projected nodes.
+fn values2<T: Scalar>(nodes: &[Vec2<T>]) -> [Vec2<f64>; MAX_FACET_NODES] {
+    let mut out = [[0.0; 2]; MAX_FACET_NODES];
+    for (o, v) in out.iter_mut().zip(nodes) {
+        *o = [v[0].re(), v[1].re()];
+    }
+    out
+}
+
+fn interpolate(facet: FacetType, nodes: &[Vec2<f64>], zeta: &Vec2<f64>) -> Vec2<f64> {
+    let n = shape_values(facet, zeta);
+    let mut x = [0.0; 2];
+    for (na, v) in n.iter().zip(nodes).take(facet.nodes()) {
+        x = [x[0] + na * v[0], x[1] + na * v[1]];
     }
     x
 }
 
-/// One Newton step `J⁻¹ (p − x(ζ))` of the planar map; `None` if singular.
-fn newton_step<T: Scalar>(
+/// `(∂x/∂ζ)⁻¹` of the planar map at `ζ`; `None` if singular.
+fn inverse_jacobian(
     facet: FacetType,
-    nodes: &[Vec2<T>],
-    p: &Vec2<T>,
-    zeta: Vec2<T>,
-) -> Option<Vec2<T>> {
-    let x = interpolate(facet, nodes, &zeta);
-    let r = sub2(p, &x);
-    // Jacobian ∂x/∂ζ in T: the shape gradients are affine in ζ.
+    nodes: &[Vec2<f64>],
+    zeta: Vec2<f64>,
+) -> Option<[[f64; 2]; 2]> {
     let dn = shape_gradients(facet, &zeta);
-    let mut j = [[T::from_f64(0.0); 2]; 2];
+    let mut j = [[0.0; 2]; 2];
     for (d, v) in dn.iter().zip(nodes).take(facet.nodes()) {
         for row in 0..2 {
-            j[row][0] = j[row][0] + v[row] * d[0];
-            j[row][1] = j[row][1] + v[row] * d[1];
+            j[row][0] += v[row] * d[0];
+            j[row][1] += v[row] * d[1];
         }
     }
     let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-    let size =
-        (j[0][0].re().abs() + j[1][1].re().abs() + j[0][1].re().abs() + j[1][0].re().abs()).powi(2);
-    if !(det.re().abs() > 1e-14 * size && size > 0.0) {
+    let size = (j[0][0].abs() + j[1][1].abs() + j[0][1].abs() + j[1][0].abs()).powi(2);
+    if !(det.abs() > 1e-14 * size && size > 0.0) {
         return None;
     }
-    let inv = det.recip();
+    let inv = 1.0 / det;
     Some([
-        (j[1][1] * r[0] - j[0][1] * r[1]) * inv,
-        (j[0][0] * r[1] - j[1][0] * r[0]) * inv,
+        [j[1][1] * inv, -j[0][1] * inv],
+        [-j[1][0] * inv, j[0][0] * inv],
+    ])
+}
+
+/// One Newton step `J⁻¹ (p − x(ζ))` of the planar map; `None` if singular.
+fn newton_step(
+    facet: FacetType,
+    nodes: &[Vec2<f64>],
+    p: &Vec2<f64>,
+    zeta: Vec2<f64>,
+) -> Option<Vec2<f64>> {
+    let r = sub2(p, &interpolate(facet, nodes, &zeta));
+    let inv = inverse_jacobian(facet, nodes, zeta)?;
+    Some([
+        inv[0][0] * r[0] + inv[0][1] * r[1],
+        inv[1][0] * r[0] + inv[1][1] * r[1],
     ])
 }
 
@@ -538,12 +626,12 @@ impl<T: Scalar> Overlap<T> {
         mut f: impl FnMut(&SegmentPoint<T>),
     ) -> bool {
         let affine = self.bilinear[0].max(self.bilinear[1]) <= AFFINE_TOL;
-        let map = |facet, nodes: &[Vec2<T>], p: &Vec2<T>, bilinear: f64| {
-            if bilinear <= EXACTLY_AFFINE_TOL {
-                affine_inverse(facet, nodes, p)
-            } else {
-                inverse_map(facet, nodes, p)
-            }
+        let maps = (
+            PlanarMap::new(slave_type, &self.slave_nodes, self.bilinear[0]),
+            PlanarMap::new(master_type, &self.master_nodes, self.bilinear[1]),
+        );
+        let (Some(slave_map), Some(master_map)) = maps else {
+            return false;
         };
         let triangles: &mut dyn Iterator<Item = Triangle<T>> = if affine {
             &mut triangulate_from_vertex(&self.polygon)
@@ -554,9 +642,7 @@ impl<T: Scalar> Overlap<T> {
             let area = tri.area();
             for (xi_ref, w) in rule {
                 let p = tri.point(*xi_ref);
-                let zeta = map(slave_type, &self.slave_nodes, &p, self.bilinear[0]);
-                let xi = map(master_type, &self.master_nodes, &p, self.bilinear[1]);
-                let (Some(zeta), Some(xi)) = (zeta, xi) else {
+                let (Some(zeta), Some(xi)) = (slave_map.invert(&p), master_map.invert(&p)) else {
                     return false;
                 };
                 f(&SegmentPoint {

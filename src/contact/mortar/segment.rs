@@ -16,9 +16,9 @@
 //!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
 //!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
 //!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
-use super::geometry::{overlap, shape_gradients, shape_values};
+use super::geometry::{overlap, shape_gradients};
 use crate::contact::dual::{self, Scalar, Vec3};
-use crate::fem::shape::facet_shape;
+use crate::fem::shape::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 
 /// A quadrature rule as (point, weight) pairs.
@@ -199,19 +199,61 @@ pub struct SegmentTerms<T> {
     pub area: T,
 }
 
-fn point_on<T: Scalar>(n: &[T; MAX_FACET_NODES], x: &[Vec3<T>], nodes: usize) -> Vec3<T> {
-    let mut p = dual::constant3::<T>([0.0; 3]);
-    for (na, xa) in n.iter().zip(x).take(nodes) {
-        p = dual::add(&p, &dual::scale(xa, *na));
+/// Shape values at a point in `T` through [`Scalar::linearised`] (one pass
+/// over the gradient each, where the bilinear product in `T` took five),
+/// and the f64 shape there.
+fn linearised_shape<T: Scalar>(
+    facet: FacetType,
+    zeta: &[T; 2],
+) -> (FacetShape, [T; MAX_FACET_NODES]) {
+    let s = facet_shape(facet, [zeta[0].re(), zeta[1].re()]);
+    let mut n = [T::from_f64(0.0); MAX_FACET_NODES];
+    for (na, (v, g)) in n.iter_mut().zip(s.n.iter().zip(&s.dn)).take(s.nodes) {
+        *na = T::linearised(*v, *g, zeta);
     }
-    p
+    (s, n)
+}
+
+/// `Φ_j = Σ_k A_jk N_k` at a point with the f64 shape `s` there, linearised
+/// (the sum in f64, one pass over the gradient per `j`).
+fn linearised_dual_basis<T: Scalar>(
+    a: &[[f64; MAX_FACET_NODES]; MAX_FACET_NODES],
+    s: &FacetShape,
+    zeta: &[T; 2],
+) -> [T; MAX_FACET_NODES] {
+    let mut phi = [T::from_f64(0.0); MAX_FACET_NODES];
+    for (p, row) in phi.iter_mut().zip(a).take(s.nodes) {
+        let (mut v, mut g) = (0.0, [0.0; 2]);
+        for (ajk, (nk, dk)) in row.iter().zip(s.n.iter().zip(&s.dn)).take(s.nodes) {
+            v += ajk * nk;
+            g = [g[0] + ajk * dk[0], g[1] + ajk * dk[1]];
+        }
+        *p = T::linearised(v, g, zeta);
+    }
+    phi
+}
+
+/// The facet point `Σ_a N_a(ζ) x_a` in `T`: the nodes' derivatives times
+/// the f64 shape values, plus the f64 tangents along the point's.
+fn point_on<T: Scalar>(s: &FacetShape, x: &[Vec3<T>], zeta: &[T; 2]) -> Vec3<T> {
+    [0, 1, 2].map(|i| {
+        let mut t = [0.0; 2];
+        for (d, xa) in s.dn.iter().zip(x).take(s.nodes) {
+            t = [t[0] + d[0] * xa[i].re(), t[1] + d[1] * xa[i].re()];
+        }
+        let mut p = T::linearised(0.0, t, zeta);
+        for (na, xa) in s.n.iter().zip(x).take(s.nodes) {
+            p.add_scaled(&xa[i], *na);
+        }
+        p
+    })
 }
 
 /// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.
 /// The facet is fixed, so the value depends on the segment variables only
 /// through `ζ`: it is computed with the two derivatives along `ζ` and
-/// chained, `J₀(ζ₀) + ∂J₀/∂ζ · (ζ − ζ₀)`, instead of carrying every segment
-/// variable through the cross product (a tenth of a frictional mortar run).
+/// linearised, instead of carrying every segment variable through the
+/// cross product (a tenth of a frictional mortar run).
 fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T; 2]) -> T {
     use crate::contact::dual::Dual;
     let z: [Dual<2>; 2] = [
@@ -227,20 +269,43 @@ fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T
         t2 = dual::add(&t2, &dual::scale(&x, d[1]));
     }
     let j = dual::norm(&dual::cross(&t1, &t2));
-    T::from_f64(j.re) + (zeta[0] - zeta[0].re()) * j.eps[0] + (zeta[1] - zeta[1].re()) * j.eps[1]
+    T::linearised(j.re, j.eps, zeta)
 }
 
-/// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane.
-fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: &[T; 2]) -> T {
-    let dn = shape_gradients(facet, zeta);
+/// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane at an
+/// f64 point.
+fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: [f64; 2]) -> T {
+    let dn = facet_shape(facet, zeta).dn;
     let mut j = [[T::from_f64(0.0); 2]; 2];
     for (d, p) in dn.iter().zip(nodes).take(facet.nodes()) {
         for (row, pr) in j.iter_mut().zip(p) {
-            row[0] = row[0] + *pr * d[0];
-            row[1] = row[1] + *pr * d[1];
+            row[0].add_scaled(pr, d[0]);
+            row[1].add_scaled(pr, d[1]);
         }
     }
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
+}
+
+/// [`plane_jacobian`] as `c₀ + c₁ ζ₁ + c₂ ζ₂`: the columns of a bilinear
+/// quad's Jacobian are affine in the other coordinate, so the `ζ₁ ζ₂` term
+/// of their cross product is the bilinear vector's with itself, zero; a
+/// triangle's is constant. Three evaluations per segment instead of one
+/// per quadrature point.
+struct PlaneJacobian<T>([T; 3]);
+
+impl<T: Scalar> PlaneJacobian<T> {
+    fn of(facet: FacetType, nodes: &[[T; 2]]) -> Self {
+        let c0 = plane_jacobian(facet, nodes, [0.0, 0.0]);
+        PlaneJacobian([
+            c0,
+            plane_jacobian(facet, nodes, [1.0, 0.0]) - c0,
+            plane_jacobian(facet, nodes, [0.0, 1.0]) - c0,
+        ])
+    }
+
+    fn at(&self, zeta: &[T; 2]) -> T {
+        self.0[0] + self.0[1] * zeta[0] + self.0[2] * zeta[1]
+    }
 }
 
 /// The integrals of the segment between slave facet `xs` (reference
@@ -273,36 +338,31 @@ pub fn segment_terms<T: Scalar>(
         area: zero,
     };
     let normal = ov.plane.normal;
-    let slave_nodes = ov.slave_nodes;
+    let projected_jacobian = PlaneJacobian::of(slave_type, &ov.slave_nodes);
     let mapped = ov.for_each_point(slave_type, master_type, &rules.triangle, |q| {
-        let projected = plane_jacobian(slave_type, &slave_nodes, &q.zeta);
+        let projected = projected_jacobian.at(&q.zeta);
         let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
         // The projected facet is counter-clockwise or clockwise depending on
         // its node order; the area element is the absolute value.
         let scale = if projected.re() < 0.0 { -scale } else { scale };
         let weight = q.weight * scale;
-        let n1 = shape_values(slave_type, &q.zeta);
-        let n2 = shape_values(master_type, &q.xi);
+        let (s1, n1) = linearised_shape(slave_type, &q.zeta);
+        let (s2, n2) = linearised_shape(master_type, &q.xi);
         // Φ_j = Σ_k A_jk N_k with the constant A in f64.
-        let mut phi = [zero; MAX_FACET_NODES];
-        for (p, row) in phi.iter_mut().zip(a).take(ns) {
-            for (nk, ajk) in n1.iter().zip(row).take(ns) {
-                *p = *p + *nk * *ajk;
-            }
-        }
+        let phi = linearised_dual_basis(a, &s1, &q.zeta);
         let gap = dual::dot(
             &normal,
-            &dual::sub(&point_on(&n2, xm, nm), &point_on(&n1, xs, ns)),
+            &dual::sub(&point_on(&s2, xm, &q.xi), &point_on(&s1, xs, &q.zeta)),
         );
         terms.area = terms.area + weight;
         for (j, phi_j) in phi.iter().enumerate().take(ns) {
             let pw = *phi_j * weight;
-            terms.weighted_gap[j] = terms.weighted_gap[j] + pw * gap;
+            terms.weighted_gap[j].add_product(pw, gap);
             for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
-                *djk = *djk + pw * *nk;
+                djk.add_product(pw, *nk);
             }
             for (mjl, nl) in terms.m[j].iter_mut().zip(&n2).take(nm) {
-                *mjl = *mjl + pw * *nl;
+                mjl.add_product(pw, *nl);
             }
         }
     });

@@ -276,6 +276,10 @@ struct PatchSpec {
     z: f64,
     angle: f64,
     master: bool,
+    /// Node perturbations (in-plane, out of plane) relative to the facet
+    /// size; zero leaves parallelograms, whose maps onto the plane are
+    /// affine.
+    jitter: [f64; 2],
 }
 
 fn patch(
@@ -290,6 +294,7 @@ fn patch(
         z,
         angle,
         master,
+        jitter,
     } = spec;
     let base = positions.len() as u32;
     let h = size / n as f64;
@@ -297,8 +302,11 @@ fn patch(
     for j in 0..=n {
         for i in 0..=n {
             let (x, y) = (i as f64 * h - size / 2.0, j as f64 * h - size / 2.0);
-            let (x, y) = (x + 0.15 * h * rng.next(), y + 0.15 * h * rng.next());
-            positions.push([c * x - s * y, s * x + c * y, z + 0.05 * h * rng.next()]);
+            let (x, y) = (
+                x + jitter[0] * h * rng.next(),
+                y + jitter[0] * h * rng.next(),
+            );
+            positions.push([c * x - s * y, s * x + c * y, z + jitter[1] * h * rng.next()]);
         }
     }
     let id = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
@@ -322,6 +330,18 @@ fn patch(
 }
 
 pub(super) fn random_case(seed: u64, slave_type: FacetType, master_type: FacetType) -> Case {
+    case_with(seed, slave_type, master_type, [0.15, 0.05])
+}
+
+/// [`random_case`] with unperturbed nodes: a square slave grid under a
+/// rotated square master grid, every facet mapping affinely onto the plane
+/// (the block slide's facets, where the inverse maps take their affine
+/// path).
+pub(super) fn parallelogram_case(seed: u64) -> Case {
+    case_with(seed, Quad4, Quad4, [0.0, 0.0])
+}
+
+fn case_with(seed: u64, slave_type: FacetType, master_type: FacetType, jitter: [f64; 2]) -> Case {
     let mut rng = Lcg::new(seed);
     let mut positions = Vec::new();
     let slave = PatchSpec {
@@ -330,6 +350,7 @@ pub(super) fn random_case(seed: u64, slave_type: FacetType, master_type: FacetTy
         z: 0.0,
         angle: 0.0,
         master: false,
+        jitter,
     };
     let slave_facets = patch(slave_type, slave, &mut rng, &mut positions);
     let n_slave = positions.len();
@@ -340,6 +361,7 @@ pub(super) fn random_case(seed: u64, slave_type: FacetType, master_type: FacetTy
         z: -0.02,
         angle,
         master: true,
+        jitter,
     };
     let master_facets = patch(master_type, master, &mut rng, &mut positions);
     let mut candidates = Vec::new();
@@ -408,14 +430,18 @@ impl Case {
 
 #[test]
 fn tangent_matches_finite_differences_of_the_residual() {
-    for (seed, s, m) in [
+    let cases = [
         (11, Quad4, Quad4),
         (12, Quad4, Quad4),
         (13, Tri3, Quad4),
         (14, Quad4, Tri3),
         (15, Tri3, Tri3),
-    ] {
-        let case = random_case(seed, s, m);
+    ]
+    .map(|(seed, s, m)| (seed, random_case(seed, s, m)))
+    .into_iter()
+    .chain([(16, parallelogram_case(16))]);
+    for (seed, case) in cases {
+        let (s, m) = (case.slave_type, case.master_type);
         let (k, closed) = case.tangent();
         assert!(closed >= 4, "seed {seed}: only {closed} closed nodes");
         let n = 3 * case.positions.len();
