@@ -148,38 +148,6 @@ impl Snes {
         Ok((atol, rtol, stol, max_it.max(0) as usize))
     }
 
-    /// Switches the Eisenstat–Walker forcing of the following solves to
-    /// PETSc's `version` (1–3), keeping its other parameters as they are.
-    /// Only matters where `-snes_ksp_ew` is on. Collective.
-    pub fn set_ew_version(&mut self, version: i32) -> Result<()> {
-        let (mut v, mut rtol0, mut rtolmax) = (0 as sys::PetscInt, 0.0, 0.0);
-        let (mut gamma, mut alpha, mut alpha2, mut threshold) = (0.0, 0.0, 0.0, 0.0);
-        // SAFETY: valid snes; every out-pointer is a live local, and the
-        // values read are handed back unchanged but for the version.
-        unsafe {
-            petsc_call!(SNESKSPGetParametersEW(
-                self.raw,
-                &mut v,
-                &mut rtol0,
-                &mut rtolmax,
-                &mut gamma,
-                &mut alpha,
-                &mut alpha2,
-                &mut threshold
-            ))?;
-            petsc_call!(SNESKSPSetParametersEW(
-                self.raw,
-                version as sys::PetscInt,
-                rtol0,
-                rtolmax,
-                gamma,
-                alpha,
-                alpha2,
-                threshold
-            ))
-        }
-    }
-
     /// How often the preconditioner is rebuilt within this and later solves:
     /// 1 every Newton iteration, -1 never (reuse the last one). The Jacobian
     /// itself is still evaluated every iteration.

@@ -393,11 +393,6 @@ impl LoadSteps<'_> {
         let solver = &self.model.solver;
         let (world, mech) = (&self.world, &mut self.mech);
         let krylov = DIM * mech.dofs.num_global_nodes() > solver.direct_max_dofs;
-        // A user's -snes_ksp_ew_version holds for every solve.
-        let ew_versions = (krylov
-            && !mech.contact.is_empty()
-            && !petsc::options::user_set("-snes_ksp_ew_version")?)
-        .then_some(super::tolerance::EW_VERSIONS);
         let mut ctx = StepContext {
             snes: &mut self.snes,
             x: &mut self.x,
@@ -412,7 +407,6 @@ impl LoadSteps<'_> {
             } else {
                 0.0
             },
-            ew_versions,
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
             acceleration: super::tolerance::inner_acceleration(solver.uzawa_acceleration, krylov),

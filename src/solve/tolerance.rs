@@ -73,39 +73,6 @@ pub fn inner_acceleration(setting: Option<usize>, krylov: bool) -> usize {
 /// failed after its cutbacks; 0.1 and 0.2 ran alike (136 and 130 GMRES).
 pub const LINEAR_FLOOR: f64 = 0.1;
 
-/// The Eisenstat–Walker variants of the Krylov path with contact: PETSc's
-/// version 3 for non-final Uzawa solves, its default version 2 for the
-/// step's last one. Version 3 bounds each forcing term from below by the
-/// reduction the Newton solve still has to make (γ·rtol·|R0| / |R_k|) and
-/// keeps it from falling faster than γ·η_{k-1}^α, so a loose solve's GMRES
-/// stops where its Newton solve can use no more (hertz-sphere h = 0.35,
-/// 2 ranks: 15 / 6 / 141 → 16 / 6 / 131 Newton / Uzawa / GMRES, PETSc
-/// flops 1.869e10 → 1.769e10; h = 0.5 126 → 122 GMRES, 9.114e9 → 8.868e9;
-/// hertz-cylinder h = 0.4 on GMRES + GAMG 203 → 195). On the last solve
-/// the same bound takes away the overshoot the contact force's balance
-/// against the support reactions relies on (h = 0.35, version 3 on every
-/// solve: imbalance 6.4e-9 → 5.6e-8; on the loose ones only: 9.6e-9), so
-/// that one keeps version 2.
-pub const EW_VERSIONS: EwVersions = EwVersions { loose: 3, tight: 2 };
-
-/// PETSc's Eisenstat–Walker version for non-final and final Newton solves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct EwVersions {
-    pub loose: i32,
-    pub tight: i32,
-}
-
-impl EwVersions {
-    /// The version for a solve to the final (`tight`) or a loose tolerance.
-    pub fn for_solve(&self, tight: bool) -> i32 {
-        if tight {
-            self.tight
-        } else {
-            self.loose
-        }
-    }
-}
-
 /// SNES's stopping rule for one Newton solve: |R| ≤ max(atol, rtol·|R0|).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonTolerance {
@@ -222,12 +189,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    #[test]
-    fn only_loose_solves_take_the_safeguarded_forcing() {
-        assert_eq!(EW_VERSIONS.for_solve(false), 3);
-        assert_eq!(EW_VERSIONS.for_solve(true), 2, "PETSc's default");
     }
 
     #[test]

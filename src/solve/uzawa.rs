@@ -38,9 +38,6 @@ pub(super) struct StepContext<'s> {
     /// The GMRES floor of non-final solves (`tolerance::LINEAR_FLOOR`;
     /// 0: none).
     pub(super) linear_floor: f64,
-    /// The Eisenstat–Walker versions of loose and final solves
-    /// (`tolerance::EW_VERSIONS`; None: PETSc's setting for every solve).
-    pub(super) ew_versions: Option<tolerance::EwVersions>,
     /// Penalty divisor of a contact-free step's first Uzawa iteration
     /// (1: off; see `soften_first_contact`).
     pub(super) softening: f64,
@@ -112,7 +109,6 @@ fn uzawa_rounds(
 ) -> Result<StepResult> {
     let softening = ctx.softening;
     let linear_floor = ctx.linear_floor;
-    let ew_versions = ctx.ew_versions;
     let mut accel = Anderson::new(ctx.acceleration);
     let StepContext {
         snes,
@@ -145,9 +141,6 @@ fn uzawa_rounds(
         snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
         if linear_floor > 0.0 {
             snes.set_linear_floor(if solve_tight { 0.0 } else { linear_floor })?;
-        }
-        if let Some(versions) = ew_versions {
-            snes.set_ew_version(versions.for_solve(solve_tight))?;
         }
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
