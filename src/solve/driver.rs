@@ -21,7 +21,7 @@ use super::report::{
 use super::schur;
 use super::setup::{self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance};
 use super::start::{initial_state, mechanics, prepare_time_step, time_stepper, Parts};
-use super::uzawa::{uzawa_loop, StepContext, StepResult};
+use super::uzawa::{chain, uzawa_loop, StepContext, StepResult};
 use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::pair_state::{PairSnapshot, PointValues};
@@ -38,6 +38,11 @@ use crate::runtime::Runtime;
 use mpi::topology::SimpleCommunicator;
 use std::borrow::Cow;
 use std::time::Instant;
+
+/// Most contact searches in one attempt at a load step: the step's own and
+/// those from a solution the candidates no longer cover (one more is
+/// enough unless the zone keeps growing; then the step is cut back).
+const SEARCHES: usize = 3;
 
 /// A model set up on this rank: partition, numbering, element data, contact
 /// pairs, Jacobian storage. Built collectively by every rank.
@@ -261,11 +266,29 @@ impl LoadSteps<'_> {
         if let Some(lag) = self.mech.lag.as_mut() {
             lag.reset();
         }
-        let attempt = first.map_or_else(|f| Ok(Err(f)), |()| self.solve(target));
+        let attempt = first.map_or_else(|f| Ok(Err(f)), |()| self.solve_searched(target));
         match attempt? {
             Ok(solved) => self.accept(sink, solved, start, target),
             Err(failure) => self.cut_back(failure, start.contact, target),
         }
+    }
+
+    /// [`Self::solve`], then while some pair's candidates (searched at the
+    /// predicted state) stop covering its solution: a search from that
+    /// state and the solve from there, at most `SEARCHES` searches in all.
+    fn solve_searched(&mut self, target: f64) -> Result<StepResult> {
+        let mut result = self.solve(target)?;
+        for _ in 1..SEARCHES {
+            let Err(StepFailure::Uncovered { outcome, uzawa }) = result else {
+                break;
+            };
+            self.search_contact(target)?;
+            if let Some(lag) = self.mech.lag.as_mut() {
+                lag.reset();
+            }
+            result = chain((outcome, uzawa), self.solve(target)?);
+        }
+        Ok(result)
     }
 
     /// The predictor, the new loads and prescribed displacements at `target`,

@@ -25,6 +25,12 @@ pub(super) enum StepFailure {
         iterations: usize,
         stats: UzawaStats,
     },
+    /// A converged Newton solve left the contact candidates of the step's
+    /// search: some slave facet now meets a master facet it was not paired
+    /// with (see `ContactPair::covers`). The step goes on after a search
+    /// from this state (its counts so far); a failure once the searches of
+    /// an attempt are used up.
+    Uncovered { outcome: SnesOutcome, uzawa: usize },
 }
 
 impl StepFailure {
@@ -150,6 +156,9 @@ pub(super) fn failure_text(f: &StepFailure) -> String {
             "Uzawa loop did not converge in {iterations} iterations, the last ones with the penalty raised {}× (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
             PENALTY_RAISE.powi(PENALTY_RAISES as i32),
             stats.max_penetration, stats.max_change, stats.max_force
+        ),
+        StepFailure::Uncovered { uzawa, .. } => format!(
+            "the contact zone still grew past the contact search's candidates after {uzawa} Uzawa iterations and every search an attempt may make"
         ),
     }
 }

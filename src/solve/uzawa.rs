@@ -97,8 +97,9 @@ pub(super) fn uzawa_loop(
     );
     if let Some(s) = ctx.snes.schur_mut() {
         // The converged step's interior, formed once (a failed one is
-        // dropped: the step starts again from the last converged state).
-        if matches!(result, Ok(Ok(_))) {
+        // dropped: the step starts again from the last converged state; an
+        // uncovered one goes on from this state).
+        if matches!(result, Ok(Ok(_) | Err(StepFailure::Uncovered { .. }))) {
             let expanded = s.expand(ctx.x);
             if let Err(e) = expanded {
                 result = Err(e.into());
@@ -112,6 +113,35 @@ pub(super) fn uzawa_loop(
     }
     ctx.snes.set_tolerances(atol, rtol, stol, max_it)?;
     result
+}
+
+/// A solve the contact search's candidates stopped covering, followed by
+/// the solve from its state after a new search: the second's result with
+/// the Newton and Uzawa counts and the residual history of both.
+pub(super) fn chain((first, uzawa): (SnesOutcome, usize), second: StepResult) -> StepResult {
+    let join = |outcome: &mut SnesOutcome, more: &mut usize| {
+        outcome.iterations += first.iterations;
+        outcome.linear_iterations += first.linear_iterations;
+        outcome.history.splice(0..0, first.history.iter().copied());
+        *more += uzawa;
+    };
+    match second {
+        Ok((mut outcome, mut more, stats)) => {
+            join(&mut outcome, &mut more);
+            Ok((outcome, more, stats))
+        }
+        Err(StepFailure::Uncovered {
+            mut outcome,
+            uzawa: mut more,
+        }) => {
+            join(&mut outcome, &mut more);
+            Err(StepFailure::Uncovered {
+                outcome,
+                uzawa: more,
+            })
+        }
+        Err(other) => Err(other),
+    }
 }
 
 /// The Uzawa iterations of one step, in rounds of at most `max_uzawa`; a
@@ -187,7 +217,18 @@ fn uzawa_rounds(
             return Ok(Ok((outcome, 0, Vec::new())));
         }
         let before = accel.is_on().then(|| normal_multipliers(mech.contact));
-        let stats = update_multipliers(world, stages, times, mech, x, factor)?;
+        let (stats, covered) = update_multipliers(world, stages, times, mech, x, factor)?;
+        if !covered {
+            // No more Uzawa work on a set of segments that misses part of
+            // the contact: the caller searches from here and goes on.
+            outcome.iterations = newton;
+            outcome.linear_iterations = linear;
+            outcome.history = history;
+            return Ok(Err(StepFailure::Uncovered {
+                outcome,
+                uzawa: total,
+            }));
+        }
         if std::mem::take(main_part) {
             // The multipliers carry the contact from here: the full tangent.
             main_part_tangent(world, mech.contact, false);
@@ -357,7 +398,7 @@ fn update_multipliers(
     mech: &mut Mechanics,
     x: &Vector,
     factor: f64,
-) -> Result<Vec<UzawaStats>> {
+) -> Result<(Vec<UzawaStats>, bool)> {
     let mark = PhaseMark::new(&mech.times, mech.contact);
     let updated = stages.scope(Phase::UzawaUpdate, || {
         mech.with_state(x, |u, pairs| {
@@ -366,12 +407,14 @@ fn update_multipliers(
                 .map(|p| p.uzawa_update(u, factor))
                 .collect::<Result<Vec<UzawaStats>>>()?;
             fault::check(FaultPhase::UzawaUpdate)?;
-            Ok(stats)
+            let covered = pairs.iter().all(|p| p.covers(u, factor));
+            Ok((stats, covered))
         })
     });
-    let local = parallel::agree(world, updated)?;
+    let (local, covered) = parallel::agree(world, updated)?;
     mark.book(Phase::UzawaUpdate, times, &mech.times, mech.contact);
-    Ok(reduce_stats(world, &local))
+    let stats = reduce_stats(world, &local);
+    Ok((stats, parallel::all_ranks(world, covered)))
 }
 
 /// The accelerated pairs' normal multipliers, concatenated, and whether

@@ -57,24 +57,7 @@ impl MortarPair {
     /// the search distance of the surface placed at `factor`. Returns
     /// whether the candidates changed.
     pub(super) fn rigid_search(&mut self, u_local: &[f64], factor: f64) -> bool {
-        let x = self.positions(u_local);
-        let surface = self.rigid_master().placed(factor);
-        let d = self.search_distance;
-        let near: Vec<bool> = x
-            .iter()
-            .map(|p| rigid::distance(&surface, p).is_some_and(|(g, _)| g <= d))
-            .collect();
-        let nf = self.facet_type.nodes();
-        let candidates: Vec<u32> = self
-            .evaluated
-            .iter()
-            .copied()
-            .filter(|&f| {
-                self.slave_facets[f as usize][..nf]
-                    .iter()
-                    .any(|&n| near[n as usize])
-            })
-            .collect();
+        let candidates = self.facets_near_rigid(u_local, factor, self.search_distance);
         match &mut self.rigid {
             Some(r) => {
                 let changed = candidates != r.candidates;
@@ -83,6 +66,36 @@ impl MortarPair {
             }
             None => false,
         }
+    }
+
+    /// Whether the step's candidates hold every evaluated facet with a node
+    /// on or behind the surface placed at `factor` (see `MortarPair::covers`).
+    pub(super) fn rigid_covers(&self, u_local: &[f64], factor: f64) -> bool {
+        let candidates = &self.rigid_master().candidates;
+        self.facets_near_rigid(u_local, factor, 0.0)
+            .iter()
+            .all(|f| candidates.binary_search(f).is_ok())
+    }
+
+    /// The evaluated facets (ascending) with a node within `distance` of
+    /// the surface placed at `factor`.
+    fn facets_near_rigid(&self, u_local: &[f64], factor: f64, distance: f64) -> Vec<u32> {
+        let x = self.positions(u_local);
+        let surface = self.rigid_master().placed(factor);
+        let near: Vec<bool> = x
+            .iter()
+            .map(|p| rigid::distance(&surface, p).is_some_and(|(g, _)| g <= distance))
+            .collect();
+        let nf = self.facet_type.nodes();
+        self.evaluated
+            .iter()
+            .copied()
+            .filter(|&f| {
+                self.slave_facets[f as usize][..nf]
+                    .iter()
+                    .any(|&n| near[n as usize])
+            })
+            .collect()
     }
 
     /// For each complete node: the nodes of its candidate facets, squared

@@ -125,6 +125,16 @@ impl ContactPair {
         }
     }
 
+    /// Whether the step's search still covers the state `u_local` (see
+    /// `MortarPair::covers`); the links' search distance (ten element
+    /// sizes, at least a tenth of the master's extent) is their margin, so
+    /// they are taken as covered.
+    pub fn covers(&self, u_local: &[f64], factor: f64) -> bool {
+        self.mortar
+            .as_ref()
+            .is_none_or(|m| m.covers(u_local, factor))
+    }
+
     /// The search that starts every load step: outer search (closest master
     /// node through the spatial index) and inner search (projection onto the
     /// facets around it) for every slave point. Returns true when the coupling
