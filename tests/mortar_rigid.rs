@@ -5,7 +5,8 @@
 //! exactly μN once every node slides (and end in the same state); a
 //! frictional block on a moving rigid cylinder gives the same answers on 1,
 //! 2 and 3 ranks; a frictional impact on a rigid plane (dynamics) never
-//! creates energy and ends near the links' momentum.
+//! creates energy and ends near the links' momentum; a block pushed past
+//! the step's search margin is found by a search from the solved state.
 mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
@@ -428,5 +429,29 @@ fn frictional_impact_on_a_rigid_plane_never_creates_energy() {
             end[k],
             end_links[k]
         );
+    }
+}
+
+/// `pressed_block` with the plane 0.05 below the block and the top pushed
+/// down 0.06 in one step, the pair's search margin 0.01: the step's search,
+/// at the undeformed state, finds no slave facet near the plane, so the
+/// first solve pushes the block 0.01 through it; the run must search again
+/// from there and end with the uniform pressure E · 0.01 / 0.5 = 20, on 1
+/// and 2 ranks.
+#[test]
+fn rigid_mortar_search_follows_a_block_pushed_past_the_steps_margin() {
+    let dir = scratch("mortar-rigid-far");
+    let body = pressed_block("hex8", 0.0, "mortar")
+        .replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0, -0.05]")
+        .replace("value = [-0.01]", "value = [-0.06]")
+        .replace("max_uzawa = 60", "max_uzawa = 60\nsearch_distance = 0.01");
+    assert!(body.contains("search_distance = 0.01") && body.contains("-0.05]"));
+    for ranks in [1, 2] {
+        let out = run_scene(&dir, &format!("far-{ranks}"), &body, ranks)
+            .unwrap_or_else(|t| panic!("{ranks} rank(s): {t}"));
+        let (mean, dev) = pressure_deviation(&out);
+        println!("{ranks} rank(s): mean pressure {mean:.9} (exact 20), max deviation {dev:.2e}");
+        assert!((mean - 20.0).abs() < 1e-6 * 20.0, "mean pressure {mean}");
+        assert!(dev < 1e-6, "pressure deviates by {dev:.2e}");
     }
 }

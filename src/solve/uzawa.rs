@@ -92,7 +92,7 @@ pub(super) fn uzawa_loop(
         mech,
         factor,
         &inner,
-        (stol, max_it),
+        (stol, max_it, condensed),
         (&mut softened, &mut main_part),
     );
     if let Some(s) = ctx.snes.schur_mut() {
@@ -106,6 +106,18 @@ pub(super) fn uzawa_loop(
             }
         }
         s.disarm();
+    }
+    if condensed {
+        // The condensed iterates hold the true state on the contact DOFs
+        // only, so the candidates are checked here, on the whole state.
+        if let Ok(Ok((outcome, uzawa, _))) = &result {
+            if !contact_covers(world, mech, ctx.x, factor)? {
+                result = Ok(Err(StepFailure::Uncovered {
+                    outcome: outcome.clone(),
+                    uzawa: *uzawa,
+                }));
+            }
+        }
     }
     restore_penalties(mech, &mut softened, softening);
     if main_part {
@@ -153,7 +165,7 @@ fn uzawa_rounds(
     mech: &mut Mechanics,
     factor: f64,
     inner: &tolerance::InnerTolerance,
-    (stol, max_it): (f64, usize),
+    (stol, max_it, condensed): (f64, usize, bool),
     (softened, main_part): (&mut bool, &mut bool),
 ) -> Result<StepResult> {
     let softening = ctx.softening;
@@ -218,7 +230,9 @@ fn uzawa_rounds(
         }
         let before = accel.is_on().then(|| normal_multipliers(mech.contact));
         let (stats, covered) = update_multipliers(world, stages, times, mech, x, factor)?;
-        if !covered {
+        // (A condensed iterate's off-contact DOFs are not the state yet:
+        // the caller checks its candidates once the step has expanded it.)
+        if !covered && !condensed {
             // No more Uzawa work on a set of segments that misses part of
             // the contact: the caller searches from here and goes on.
             outcome.iterations = newton;
@@ -415,6 +429,19 @@ fn update_multipliers(
     mark.book(Phase::UzawaUpdate, times, &mech.times, mech.contact);
     let stats = reduce_stats(world, &local);
     Ok((stats, parallel::all_ranks(world, covered)))
+}
+
+/// Collective: whether every pair's candidates, on every rank, still
+/// cover the state `x` at load `factor` (`ContactPair::covers`).
+fn contact_covers(
+    world: &impl Communicator,
+    mech: &mut Mechanics,
+    x: &Vector,
+    factor: f64,
+) -> Result<bool> {
+    let local = mech.with_state(x, |u, pairs| Ok(pairs.iter().all(|p| p.covers(u, factor))));
+    let covered = parallel::agree(world, local)?;
+    Ok(parallel::all_ranks(world, covered))
 }
 
 /// The accelerated pairs' normal multipliers, concatenated, and whether
