@@ -1,4 +1,5 @@
 //! The contact tangent D on C, on rank 0, as compressed rows.
+use super::super::shell::error;
 use super::super::{petsc_call, sys, PetscInt, Result};
 
 /// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
@@ -77,11 +78,21 @@ impl Sparse {
 /// returns its error after it.
 pub(super) fn gather_sparse(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Sparse> {
     use mpi::traits::{Communicator, Root};
-    let local = own_rows(m, c, fixed);
+    let local = own_rows(m, c, fixed).and_then(|t| match i32::try_from(t.len()) {
+        Ok(_) => Ok(t),
+        Err(_) => Err(error(
+            "gather_sparse",
+            format!(
+                "{} values of the contact tangent exceed one gather",
+                t.len()
+            ),
+        )),
+    });
     let sent: &[f64] = local.as_deref().unwrap_or(&[]);
     let world = mpi::topology::SimpleCommunicator::world();
     let root = world.process_at_rank(0);
-    let n = i32::try_from(sent.len()).unwrap_or(0);
+    // Fits: checked above (0 when this rank failed).
+    let n = sent.len() as i32;
     if world.rank() != 0 {
         root.gather_into(&n);
         root.gather_varcount_into(sent);
