@@ -1,4 +1,5 @@
 //! The contact tangent D on C, on rank 0, as compressed rows.
+use super::super::shell::error;
 use super::super::{petsc_call, sys, PetscInt, Result};
 
 /// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
@@ -65,40 +66,114 @@ impl Sparse {
     }
 }
 
-/// A sequential |C| × |C| matrix's rows, without the `fixed` rows and
-/// columns.
-pub(super) fn read_sparse(m: sys::Mat, fixed: &[bool]) -> Result<Sparse> {
+/// D from the parallel contact tangent `m` onto rank 0 (empty elsewhere):
+/// each rank reads its own rows of C, keeps their entries at columns in C
+/// (not `fixed`, non-zero) as (row, column, value) triplets in positions,
+/// and rank 0 concatenates them in rank order. Ranks own ascending row
+/// ranges and MatGetRow gives a row's columns ascending, so the rows come
+/// out as a submatrix on C would give them, with only the non-zero
+/// entries moved (MatCreateSubMatrices moved the whole contact pattern, most
+/// of it the zeros of open links). `c` sorted. Collective: a rank whose
+/// reading failed still takes part in the gather, with no entries, and
+/// returns its error after it.
+pub(super) fn gather_sparse(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Sparse> {
+    use mpi::traits::{Communicator, Root};
+    let local = own_rows(m, c, fixed).and_then(|t| match i32::try_from(t.len()) {
+        Ok(_) => Ok(t),
+        Err(_) => Err(error(
+            "gather_sparse",
+            format!(
+                "{} values of the contact tangent exceed one gather",
+                t.len()
+            ),
+        )),
+    });
+    let sent: &[f64] = local.as_deref().unwrap_or(&[]);
+    let world = mpi::topology::SimpleCommunicator::world();
+    let root = world.process_at_rank(0);
+    // Fits: checked above (0 when this rank failed).
+    let n = sent.len() as i32;
+    if world.rank() != 0 {
+        root.gather_into(&n);
+        root.gather_varcount_into(sent);
+        return local.map(|_| Sparse::default());
+    }
+    let mut counts = vec![0i32; world.size() as usize];
+    root.gather_into_root(&n, &mut counts[..]);
+    let displs: Vec<i32> = counts
+        .iter()
+        .scan(0, |acc, &k| {
+            let d = *acc;
+            *acc += k;
+            Some(d)
+        })
+        .collect();
+    let mut all = vec![0.0; counts.iter().map(|&k| k as usize).sum()];
+    let mut part = mpi::datatype::PartitionMut::new(&mut all[..], counts, displs);
+    root.gather_varcount_into_root(sent, &mut part);
+    local?;
+    Ok(from_triplets(&all, c.len()))
+}
+
+/// This rank's triplets (row, column, value; positions in C stored as f64,
+/// exact below 2⁵³) of `m`'s owned rows of C.
+fn own_rows(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Vec<f64>> {
+    let (mut lo, mut hi): (PetscInt, PetscInt) = (0, 0);
+    // SAFETY: a valid matrix and out-pointers.
+    unsafe { petsc_call!(MatGetOwnershipRange(m, &mut lo, &mut hi))? };
+    let from = c.partition_point(|&d| d < lo);
+    let to = c.partition_point(|&d| d < hi);
+    let mut out = Vec::new();
+    for (i, &row) in c.iter().enumerate().take(to).skip(from) {
+        if fixed[i] {
+            continue;
+        }
+        let mut nz: PetscInt = 0;
+        let mut cols: *const PetscInt = std::ptr::null();
+        let mut vals: *const f64 = std::ptr::null();
+        // SAFETY: `m` is a valid assembled parallel matrix that owns `row`
+        // here; the row's pointers are read only between MatGetRow and the
+        // paired MatRestoreRow, `nz` entries each.
+        unsafe {
+            petsc_call!(MatGetRow(m, row, &mut nz, &mut cols, &mut vals))?;
+            if nz > 0 && !cols.is_null() && !vals.is_null() {
+                let cs = std::slice::from_raw_parts(cols, nz as usize);
+                let vs = std::slice::from_raw_parts(vals, nz as usize);
+                for (&col, &v) in cs.iter().zip(vs) {
+                    if let Ok(k) = c.binary_search(&col) {
+                        if !fixed[k] && v != 0.0 {
+                            out.extend_from_slice(&[i as f64, k as f64, v]);
+                        }
+                    }
+                }
+            }
+            petsc_call!(MatRestoreRow(m, row, &mut nz, &mut cols, &mut vals))?;
+        }
+    }
+    Ok(out)
+}
+
+/// Compressed rows of `n` rows from triplets sorted by row, then column.
+fn from_triplets(t: &[f64], n: usize) -> Sparse {
     let mut d = Sparse {
         start: vec![0],
         ..Sparse::default()
     };
-    for (row, &skip) in fixed.iter().enumerate() {
-        if !skip {
-            let mut nz: PetscInt = 0;
-            let mut cols: *const PetscInt = std::ptr::null();
-            let mut vals: *const f64 = std::ptr::null();
-            // SAFETY: `m` is a valid assembled sequential matrix with
-            // fixed.len() rows; the row's pointers are read only between
-            // MatGetRow and the paired MatRestoreRow, `nz` entries each.
-            unsafe {
-                let r = row as PetscInt;
-                petsc_call!(MatGetRow(m, r, &mut nz, &mut cols, &mut vals))?;
-                if nz > 0 && !cols.is_null() && !vals.is_null() {
-                    let cs = std::slice::from_raw_parts(cols, nz as usize);
-                    let vs = std::slice::from_raw_parts(vals, nz as usize);
-                    for (&c, &v) in cs.iter().zip(vs) {
-                        if !fixed[c as usize] && v != 0.0 {
-                            d.col.push(c as usize);
-                            d.val.push(v);
-                        }
-                    }
-                }
-                petsc_call!(MatRestoreRow(m, r, &mut nz, &mut cols, &mut vals))?;
-            }
+    let mut row = 0;
+    for e in t.chunks_exact(3) {
+        let i = e[0] as usize;
+        while row < i {
+            d.start.push(d.col.len());
+            row += 1;
         }
-        d.start.push(d.col.len());
+        d.col.push(e[1] as usize);
+        d.val.push(e[2]);
     }
-    Ok(d)
+    while row < n {
+        d.start.push(d.col.len());
+        row += 1;
+    }
+    d
 }
 
 #[cfg(test)]
@@ -122,6 +197,17 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn triplets_become_the_same_rows() {
+        let t = [0.0, 0.0, 2.0, 0.0, 3.0, 1.0, 2.0, 1.0, -1.0];
+        let s = super::from_triplets(&t, 4);
+        assert_eq!(s.start, d().start);
+        assert_eq!(s.col, d().col);
+        assert_eq!(s.val, d().val);
+        let empty = super::from_triplets(&[], 3);
+        assert_eq!(empty.start, vec![0, 0, 0, 0]);
     }
 
     #[test]

@@ -2,44 +2,13 @@
 //! I + D_UU G_UU and its LU per set-up, and y = M_UU⁻¹ (D z_C)_U per solve.
 use super::super::shell::error;
 use super::super::{petsc_call, sys, to_petsc_int, Matrix, Result, Vector};
-use super::sparse::{read_sparse, Sparse};
+use super::sparse::{gather_sparse, Sparse};
 use super::{self_comm, LowRankPreconditioner, OwnedMat};
 
 impl LowRankPreconditioner {
     /// D from `kc` onto rank 0 (empty elsewhere). Collective.
     pub(super) fn read_tangent(&mut self, kc: &Matrix) -> Result<Sparse> {
-        let here = to_petsc_int(if self.root { self.c.len() } else { 0 })?;
-        let mut is: sys::IS = std::ptr::null_mut();
-        let mut subs: *mut sys::Mat = std::ptr::null_mut();
-        // SAFETY: `kc` is a valid assembled matrix of K's size; the index
-        // set (C on rank 0, empty elsewhere) is copied and destroyed; the
-        // submatrix array is destroyed on every path after its rows are read.
-        unsafe {
-            petsc_call!(ISCreateGeneral(
-                self_comm(),
-                here,
-                self.c.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut is
-            ))?;
-            let made = petsc_call!(MatCreateSubMatrices(
-                kc.raw(),
-                1,
-                &is,
-                &is,
-                sys::MatReuse_MAT_INITIAL_MATRIX,
-                &mut subs
-            ));
-            sys::ISDestroy(&mut is);
-            made?;
-            let read = if self.root && !subs.is_null() {
-                read_sparse(*subs, &self.fixed)
-            } else {
-                Ok(Sparse::default())
-            };
-            sys::MatDestroySubMatrices(1, &mut subs);
-            read
-        }
+        gather_sparse(kc.raw(), &self.c, &self.fixed)
     }
 
     /// Rank 0: M_UU = I + D_UU G_UU, column by column (D sparse), and its
