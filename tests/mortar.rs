@@ -456,7 +456,7 @@ fn bad_formulation_is_a_scene_error_naming_the_line() {
 /// from the solution and end with the answer of the default margin, on 2
 /// ranks against 1. (Before the search followed the solution, the facets
 /// outside that band went through the block unconstrained: total force
-/// 49.74 against 52.97, and no Hertz profile.)
+/// 47.25 against 52.97, and no Hertz profile.)
 #[test]
 fn mortar_search_follows_a_contact_zone_that_grows_past_the_steps_margin() {
     let dir = scratch("mortar-growing-zone");
