@@ -286,7 +286,9 @@ impl LoadSteps<'_> {
             if let Some(lag) = self.mech.lag.as_mut() {
                 lag.reset();
             }
-            result = chain((outcome, uzawa), self.solve(target)?);
+            let mut next = self.solve(target)?;
+            chain((outcome, uzawa), &mut next);
+            result = next;
         }
         Ok(result)
     }

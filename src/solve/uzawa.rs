@@ -128,32 +128,21 @@ pub(super) fn uzawa_loop(
 }
 
 /// A solve the contact search's candidates stopped covering, followed by
-/// the solve from its state after a new search: the second's result with
-/// the Newton and Uzawa counts and the residual history of both.
-pub(super) fn chain((first, uzawa): (SnesOutcome, usize), second: StepResult) -> StepResult {
-    let join = |outcome: &mut SnesOutcome, more: &mut usize| {
-        outcome.iterations += first.iterations;
-        outcome.linear_iterations += first.linear_iterations;
-        outcome.history.splice(0..0, first.history.iter().copied());
-        *more += uzawa;
-    };
-    match second {
-        Ok((mut outcome, mut more, stats)) => {
-            join(&mut outcome, &mut more);
-            Ok((outcome, more, stats))
-        }
+/// the solve from its state after a new search (`second`): the second's
+/// result gets the Newton and Uzawa counts and the residual history of both.
+pub(super) fn chain((first, uzawa): (SnesOutcome, usize), second: &mut StepResult) {
+    let (outcome, more) = match second {
+        Ok((outcome, more, _)) => (outcome, more),
         Err(StepFailure::Uncovered {
-            mut outcome,
-            uzawa: mut more,
-        }) => {
-            join(&mut outcome, &mut more);
-            Err(StepFailure::Uncovered {
-                outcome,
-                uzawa: more,
-            })
-        }
-        Err(other) => Err(other),
-    }
+            outcome,
+            uzawa: more,
+        }) => (outcome, more),
+        Err(_) => return,
+    };
+    outcome.iterations += first.iterations;
+    outcome.linear_iterations += first.linear_iterations;
+    outcome.history.splice(0..0, first.history);
+    *more += uzawa;
 }
 
 /// The Uzawa iterations of one step, in rounds of at most `max_uzawa`; a
