@@ -73,8 +73,9 @@ impl DenseCounts {
 }
 
 /// Calls `f(row, columns, values)` for each row in `rows` of the assembled
-/// sequential matrix `m`.
-fn for_rows(
+/// matrix `m` (rows this process holds: any of a sequential matrix, the
+/// owned ones of a parallel one).
+pub(super) fn for_rows(
     m: sys::Mat,
     rows: impl Iterator<Item = PetscInt>,
     mut f: impl FnMut(PetscInt, &[PetscInt], &[f64]),

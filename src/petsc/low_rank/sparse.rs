@@ -1,4 +1,5 @@
 //! The contact tangent D on C, on rank 0, as compressed rows.
+use super::super::schur::for_rows;
 use super::super::shell::error;
 use super::super::{petsc_call, sys, PetscInt, Result};
 
@@ -124,32 +125,20 @@ fn own_rows(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Vec<f64>> {
     let from = c.partition_point(|&d| d < lo);
     let to = c.partition_point(|&d| d < hi);
     let mut out = Vec::new();
-    for (i, &row) in c.iter().enumerate().take(to).skip(from) {
-        if fixed[i] {
-            continue;
-        }
-        let mut nz: PetscInt = 0;
-        let mut cols: *const PetscInt = std::ptr::null();
-        let mut vals: *const f64 = std::ptr::null();
-        // SAFETY: `m` is a valid assembled parallel matrix that owns `row`
-        // here; the row's pointers are read only between MatGetRow and the
-        // paired MatRestoreRow, `nz` entries each.
-        unsafe {
-            petsc_call!(MatGetRow(m, row, &mut nz, &mut cols, &mut vals))?;
-            if nz > 0 && !cols.is_null() && !vals.is_null() {
-                let cs = std::slice::from_raw_parts(cols, nz as usize);
-                let vs = std::slice::from_raw_parts(vals, nz as usize);
-                for (&col, &v) in cs.iter().zip(vs) {
-                    if let Ok(k) = c.binary_search(&col) {
-                        if !fixed[k] && v != 0.0 {
-                            out.extend_from_slice(&[i as f64, k as f64, v]);
-                        }
-                    }
+    let rows = (from..to).filter(|&i| !fixed[i]).map(|i| c[i]);
+    for_rows(m, rows, |row, cols, vals| {
+        // C is sorted: a row's position in it is found again.
+        let Ok(i) = c.binary_search(&row) else {
+            return;
+        };
+        for (&col, &v) in cols.iter().zip(vals) {
+            if let Ok(k) = c.binary_search(&col) {
+                if !fixed[k] && v != 0.0 {
+                    out.extend_from_slice(&[i as f64, k as f64, v]);
                 }
             }
-            petsc_call!(MatRestoreRow(m, row, &mut nz, &mut cols, &mut vals))?;
         }
-    }
+    })?;
     Ok(out)
 }
 
