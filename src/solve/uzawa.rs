@@ -218,10 +218,11 @@ fn uzawa_rounds(
             return Ok(Ok((outcome, 0, Vec::new())));
         }
         let before = accel.is_on().then(|| normal_multipliers(mech.contact));
-        let (stats, covered) = update_multipliers(world, stages, times, mech, x, factor)?;
-        // (A condensed iterate's off-contact DOFs are not the state yet:
-        // the caller checks its candidates once the step has expanded it.)
-        if !covered && !condensed {
+        // A condensed iterate's off-contact DOFs are not the state yet: the
+        // caller checks its candidates once the step has expanded it.
+        let (stats, covered) =
+            update_multipliers(world, stages, times, mech, x, (factor, !condensed))?;
+        if !covered {
             // No more Uzawa work on a set of segments that misses part of
             // the contact: the caller searches from here and goes on.
             outcome.iterations = newton;
@@ -393,14 +394,16 @@ fn max_uzawa(pairs: &[ContactPair]) -> usize {
 }
 
 /// Collective: the multiplier update of every pair at the solved state `x`,
-/// agreed, booked as the Uzawa-update phase, and reduced over the ranks.
+/// agreed, booked as the Uzawa-update phase, and reduced over the ranks;
+/// with `check_cover`, also whether every pair's candidates still cover `x`
+/// on every rank (`ContactPair::covers`; true without it).
 fn update_multipliers(
     world: &impl Communicator,
     stages: &Stages,
     times: &mut PhaseTimes,
     mech: &mut Mechanics,
     x: &Vector,
-    factor: f64,
+    (factor, check_cover): (f64, bool),
 ) -> Result<(Vec<UzawaStats>, bool)> {
     let mark = PhaseMark::new(&mech.times, mech.contact);
     let updated = stages.scope(Phase::UzawaUpdate, || {
@@ -410,7 +413,7 @@ fn update_multipliers(
                 .map(|p| p.uzawa_update(u, factor))
                 .collect::<Result<Vec<UzawaStats>>>()?;
             fault::check(FaultPhase::UzawaUpdate)?;
-            let covered = pairs.iter().all(|p| p.covers(u, factor));
+            let covered = !check_cover || pairs.iter().all(|p| p.covers(u, factor));
             Ok((stats, covered))
         })
     });
