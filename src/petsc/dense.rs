@@ -1,7 +1,10 @@
-//! Dense symmetric factorisations through LAPACK (the system's, Debian's
-//! OpenBLAS), for the contact Schur complement: a Cholesky factor of S0's
-//! leading block kept once, so that a change confined to the trailing
-//! block costs a factorisation of that block alone.
+//! Dense factorisations through LAPACK (the system's, Debian's OpenBLAS),
+//! for the contact Schur complement: a Cholesky factor of S0's leading
+//! block kept once, so that a change confined to the trailing block costs
+//! a factorisation of that block alone: Cholesky for a symmetric change
+//! ([`PartialCholesky::factor_into`]), LU with row pivots for any other
+//! ([`PartialLu`], whose solve is ours: PETSc keeps a dense LU's pivots
+//! private, so its Schur solve cannot read this one).
 //!
 //! With S = [A Bᵀ; B E] (A the leading `split` × `split` block), the lower
 //! Cholesky factor of S is [L11 0; L21 L22] with L11 L11ᵀ = A,
@@ -41,6 +44,56 @@ extern "C" {
         uplo_len: usize,
         transa_len: usize,
         diag_len: usize,
+    );
+    #[allow(clippy::too_many_arguments)]
+    fn dtrsv_(
+        uplo: *const c_char,
+        trans: *const c_char,
+        diag: *const c_char,
+        n: *const c_int,
+        a: *const f64,
+        lda: *const c_int,
+        x: *mut f64,
+        incx: *const c_int,
+        uplo_len: usize,
+        trans_len: usize,
+        diag_len: usize,
+    );
+    #[allow(clippy::too_many_arguments)]
+    fn dgemv_(
+        trans: *const c_char,
+        m: *const c_int,
+        n: *const c_int,
+        alpha: *const f64,
+        a: *const f64,
+        lda: *const c_int,
+        x: *const f64,
+        incx: *const c_int,
+        beta: *const f64,
+        y: *mut f64,
+        incy: *const c_int,
+        trans_len: usize,
+    );
+    fn dgetrf_(
+        m: *const c_int,
+        n: *const c_int,
+        a: *mut f64,
+        lda: *const c_int,
+        ipiv: *mut c_int,
+        info: *mut c_int,
+    );
+    #[allow(clippy::too_many_arguments)]
+    fn dgetrs_(
+        trans: *const c_char,
+        n: *const c_int,
+        nrhs: *const c_int,
+        a: *const f64,
+        lda: *const c_int,
+        ipiv: *const c_int,
+        b: *mut f64,
+        ldb: *const c_int,
+        info: *mut c_int,
+        trans_len: usize,
     );
     #[allow(clippy::too_many_arguments)]
     fn dsyrk_(
@@ -192,6 +245,176 @@ impl PartialCholesky {
         }
         potrf_block(out, n, p * n + p, n - p)
     }
+
+    /// Factors S0 + D into `out`, for D given by its entries (row, column,
+    /// value; any pattern, not symmetric) in the trailing block: S0's
+    /// leading columns as they are here, the trailing block's Schur
+    /// complement E − L21 L21ᵀ + D_EE by LU with row pivots. False for an
+    /// entry outside the trailing block (a caller's bug) or a singular
+    /// S0 + D; `out` cannot solve until a later call succeeds.
+    pub fn factor_lu_into(&self, d: &[(usize, usize, f64)], out: &mut PartialLu) -> bool {
+        let (n, p) = (self.n, self.split);
+        out.factored = false;
+        if out.a.len() != n * n {
+            out.a = vec![0.0; n * n];
+            out.leading = None;
+        }
+        out.n = n;
+        out.split = p;
+        if out.leading != Some(p) {
+            for j in 0..p {
+                out.a[j * n + j..(j + 1) * n].copy_from_slice(&self.a[j * n + j..(j + 1) * n]);
+            }
+            out.leading = Some(p);
+        }
+        // The trailing block whole: LU reads both triangles, and `self`
+        // holds the lower one.
+        for j in p..n {
+            for i in p..n {
+                out.a[j * n + i] = if i >= j {
+                    self.a[j * n + i]
+                } else {
+                    self.a[i * n + j]
+                };
+            }
+        }
+        for &(r, c, v) in d {
+            if r < p || c < p || r >= n || c >= n {
+                return false;
+            }
+            out.a[c * n + r] += v;
+        }
+        let m = n - p;
+        out.ipiv.resize(m, 0);
+        if m > 0 {
+            let (Some(mi), Some(ld)) = (int(m), int(n)) else {
+                return false;
+            };
+            let mut info: c_int = 0;
+            // SAFETY: `out.a` holds n × n entries (resized above); the
+            // trailing m × m block starts at p·n + p with leading dimension
+            // n and ends at the buffer's end; `ipiv` holds m entries.
+            unsafe {
+                dgetrf_(
+                    &mi,
+                    &mi,
+                    out.a.as_mut_ptr().add(p * n + p),
+                    &ld,
+                    out.ipiv.as_mut_ptr(),
+                    &mut info,
+                )
+            };
+            if info != 0 {
+                return false;
+            }
+        }
+        out.factored = true;
+        true
+    }
+}
+
+/// S = S0 + D factored as [L11 0; L21 I] [L11ᵀ L21ᵀ; 0 E − L21 L21ᵀ + D_EE]
+/// with the last block LU-factored (P L U): what
+/// [`PartialCholesky::factor_lu_into`] writes.
+#[derive(Default)]
+pub struct PartialLu {
+    n: usize,
+    split: usize,
+    /// Column-major n × n: L11 and L21 in the leading columns' lower part,
+    /// the trailing block's L and U.
+    a: Vec<f64>,
+    ipiv: Vec<c_int>,
+    /// The split whose leading columns `a` holds.
+    leading: Option<usize>,
+    factored: bool,
+}
+
+impl PartialLu {
+    /// The first position of the trailing block.
+    pub fn split(&self) -> usize {
+        self.split
+    }
+
+    /// Overwrites `b` (n entries) with S⁻¹ b: forward through the leading
+    /// block, the trailing block's LU solve, back through the leading
+    /// block. False when nothing is factored or `b` has the wrong length.
+    pub fn solve(&self, b: &mut [f64]) -> bool {
+        let (n, p) = (self.n, self.split);
+        if !self.factored || b.len() != n || self.a.len() != n * n {
+            return false;
+        }
+        let m = n - p;
+        let (Some(nn), Some(pi), Some(mi)) = (int(n), int(p), int(m)) else {
+            return false;
+        };
+        let (one, minus, inc) = (1.0f64, -1.0f64, 1 as c_int);
+        let a = self.a.as_ptr();
+        let x = b.as_mut_ptr();
+        // SAFETY: `a` is n × n column-major (checked above): L11 its
+        // leading p × p block, L21 the m × p block at row p, the trailing
+        // LU the m × m block at (p, p), all with leading dimension n; `ipiv`
+        // holds m pivots from dgetrf; `b` holds n entries, its first p
+        // (x) and last m (x + p) are disjoint ranges.
+        unsafe {
+            if p > 0 {
+                dtrsv_(&L, &N, &N, &pi, a, &nn, x, &inc, 1, 1, 1);
+                if m > 0 {
+                    dgemv_(
+                        &N,
+                        &mi,
+                        &pi,
+                        &minus,
+                        a.add(p),
+                        &nn,
+                        x,
+                        &inc,
+                        &one,
+                        x.add(p),
+                        &inc,
+                        1,
+                    );
+                }
+            }
+            if m > 0 {
+                let mut info: c_int = 0;
+                dgetrs_(
+                    &N,
+                    &mi,
+                    &inc,
+                    a.add(p * n + p),
+                    &nn,
+                    self.ipiv.as_ptr(),
+                    x.add(p),
+                    &mi,
+                    &mut info,
+                    1,
+                );
+                if info != 0 {
+                    return false;
+                }
+            }
+            if p > 0 {
+                if m > 0 {
+                    dgemv_(
+                        &T,
+                        &mi,
+                        &pi,
+                        &minus,
+                        a.add(p),
+                        &nn,
+                        x.add(p),
+                        &inc,
+                        &one,
+                        x,
+                        &inc,
+                        1,
+                    );
+                }
+                dtrsv_(&L, &T, &N, &pi, a, &nn, x, &inc, 1, 1, 1);
+            }
+        }
+        true
+    }
 }
 
 #[cfg(test)]
@@ -264,6 +487,65 @@ mod tests {
                 .fold(0.0, f64::max);
             assert!(err < 1e-12 * n as f64, "split {split}, again: {err:e}");
         }
+    }
+
+    #[test]
+    fn partial_lu_solves_a_non_symmetric_change() {
+        let n = 37;
+        let s0 = spd(n);
+        for split in [0, 1, 20, 36, 37] {
+            let p = PartialCholesky::new(&s0, n, split).expect("SPD");
+            let mut lu = PartialLu::default();
+            for round in 0..2 {
+                let mut d = Vec::new();
+                for r in split..n {
+                    for c in split..n {
+                        let v = (0.7 + round as f64) / (1.0 + (3 * r + c) as f64)
+                            - 0.2 / (2.0 + (r + 5 * c) as f64);
+                        d.push((r, c, v));
+                    }
+                }
+                let mut s = s0.clone();
+                for &(r, c, v) in &d {
+                    s[c * n + r] += v;
+                }
+                assert!(p.factor_lu_into(&d, &mut lu), "split {split}");
+                let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.5).collect();
+                let mut x = b.clone();
+                assert!(lu.solve(&mut x), "split {split}");
+                let err = (0..n)
+                    .map(|i| ((0..n).map(|j| s[j * n + i] * x[j]).sum::<f64>() - b[i]).abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    err < 1e-12 * n as f64,
+                    "split {split}, round {round}: {err:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn partial_lu_refuses_singular_and_misplaced() {
+        let n = 10;
+        let s0 = spd(n);
+        let p = PartialCholesky::new(&s0, n, 4).expect("SPD");
+        let mut lu = PartialLu::default();
+        assert!(!p.factor_lu_into(&[(2, 8, 1.0)], &mut lu));
+        assert!(!lu.solve(&mut [0.0; 10]));
+        // D cancels the trailing block's Schur complement: S is singular.
+        let mut e = PartialLu::default();
+        assert!(p.factor_lu_into(&[], &mut e));
+        let d: Vec<_> = (4..n)
+            .flat_map(|c| (4..n).map(move |r| (r, c)))
+            .map(|(r, c)| (r, c, -e_entry(&p, r, c)))
+            .collect();
+        assert!(!p.factor_lu_into(&d, &mut lu));
+    }
+
+    /// The trailing Schur complement E − L21 L21ᵀ that `p` holds.
+    fn e_entry(p: &PartialCholesky, r: usize, c: usize) -> f64 {
+        let (i, j) = if r >= c { (r, c) } else { (c, r) };
+        p.a[j * p.n + i]
     }
 
     #[test]
