@@ -25,6 +25,7 @@
 //!   and its motion, `rigid_pair` their run-time side;
 //! - `pair_output`: the pair's nodal fields, force and point values;
 //!   `pair_restart`: taking them over from a result file.
+mod facet_search;
 pub mod friction;
 pub mod geometry;
 mod halo;

@@ -21,7 +21,6 @@ use crate::contact::dual::Dual;
 use crate::contact::outcome::UzawaStats;
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
-use crate::fem::surface::facet_normal_at_centre;
 use crate::fem::{FacetType, MAX_FACET_NODES};
 use crate::model::RigidSurface;
 
@@ -84,6 +83,11 @@ pub struct MortarPair {
     pub(super) h: Vec<f64>,
     pub(super) candidates: Vec<(u32, u32)>,
     pub(super) search_distance: f64,
+    /// The links' search distance: nodes of facets within it of the other
+    /// surface at the last search (`reserve`, node ids) are held in the
+    /// contact DOFs though no candidate couples them yet.
+    pub(super) reach: f64,
+    pub(super) reserve: Vec<u32>,
     pub(super) rules: MortarRules,
     /// Owned mesh nodes of this rank (the length of the output fields).
     pub(super) owned_mesh_nodes: usize,
@@ -161,7 +165,9 @@ impl MortarPair {
         if self.rigid.is_some() {
             return self.rigid_search(u_local, factor);
         }
-        let candidates = self.facet_pairs(&self.positions(u_local), self.search_distance);
+        let x = self.positions(u_local);
+        self.reserve = self.nodes_within(&x, self.reach);
+        let candidates = self.facet_pairs(&x, self.search_distance);
         // Compared by set index: the held master's numbering changes
         // with each exchange.
         let key: Vec<(u32, u32)> = candidates
@@ -198,61 +204,16 @@ impl MortarPair {
             .all(|pair| self.candidates.binary_search(pair).is_ok())
     }
 
-    /// Every (evaluated slave, held master) facet pair whose bounding boxes
-    /// at positions `x`, grown by `margin`, meet; by slave, then master. A
-    /// master facet's box also reaches one facet size behind it (into its
-    /// body), so that a slave facet pushed through the master surface
-    /// further than its own thickness still pairs with the facets it
-    /// crossed.
-    fn facet_pairs(&self, x: &[[f64; 3]], margin: f64) -> Vec<(u32, u32)> {
-        let nf = self.facet_type.nodes();
-        let bbox = |f: &[u32; MAX_FACET_NODES]| {
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for &n in &f[..nf] {
-                for c in 0..3 {
-                    lo[c] = lo[c].min(x[n as usize][c]);
-                    hi[c] = hi[c].max(x[n as usize][c]);
-                }
-            }
-            (lo, hi)
-        };
-        let masters: Vec<_> = self
-            .master_facets
+    /// The global DOFs of the nodes reserved at the last search: a search
+    /// that adds candidates among them does not grow the contact DOFs, so a
+    /// contact Schur complement keeps its factor of the bulk stiffness (a
+    /// contact zone that grows past the candidates' margin within one step
+    /// costs a second search, not a second factorisation).
+    pub fn reserve_dofs(&self) -> Vec<GlobalDof> {
+        self.reserve
             .iter()
-            .map(|f| {
-                let (mut lo, mut hi) = bbox(f);
-                let corners: Vec<[f64; 3]> = f[..nf].iter().map(|&n| x[n as usize]).collect();
-                let depth = (0..3).map(|c| hi[c] - lo[c]).fold(0.0, f64::max);
-                if let Ok(n) = facet_normal_at_centre(self.facet_type, &corners) {
-                    for c in 0..3 {
-                        lo[c] = lo[c].min(lo[c] - depth * n[c]);
-                        hi[c] = hi[c].max(hi[c] - depth * n[c]);
-                    }
-                }
-                (lo, hi)
-            })
-            .collect();
-        // Masters sorted by their lower x bound: a sweep finds each slave's.
-        let mut order: Vec<u32> = (0..masters.len() as u32).collect();
-        order.sort_by(|a, b| masters[*a as usize].0[0].total_cmp(&masters[*b as usize].0[0]));
-        let d = margin;
-        let mut pairs = Vec::new();
-        for &s in &self.evaluated {
-            let (lo, hi) = bbox(&self.slave_facets[s as usize]);
-            let end = order.partition_point(|&m| masters[m as usize].0[0] <= hi[0] + d);
-            let mut found: Vec<u32> = order[..end]
-                .iter()
-                .copied()
-                .filter(|&m| {
-                    let (mlo, mhi) = masters[m as usize];
-                    (0..3).all(|c| mlo[c] <= hi[c] + d && mhi[c] >= lo[c] - d)
-                })
-                .collect();
-            found.sort_unstable();
-            pairs.extend(found.into_iter().map(|m| (s, m)));
-        }
-        pairs
+            .flat_map(|&n| self.node_dofs[n as usize])
+            .collect()
     }
 
     pub(super) fn local_dof(&self, id: u32, c: usize) -> usize {

@@ -34,14 +34,16 @@ impl MortarPair {
     /// `master`: the master facet set or rigid surface, and the ranks its
     /// set-up exchanges with (collective); `penalty(h)`: the pair's εN for a
     /// node of element size `h`; `friction`: the pair's Coulomb friction, if
-    /// it computes any (μ > 0).
+    /// it computes any (μ > 0); `(margin, reach)`: the candidates' search
+    /// margin and the distance within which nodes are reserved for the
+    /// contact DOFs (see [`MortarPair::reserve_dofs`]).
     pub fn new(
         mesh: &LocalMesh,
         dofs: &DofMap,
         spec: &PairSpec,
         (master, ranks): (MortarMaster, &dyn RankExchange),
         penalty: impl Fn(f64) -> f64,
-        search_distance: f64,
+        (search_distance, reach): (f64, f64),
         friction: Option<FrictionSpec>,
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
@@ -202,6 +204,8 @@ impl MortarPair {
             h,
             candidates: Vec::new(),
             search_distance,
+            reach,
+            reserve: Vec::new(),
             rules: MortarRules::default(),
             owned_mesh_nodes: dofs.num_owned_nodes(),
             owned_pair_nodes: share.owned_pair_nodes,

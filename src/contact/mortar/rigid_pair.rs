@@ -58,6 +58,15 @@ impl MortarPair {
     /// whether the candidates changed.
     pub(super) fn rigid_search(&mut self, u_local: &[f64], factor: f64) -> bool {
         let candidates = self.facets_near_rigid(u_local, factor, self.search_distance);
+        let nf = self.facet_type.nodes();
+        let mut reserve: Vec<u32> = self
+            .facets_near_rigid(u_local, factor, self.reach)
+            .iter()
+            .flat_map(|&f| self.slave_facets[f as usize][..nf].to_vec())
+            .collect();
+        reserve.sort_unstable();
+        reserve.dedup();
+        self.reserve = reserve;
         match &mut self.rigid {
             Some(r) => {
                 let changed = candidates != r.candidates;

@@ -4,7 +4,7 @@ use super::{ContactPair, MasterSide};
 use crate::assembly::RankExchange;
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
-use crate::dofs::DofMap;
+use crate::dofs::{DofMap, GlobalDof};
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 
@@ -133,6 +133,15 @@ impl ContactPair {
         self.mortar
             .as_ref()
             .is_none_or(|m| m.covers(u_local, factor))
+    }
+
+    /// DOFs to hold in the contact DOFs beyond the pattern's (a mortar
+    /// pair's nodes within the search distance; none for links, whose
+    /// pattern already spans it).
+    pub fn reserve_dofs(&self) -> Vec<GlobalDof> {
+        self.mortar
+            .as_ref()
+            .map_or_else(Vec::new, |m| m.reserve_dofs())
     }
 
     /// The search that starts every load step: outer search (closest master

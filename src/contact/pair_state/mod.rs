@@ -155,8 +155,8 @@ impl ContactPair {
                 |h| spec.penalty.unwrap_or(10.0 * softest_youngs / h),
                 // Candidates are fixed for a step and every one widens the
                 // Jacobian pattern: one element size of margin, not the
-                // links' search distance.
-                search_distance.min(slave.h),
+                // links' search distance, which only reserves contact DOFs.
+                (search_distance.min(slave.h), search_distance),
                 friction_spec,
             )?),
         };
