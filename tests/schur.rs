@@ -3,8 +3,9 @@
 //!
 //! One process (MPI and PETSc start once per process), so one test: the
 //! Schur solve of a small matrix against a dense solve, C forced to grow,
-//! and whole runs of hertz-cylinder, frictionless (LDLᵀ) and with
-//! Coulomb friction over two steps (LU), with and without the Schur path.
+//! and whole runs of hertz-cylinder, frictionless (LDLᵀ), with Coulomb
+//! friction over two steps and with a mortar pair (both non-symmetric:
+//! the dense LU path), with and without the Schur path.
 use contactlink::petsc::schur::SchurPreconditioner;
 use contactlink::petsc::{Matrix, PatternBuilder, PetscInt, Vector};
 use contactlink::pipeline;
@@ -146,7 +147,7 @@ fn small_matrices() {
         let skew = !cholesky;
         let mut pc = SchurPreconditioner::new(petsc_matrix(&k, &rows), rows.clone(), cholesky);
         let c1: Vec<usize> = (9..15).collect();
-        pc.want(c1.iter().map(|&d| d as PetscInt).collect());
+        pc.want(c1.iter().map(|&d| d as PetscInt).collect(), Vec::new());
         let j1 = with_contact(&k, &c1, 50.0, skew);
         check(&mut pc, &j1, &minus(&j1, &k), &format!("{kind}, C of 6"));
         // A new tangent on the same C: only the dense part is factored again.
@@ -162,7 +163,7 @@ fn small_matrices() {
         let kc2 = with_contact(&vec![0.0; N * N], &c2, 80.0, skew);
         let mut j2 = with_contact(&k, &c2, 80.0, skew);
         dirichlet(&mut j2, &fixed);
-        pc.want(c2.iter().map(|&d| d as PetscInt).collect());
+        pc.want(c2.iter().map(|&d| d as PetscInt).collect(), Vec::new());
         check(&mut pc, &j2, &kc2, &format!("{kind}, C grown to 12"));
         assert_eq!((pc.bulk_factorisations, pc.growths), (2, 1), "{kind}");
         assert_eq!(pc.schur_size(), 12, "{kind}");
@@ -179,7 +180,7 @@ fn partial_factorisations() {
     let mut k = bulk();
     dirichlet(&mut k, &[0, 1, 2]);
     let mut pc = SchurPreconditioner::new(petsc_matrix(&k, &rows), rows.clone(), true);
-    pc.want((6..18).collect());
+    pc.want((6..18).collect(), Vec::new());
     let steps: [(std::ops::Range<usize>, f64, &str); 5] = [
         (12..18, 50.0, "first tangent, on half of C"),
         (14..18, 70.0, "on a third of C"),
@@ -199,6 +200,36 @@ fn partial_factorisations() {
     assert_eq!((d.whole, d.trailing, d.leading), (2, 3, 1), "{d:?}");
     assert_eq!(d.largest_trailing, 8, "{d:?}");
     assert_eq!((pc.bulk_factorisations, pc.schur_factorisations), (1, 5));
+}
+
+/// Reserved DOFs join C when it is formed and keep a contact zone that
+/// reaches them from growing it; a DOF outside both still grows C. Both
+/// kinds of tangent (the non-symmetric one on its own LU path).
+fn reserved_dofs() {
+    let rows: Vec<PetscInt> = vec![0, 1, 2];
+    let mut k = bulk();
+    dirichlet(&mut k, &[0, 1, 2]);
+    for symmetric in [true, false] {
+        let mut pc = SchurPreconditioner::new(petsc_matrix(&k, &rows), rows.clone(), symmetric);
+        pc.want((12..15).collect(), (9..18).collect());
+        let c: Vec<usize> = (12..15).collect();
+        let j = with_contact(&k, &c, 50.0, !symmetric);
+        check(&mut pc, &j, &minus(&j, &k), "first touch, C reserved");
+        assert_eq!(pc.schur_size(), 9, "symmetric {symmetric}");
+        // The zone reaches the reserve: no growth.
+        pc.want((9..18).collect(), Vec::new());
+        let c: Vec<usize> = (9..18).collect();
+        let j = with_contact(&k, &c, 60.0, !symmetric);
+        check(&mut pc, &j, &minus(&j, &k), "zone over the reserve");
+        assert_eq!((pc.bulk_factorisations, pc.growths), (1, 0));
+        // Beyond it: C grows.
+        pc.want((9..21).collect(), Vec::new());
+        let c: Vec<usize> = (9..21).collect();
+        let j = with_contact(&k, &c, 70.0, !symmetric);
+        check(&mut pc, &j, &minus(&j, &k), "zone past the reserve");
+        assert_eq!((pc.bulk_factorisations, pc.growths), (2, 1));
+        assert_eq!(pc.schur_size(), 12);
+    }
 }
 
 /// Displacement, reactions and contact forces of a scene with and without
@@ -268,7 +299,15 @@ fn schur_path() {
     let rt = Runtime::start(&[]).expect("MPI and PETSc start");
     small_matrices();
     partial_factorisations();
+    reserved_dofs();
     same_run(&rt, "hertz-cylinder", &["mesh.fine_size=0.4"]);
+    // A mortar pair on a deformable master: a non-symmetric tangent on K's
+    // LDLᵀ factor (the LU path of the dense part).
+    same_run(
+        &rt,
+        "hertz-cylinder",
+        &["mesh.fine_size=0.4", "contact.formulation=\"mortar\""],
+    );
     whole_newton_same_iterates(&rt);
     // Coulomb friction (LU), two load steps (a second search and pattern).
     same_run(

@@ -52,8 +52,24 @@ impl Layout {
         out
     }
 
+    /// The mean of S0's diagonal over the unconstrained positions (1 when
+    /// there are none or it is not positive).
+    pub fn mean_free_diagonal(&self) -> f64 {
+        let n = self.c.len();
+        let free: Vec<f64> = (0..n)
+            .filter(|&p| !self.fixed[p])
+            .map(|p| self.base[p * n + p])
+            .collect();
+        let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
+        if mean > 0.0 && mean.is_finite() {
+            mean
+        } else {
+            1.0
+        }
+    }
+
     /// The entries of the whole vector `a` on C, in Schur positions.
-    fn gather(&self, a: &[f64]) -> Vec<f64> {
+    pub(super) fn gather(&self, a: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.c.len()];
         for (&d, &p) in self.c.iter().zip(&self.pos) {
             out[p] = a[d as usize];

@@ -21,8 +21,23 @@
 //! trailing block alone, in place in the Schur matrix PETSc solves with. A
 //! tangent that makes S indefinite falls back to LDLᵀ of the whole S
 //! (LAPACK's dsytrf, as every factorisation did before; the first one too).
+//!
+//! A non-symmetric tangent (friction, a mortar pair on a deformable
+//! master) keeps K's symmetric factor (the Schur path's bodies are linear
+//! elastic) and the same split, with the trailing block LU-factored
+//! ([`PartialLu`]). PETSc's Schur solve reads only its own dense factors,
+//! so that solve is ours, and the factor matrix's Schur array holds a
+//! reference S_ref = S0 + σ I (σ the mean of S0's diagonal), factored once:
+//! MatSolve then gives x_ref = J_ref⁻¹ b for J_ref = K + σ P Pᵀ (P the
+//! columns of the identity on C), and J x = b is
+//!
+//!   (S0 + D) x_C = S_ref x_ref_C,  x = J_ref⁻¹ (b − P (D − σ I) x_C)
+//!
+//! (J = J_ref + P (D − σ I) Pᵀ and Pᵀ J_ref⁻¹ P = S_ref⁻¹): two sparse
+//! solves and one dense. S_ref is positive definite where S0 is only
+//! semi-definite (a body held by contact alone).
 use super::condensed::Layout;
-use super::dense::PartialCholesky;
+use super::dense::{PartialCholesky, PartialLu};
 use super::shell::error;
 use super::{petsc_call, sys, Matrix, PetscInt, Result, Vector};
 use std::rc::Rc;
@@ -33,11 +48,17 @@ pub struct SchurFactor {
     is: sys::IS,
     /// C, its Schur order and S0 (shared with the condensed Newton state).
     layout: Rc<Layout>,
-    cholesky: bool,
+    /// The contact tangent is symmetric (else the LU path, see the module).
+    symmetric: bool,
     /// The entries of the last tangent (Schur positions): S = S0 + these.
     tangent: Vec<(usize, usize, f64)>,
     /// Symmetric only: S0's leading block factored, once per split.
     partial: Option<PartialCholesky>,
+    /// Non-symmetric only: S = S0 + D factored, and σ of the reference
+    /// S_ref = S0 + σ I in the factor matrix's Schur array (None: not yet
+    /// factored).
+    lu: PartialLu,
+    reference: Option<f64>,
     /// S0's leading block was not positive definite: LDLᵀ from now on.
     partial_refused: bool,
     /// The split whose leading columns the factor matrix's Schur array
@@ -52,14 +73,16 @@ pub struct SchurFactor {
 /// How the dense Schur complements were factored.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DenseCounts {
-    /// Factorisations of the trailing block alone (Cholesky).
+    /// Factorisations of the trailing block alone (Cholesky; LU for a
+    /// non-symmetric tangent).
     pub trailing: usize,
     /// The largest trailing block, in DOFs.
     pub largest_trailing: usize,
     /// Factorisations of S0's leading block (one per split).
     pub leading: usize,
-    /// Factorisations of the whole S (LU; or LDLᵀ: the first, and where
-    /// the trailing block was not positive definite).
+    /// Factorisations of the whole S by PETSc (LDLᵀ: the first, and where
+    /// the trailing block was not positive definite; the reference S_ref
+    /// of a non-symmetric tangent).
     pub whole: usize,
 }
 
@@ -113,17 +136,17 @@ fn by_key(c: &[PetscInt], key: &[(PetscInt, f64)]) -> Vec<PetscInt> {
 }
 
 impl SchurFactor {
-    /// Factors `k` (assembled, sequential, the rows and columns of the
-    /// sorted DOFs `constrained` replaced by the identity) with the Schur
-    /// complement on the sorted, distinct DOFs `c`: LDLᵀ when `cholesky`,
-    /// else LU. `key` (sorted by DOF) orders C for the partial dense
-    /// factorisations (symmetric only): the DOFs a contact tangent is
-    /// likely to touch should have the smallest keys.
+    /// Factors `k` (assembled, sequential, symmetric, the rows and columns
+    /// of the sorted DOFs `constrained` replaced by the identity) as LDLᵀ
+    /// with the Schur complement on the sorted, distinct DOFs `c`, for
+    /// contact tangents that are `symmetric` or not. `key` (sorted by DOF)
+    /// orders C for the partial dense factorisations: the DOFs a contact
+    /// tangent is likely to touch should have the smallest keys.
     pub fn new(
         k: &Matrix,
         c: Vec<PetscInt>,
         constrained: &[PetscInt],
-        cholesky: bool,
+        symmetric: bool,
         key: &[(PetscInt, f64)],
     ) -> Result<Self> {
         if c.is_empty() || c.windows(2).any(|w| w[0] >= w[1]) {
@@ -137,7 +160,7 @@ impl SchurFactor {
             .iter()
             .map(|d| constrained.binary_search(d).is_ok())
             .collect();
-        let order = if cholesky { by_key(&c, key) } else { c.clone() };
+        let order = by_key(&c, key);
         let mut pos = vec![0; n];
         let mut fixed = vec![false; n];
         for (p, d) in order.iter().enumerate() {
@@ -157,19 +180,17 @@ impl SchurFactor {
                 fixed,
                 base: Vec::new(),
             }),
-            cholesky,
+            symmetric,
             tangent: Vec::new(),
             partial: None,
+            lu: PartialLu::default(),
+            reference: None,
             partial_refused: false,
             in_array: None,
             factored_once: false,
             counts: DenseCounts::default(),
         };
-        let kind = if cholesky {
-            sys::MatFactorType_MAT_FACTOR_CHOLESKY
-        } else {
-            sys::MatFactorType_MAT_FACTOR_LU
-        };
+        let kind = sys::MatFactorType_MAT_FACTOR_CHOLESKY;
         let mut s0: sys::Mat = std::ptr::null_mut();
         // SAFETY: `k` is a valid assembled matrix; the factor and the index
         // set are owned by `me` (destroyed in Drop, also on an early error);
@@ -193,24 +214,13 @@ impl SchurFactor {
             petsc_call!(MatFactorSetSchurIS(me.factor, me.is))?;
             let mut info = sys::MatFactorInfo::default();
             petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            if cholesky {
-                petsc_call!(MatCholeskyFactorSymbolic(
-                    me.factor,
-                    k.raw(),
-                    std::ptr::null_mut(),
-                    &info
-                ))?;
-                petsc_call!(MatCholeskyFactorNumeric(me.factor, k.raw(), &info))?;
-            } else {
-                petsc_call!(MatLUFactorSymbolic(
-                    me.factor,
-                    k.raw(),
-                    std::ptr::null_mut(),
-                    std::ptr::null_mut(),
-                    &info
-                ))?;
-                petsc_call!(MatLUFactorNumeric(me.factor, k.raw(), &info))?;
-            }
+            petsc_call!(MatCholeskyFactorSymbolic(
+                me.factor,
+                k.raw(),
+                std::ptr::null_mut(),
+                &info
+            ))?;
+            petsc_call!(MatCholeskyFactorNumeric(me.factor, k.raw(), &info))?;
             me.check_factor_error()?;
             let mut status: sys::MatFactorSchurStatus = 0;
             petsc_call!(MatFactorCreateSchurComplement(
@@ -223,9 +233,7 @@ impl SchurFactor {
                 petsc_call!(MatDenseGetArrayRead(s0, &mut arr))?;
                 base.copy_from_slice(std::slice::from_raw_parts(arr, n * n));
                 petsc_call!(MatDenseRestoreArrayRead(s0, &mut arr))?;
-                if cholesky {
-                    symmetrise(&mut base, n);
-                }
+                symmetrise(&mut base, n);
                 Ok(())
             })();
             sys::MatDestroy(&mut s0);
@@ -274,6 +282,11 @@ impl SchurFactor {
     /// Solves with the factored dense Schur complement alone: `rhs` and
     /// `sol` in Schur positions (vectors of |C| entries).
     pub fn solve_schur(&self, rhs: &Vector, sol: &mut Vector) -> Result<()> {
+        if !self.symmetric {
+            let mut v = rhs.with_array(<[f64]>::to_vec)?;
+            self.solve_lu(&mut v)?;
+            return sol.with_array_mut(|a| a.copy_from_slice(&v));
+        }
         // SAFETY: valid factor whose Schur complement the last `update`
         // factored (PETSc factors it first otherwise); vectors of the
         // Schur size (PETSc checks).
@@ -318,7 +331,12 @@ impl SchurFactor {
     /// Jacobian's Dirichlet replacement would drop them).
     pub fn update(&mut self, kc: &Matrix) -> Result<()> {
         let d = self.tangent_entries(kc)?;
-        if self.cholesky && self.trailing_update(&d)? {
+        if !self.symmetric {
+            self.lu_update(&d)?;
+            self.tangent = d;
+            return Ok(());
+        }
+        if self.trailing_update(&d)? {
             self.tangent = d;
             return Ok(());
         }
@@ -415,14 +433,12 @@ impl SchurFactor {
             petsc_call!(MatDenseGetArray(s, &mut arr))?;
             std::slice::from_raw_parts_mut(arr, n * n).copy_from_slice(dense);
             petsc_call!(MatDenseRestoreArray(s, &mut arr))?;
-            if self.cholesky {
-                // Cleared after the fast path's Cholesky factors.
-                petsc_call!(MatSetOption(
-                    s,
-                    sys::MatOption_MAT_SPD,
-                    sys::PetscBool_PETSC_FALSE
-                ))?;
-            }
+            // Cleared after the fast path's Cholesky factors.
+            petsc_call!(MatSetOption(
+                s,
+                sys::MatOption_MAT_SPD,
+                sys::PetscBool_PETSC_FALSE
+            ))?;
             petsc_call!(MatFactorRestoreSchurComplement(
                 self.factor,
                 &mut s,
@@ -438,10 +454,97 @@ impl SchurFactor {
     /// its Dirichlet replacement, Kc without the constrained rows and
     /// columns).
     pub fn solve(&self, b: &Vector, x: &mut Vector) -> Result<()> {
+        let Some(sigma) = self.reference.filter(|_| !self.symmetric) else {
+            return self.sparse_solve(b, x);
+        };
+        // The reference solve, then the correction (see the module).
+        self.sparse_solve(b, x)?;
+        let l = &*self.layout;
+        let x_ref = x.with_array(|a| l.gather(a))?;
+        let mut x_c = l.times_base(&x_ref);
+        for (p, v) in x_c.iter_mut().enumerate() {
+            if !l.fixed[p] {
+                *v += sigma * x_ref[p];
+            }
+        }
+        self.solve_lu(&mut x_c)?;
+        let mut dx = vec![0.0; x_c.len()];
+        for &(r, c, v) in &self.tangent {
+            dx[r] += v * x_c[c];
+        }
+        for (p, v) in dx.iter_mut().enumerate() {
+            if !l.fixed[p] {
+                *v -= sigma * x_c[p];
+            }
+        }
+        let mut b2 = b.duplicate()?;
+        b2.copy_from(b)?;
+        b2.with_array_mut(|a| {
+            for (&d, &p) in l.c.iter().zip(&l.pos) {
+                a[d as usize] -= dx[p];
+            }
+        })?;
+        self.sparse_solve(&b2, x)
+    }
+
+    /// MatSolve with the factor: J⁻¹ b for the Jacobian whose Schur
+    /// complement the factor matrix's array holds.
+    fn sparse_solve(&self, b: &Vector, x: &mut Vector) -> Result<()> {
         // SAFETY: valid factor, its Schur complement set and factored by
         // `update` (MatSolve factors it first otherwise); vectors of the
         // factored size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), x.raw())) }
+    }
+
+    /// The non-symmetric path's set-up: the reference factored into the
+    /// factor matrix once, then S0 + D by [`PartialLu`] with the split
+    /// chosen as on the symmetric path.
+    fn lu_update(&mut self, d: &[(usize, usize, f64)]) -> Result<()> {
+        let n = self.layout.c.len();
+        if self.reference.is_none() {
+            let sigma = self.layout.mean_free_diagonal();
+            let mut dense = self.layout.base.clone();
+            for p in (0..n).filter(|&p| !self.layout.fixed[p]) {
+                dense[p * n + p] += sigma;
+            }
+            self.factor_whole(&dense)?;
+            self.counts.whole += 1;
+            self.reference = Some(sigma);
+        }
+        let first = d.iter().map(|&(r, c, _)| r.min(c)).min().unwrap_or(n);
+        if self.partial.as_ref().is_none_or(|p| p.split() > first) {
+            let split = first.saturating_sub(n - first);
+            let base = &self.layout.base;
+            self.partial =
+                PartialCholesky::new(base, n, split).or_else(|| PartialCholesky::new(base, n, 0));
+            self.counts.leading += 1;
+        }
+        let Some(partial) = &self.partial else {
+            return Err(error(
+                "SchurFactor::update",
+                format!("the contact Schur complement's order ({n} DOFs) does not fit LAPACK"),
+            ));
+        };
+        if !partial.factor_lu_into(d, &mut self.lu) {
+            return Err(error(
+                "SchurFactor::update",
+                format!("the contact Schur complement on {n} DOFs is singular (LU of its trailing {} DOFs)", n - partial.split()),
+            ));
+        }
+        self.counts.trailing += 1;
+        self.counts.largest_trailing = self.counts.largest_trailing.max(n - partial.split());
+        Ok(())
+    }
+
+    /// `v` (Schur positions) ← S⁻¹ v with the non-symmetric path's factor.
+    fn solve_lu(&self, v: &mut [f64]) -> Result<()> {
+        if self.lu.solve(v) {
+            return Ok(());
+        }
+        Err(error(
+            "SchurFactor::solve",
+            "the dense Schur complement is not factored".into(),
+        ))
     }
 }
 

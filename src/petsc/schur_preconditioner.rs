@@ -15,9 +15,11 @@ use std::rc::Rc;
 pub struct SchurPreconditioner {
     k: Matrix,
     constrained: Vec<PetscInt>,
-    cholesky: bool,
+    /// The contact tangent is symmetric (see `SchurFactor`).
+    symmetric: bool,
     factor: Option<SchurFactor>,
     wanted: Vec<PetscInt>,
+    reserved: Vec<PetscInt>,
     key: Vec<(PetscInt, f64)>,
     /// Sparse factorisations of K (the first, and one per growth of C).
     pub bulk_factorisations: usize,
@@ -44,15 +46,16 @@ impl SchurPreconditioner {
     /// the Jacobian replaces by the identity (K is factored with the same
     /// replacement, made on a copy that lives only while it is factored,
     /// and the contact tangent's entries there are dropped).
-    pub fn new(k: Matrix, mut constrained: Vec<PetscInt>, cholesky: bool) -> Self {
+    pub fn new(k: Matrix, mut constrained: Vec<PetscInt>, symmetric: bool) -> Self {
         constrained.sort_unstable();
         constrained.dedup();
         SchurPreconditioner {
             k,
             constrained,
-            cholesky,
+            symmetric,
             factor: None,
             wanted: Vec::new(),
+            reserved: Vec::new(),
             key: Vec::new(),
             bulk_factorisations: 0,
             schur_factorisations: 0,
@@ -105,11 +108,17 @@ impl SchurPreconditioner {
     }
 
     /// The DOFs the contact tangent may touch from now on (any order,
-    /// repeats allowed): C grows at the next set-up if they are not in it.
-    pub fn want(&mut self, mut dofs: Vec<PetscInt>) {
+    /// repeats allowed): C grows at the next set-up if they are not in it;
+    /// and the `reserved` ones, taken into C whenever it is formed, which
+    /// do not make it grow (a contact zone expected to reach them within
+    /// the run: one factorisation of K instead of one per growth).
+    pub fn want(&mut self, mut dofs: Vec<PetscInt>, mut reserved: Vec<PetscInt>) {
         dofs.sort_unstable();
         dofs.dedup();
         self.wanted = dofs;
+        reserved.sort_unstable();
+        reserved.dedup();
+        self.reserved = reserved;
     }
 
     /// An order key for the DOFs of C (smallest: most likely to be touched
@@ -156,6 +165,7 @@ impl SchurPreconditioner {
         }
         if grow {
             let mut c: Vec<PetscInt> = self.wanted.clone();
+            c.extend_from_slice(&self.reserved);
             if let Some(f) = &self.factor {
                 c.extend_from_slice(f.dofs());
                 self.growths += 1;
@@ -175,7 +185,7 @@ impl SchurPreconditioner {
                 &kd,
                 c,
                 &self.constrained,
-                self.cholesky,
+                self.symmetric,
                 &self.key,
             )?);
             self.bulk_factorisations += 1;

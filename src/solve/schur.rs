@@ -130,17 +130,34 @@ pub(super) fn contact_dofs(pairs: &[ContactPair], dofs: &DofMap) -> Result<Vec<P
     for p in pairs {
         p.add_pattern(dofs, &mut t)?;
     }
+    Ok(whole_nodes(&t.0))
+}
+
+/// The DOFs the pairs reserve for C beyond their pattern (a mortar pair's
+/// nodes within the search distance), whole nodes.
+fn reserved_dofs(pairs: &[ContactPair]) -> Vec<PetscInt> {
+    let r: Vec<PetscInt> = pairs
+        .iter()
+        .flat_map(ContactPair::reserve_dofs)
+        .map(|d| d.0)
+        .filter(|&d| d >= 0)
+        .collect();
+    whole_nodes(&r)
+}
+
+/// The three DOFs of each node some DOF of `dofs` belongs to, sorted.
+fn whole_nodes(dofs: &[PetscInt]) -> Vec<PetscInt> {
     let d = DIM as PetscInt;
-    let mut out: Vec<PetscInt> =
-        t.0.iter()
-            .flat_map(|&g| {
-                let n = g / d;
-                (0..d).map(move |c| n * d + c)
-            })
-            .collect();
+    let mut out: Vec<PetscInt> = dofs
+        .iter()
+        .flat_map(|&g| {
+            let n = g / d;
+            (0..d).map(move |c| n * d + c)
+        })
+        .collect();
     out.sort_unstable();
     out.dedup();
-    Ok(out)
+    out
 }
 
 /// After a new Jacobian pattern: the DOFs C must hold from now on, and
@@ -153,8 +170,12 @@ pub(super) fn want(
 ) -> Result<()> {
     if let Some(s) = snes.schur_mut() {
         let c = contact_dofs(pairs, dofs)?;
-        s.order_by(distance_to_other_body(&c, dofs, mesh));
-        s.want(c);
+        let reserved = reserved_dofs(pairs);
+        let mut all = [c.as_slice(), &reserved].concat();
+        all.sort_unstable();
+        all.dedup();
+        s.order_by(distance_to_other_body(&all, dofs, mesh));
+        s.want(c, reserved);
     }
     if let Some(s) = snes.low_rank_mut() {
         // Collective: this rank's share, gathered.
