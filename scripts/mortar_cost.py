@@ -9,7 +9,10 @@ and prints per scene and formulation the DOFs, Newton and Uzawa iterations,
 preconditioner builds, and the median over REPEATS (default 3) of the wall
 time the run reports and of the process's CPU time (user + system), with
 the load average before and after. Ratios are mortar / links. SCENE
-names (prefixes of the names below) select scenes.
+names (prefixes of the names below) select scenes; a SCENE that is a
+.toml file is run as given (e.g. the graded line meshes that
+`python3 scripts/bench_peers.py --cases line --dry-run --out DIR` writes:
+DIR/line-b40.toml).
 """
 import os
 import re
@@ -64,9 +67,11 @@ def run(exe, args, formulation):
 def main(exe, repeats, only):
     os.makedirs("out", exist_ok=True)
     print(f"load average before: {os.getloadavg()}")
-    for name, args in SCENES:
-        if only and not any(name.startswith(o) for o in only):
-            continue
+    files = [o for o in only if o.endswith(".toml")]
+    names = [o for o in only if not o.endswith(".toml")]
+    scenes = [(n, a) for n, a in SCENES if not only or any(n.startswith(o) for o in names)]
+    scenes += [(os.path.basename(f)[: -len(".toml")], [f]) for f in files]
+    for name, args in scenes:
         runs = {"links": [], "mortar": []}
         for _ in range(repeats):
             for f in ("links", "mortar"):
