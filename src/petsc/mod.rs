@@ -14,6 +14,7 @@ pub mod schur;
 mod schur_preconditioner;
 mod shell;
 pub mod signals;
+mod slope;
 pub mod snes;
 pub mod sys;
 pub mod vector;

@@ -3,6 +3,7 @@
 use super::low_rank::LowRankPreconditioner;
 use super::reason::{KspReason, SnesReason};
 use super::schur::SchurPreconditioner;
+use super::slope::LastSolve;
 use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -75,6 +76,10 @@ pub struct Snes {
     /// The linear solves' floor (`set_linear_floor`), boxed for the same
     /// reason and dropped after the SNES too.
     floor: Option<Box<LinearFloor>>,
+    /// On the Schur and low-rank paths, the operator the line search's
+    /// slope is taken with (`super::slope`); boxed and dropped after the
+    /// SNES, as above.
+    slope: Option<Box<LastSolve>>,
 }
 
 /// A KSP convergence test and the destructor of its context.
@@ -112,6 +117,7 @@ impl Snes {
             schur: None,
             low_rank: None,
             floor: None,
+            slope: None,
         };
         Ok(snes)
     }
@@ -192,6 +198,7 @@ impl Snes {
             petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
             petsc_call!(KSPGetPC(ksp, &mut pc))?;
             super::schur::install(pc, ptr)?;
+            self.watch_solves(ksp)?;
             // A fresh exact solve needs no Krylov iterations around it
             // (GMRES took one each, at twice the solves); a user's
             // -ksp_type stands.
@@ -262,12 +269,20 @@ impl Snes {
             petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
             petsc_call!(KSPGetPC(ksp, &mut pc))?;
             super::low_rank::install(pc, ptr)?;
+            self.watch_solves(ksp)?;
             // An exact solve, as on the Schur path.
             if !super::options::user_set("-ksp_type")? {
                 petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
             }
             Ok(())
         }
+    }
+
+    /// The linear solves of `ksp` (this SNES's) recorded for the line
+    /// search's slope (see `super::slope`).
+    fn watch_solves(&mut self, ksp: sys::KSP) -> Result<()> {
+        let slope = self.slope.get_or_insert_with(|| Box::new(LastSolve::new()));
+        slope.watch(ksp)
     }
 
     /// The low-rank preconditioner's state, if installed.
@@ -315,6 +330,13 @@ impl Snes {
             jacobian_stopped: false,
         };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
+        // The operator is the Jacobian matrix itself, or on the contact
+        // paths whose matrix holds the contact tangent alone a shell for
+        // the line search's slope.
+        let operator = match self.slope.as_mut() {
+            Some(s) => s.operator(j.raw())?,
+            None => j.raw(),
+        };
         const HIST: usize = 200;
         let mut hist = [0.0f64; HIST];
         let mut hist_its = [0 as sys::PetscInt; HIST];
@@ -331,7 +353,7 @@ impl Snes {
             ))?;
             petsc_call!(SNESSetJacobian(
                 self.raw,
-                j.raw(),
+                operator,
                 j.raw(),
                 Some(jacobian_trampoline),
                 ctx_ptr
@@ -563,13 +585,13 @@ unsafe extern "C" fn residual_trampoline(
 unsafe extern "C" fn jacobian_trampoline(
     snes: sys::SNES,
     x: sys::Vec,
-    a: sys::Mat,
-    _p: sys::Mat,
+    _a: sys::Mat,
+    p: sys::Mat,
     ctx: *mut c_void,
 ) -> sys::PetscErrorCode {
-    // SAFETY: PETSc passes valid objects for the call's duration; A and P are the
-    // same matrix (set in `solve`).
-    let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(a)) };
+    // SAFETY: PETSc passes valid objects for the call's duration; P is the
+    // Jacobian matrix set in `solve` (A is P or the slope's shell).
+    let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(p)) };
     let code = run_callback(ctx, snes, Kind::Jacobian, |p| p.jacobian(&xv, &mut am));
     // SNES reads its preconditioner lag after this callback returns, so a
     // lag set here decides this iteration: -2 rebuilds once, -1 reuses.
