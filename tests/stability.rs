@@ -88,6 +88,30 @@ fn penalty_over_nine_decades_gives_the_same_pressure() {
     }
 }
 
+/// The same with a mortar pair, whose non-symmetric tangent takes the
+/// Schur path's LU branch: at 10⁶ times the default penalty its solve once
+/// carried x_C's roundoff times |D|/σ into the interior, and the force came
+/// out 9.589.
+#[test]
+fn mortar_penalty_over_nine_decades_gives_the_same_pressure() {
+    let base = 10.0 * E / H_SLAVE;
+    for k in [1e-3, 1.0, 1e2, 1e6] {
+        let (n, newton, uzawa) = patch(
+            &format!("mortar-penalty-{k:e}"),
+            &[
+                "--set",
+                &format!("contact.penalty={}", k * base),
+                "--set",
+                "contact.max_uzawa=300",
+                "--set",
+                "contact.formulation=mortar",
+            ],
+        );
+        println!("mortar, penalty ×{k:e}: normal force {n:.9}, Newton {newton}, Uzawa {uzawa}");
+        assert_force(&format!("mortar, penalty ×{k:e}"), n, 0.0);
+    }
+}
+
 #[test]
 fn initial_penetration_of_half_an_element_is_pushed_out() {
     // Upper elements are 0.25 high: start 0.125 inside the lower block.

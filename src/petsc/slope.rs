@@ -73,12 +73,16 @@ impl LastSolve {
             petsc_call!(MatShellSetOperation(
                 self.shell,
                 sys::MatOperation_MATOP_MULT,
-                Some(std::mem::transmute::<MatVecOp, unsafe extern "C" fn()>(mult))
+                Some(std::mem::transmute::<MatVecOp, unsafe extern "C" fn()>(
+                    mult
+                ))
             ))?;
             petsc_call!(MatShellSetOperation(
                 self.shell,
                 sys::MatOperation_MATOP_MULT_TRANSPOSE,
-                Some(std::mem::transmute::<MatVecOp, unsafe extern "C" fn()>(mult_t))
+                Some(std::mem::transmute::<MatVecOp, unsafe extern "C" fn()>(
+                    mult_t
+                ))
             ))?;
         }
         Ok(self.shell)
