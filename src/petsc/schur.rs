@@ -373,12 +373,7 @@ impl SchurFactor {
         }
         let first = d.iter().map(|&(r, c, _)| r.min(c)).min().unwrap_or(n);
         if self.partial.as_ref().is_none_or(|p| p.split() > first) {
-            // Room for the touched tail to double before S0's leading block
-            // must be factored again: a first touch grows (hertz line b/40:
-            // the tail from 324 to 504 DOFs between the first two tangents),
-            // and a trailing block of 2t DOFs still costs (2t/n)³ of the
-            // whole (6 % at t = n/5).
-            let split = first.saturating_sub(n - first);
+            let split = split_before(first, n);
             self.in_array = None;
             self.partial = PartialCholesky::new(&self.layout.base, n, split);
             self.partial_refused = self.partial.is_none();
@@ -516,7 +511,7 @@ impl SchurFactor {
         }
         let first = d.iter().map(|&(r, c, _)| r.min(c)).min().unwrap_or(n);
         if self.partial.as_ref().is_none_or(|p| p.split() > first) {
-            let split = first.saturating_sub(n - first);
+            let split = split_before(first, n);
             let base = &self.layout.base;
             self.partial =
                 PartialCholesky::new(base, n, split).or_else(|| PartialCholesky::new(base, n, 0));
@@ -549,6 +544,16 @@ impl SchurFactor {
             "the dense Schur complement is not factored".into(),
         ))
     }
+}
+
+/// Where S0's leading block ends for a tangent whose first touched Schur
+/// position is `first` (of `n`): room for the touched tail to double before
+/// the leading block must be factored again. A first touch grows (hertz
+/// line b/40: the tail from 324 to 504 DOFs between the first two
+/// tangents), and a trailing block of 2t DOFs still costs (2t/n)³ of the
+/// whole (6 % at t = n/5).
+fn split_before(first: usize, n: usize) -> usize {
+    first.saturating_sub(n - first)
 }
 
 /// `f` on the array of the factored Schur matrix of `factor` (n × n), which

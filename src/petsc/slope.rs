@@ -24,10 +24,6 @@ pub struct LastSolve {
     tangent: sys::Mat,
     rhs: Option<Vector>,
     sol: Option<Vector>,
-    /// Products answered by the last solve's right-hand side, and by the
-    /// contact tangent.
-    pub from_solve: usize,
-    pub from_tangent: usize,
 }
 
 impl LastSolve {
@@ -37,8 +33,6 @@ impl LastSolve {
             tangent: std::ptr::null_mut(),
             rhs: None,
             sol: None,
-            from_solve: 0,
-            from_tangent: 0,
         }
     }
 
@@ -109,18 +103,16 @@ impl LastSolve {
     }
 
     /// y = A x: the last right-hand side when x is the last solution.
-    fn mult(&mut self, x: sys::Vec, y: sys::Vec) -> Result<()> {
+    fn mult(&self, x: sys::Vec, y: sys::Vec) -> Result<()> {
         if let (Some(sol), Some(rhs)) = (&self.sol, &self.rhs) {
             let mut same = sys::PetscBool_PETSC_FALSE;
             // SAFETY: valid vectors of the operator's layout (PETSc checks).
             unsafe { petsc_call!(VecEqual(x, sol.raw(), &mut same))? };
             if same == sys::PetscBool_PETSC_TRUE {
-                self.from_solve += 1;
                 // SAFETY: as above.
                 return unsafe { petsc_call!(VecCopy(rhs.raw(), y)) };
             }
         }
-        self.from_tangent += 1;
         // SAFETY: the tangent is the solve's Jacobian matrix, assembled.
         unsafe { petsc_call!(MatMult(self.tangent, x, y)) }
     }
@@ -163,14 +155,25 @@ unsafe extern "C" fn post_solve(
     code(s.record(&bv, &xv))
 }
 
-unsafe extern "C" fn shell_mult(a: sys::Mat, x: sys::Vec, y: sys::Vec) -> sys::PetscErrorCode {
+/// The state behind the shell `a` (None if PETSc cannot give it).
+///
+/// # Safety
+/// `a` must be a shell made by [`LastSolve::operator`], its state alive.
+unsafe fn shell_state<'a>(a: sys::Mat) -> Option<&'a mut LastSolve> {
     let mut ctx: *mut c_void = std::ptr::null_mut();
-    // SAFETY: `a` is the shell made in `operator`, its context the state.
-    if unsafe { sys::MatShellGetContext(a, &mut ctx as *mut *mut c_void as *mut c_void) } != 0 {
-        return sys::PETSC_ERR_LIB;
+    // SAFETY: `a` is a valid shell (the caller's promise); the out-pointer
+    // is a local.
+    let got = unsafe { sys::MatShellGetContext(a, &mut ctx as *mut *mut c_void as *mut c_void) };
+    // SAFETY: its context is the state (the caller's promise).
+    (got == 0).then(|| unsafe { state(ctx) })
+}
+
+unsafe extern "C" fn shell_mult(a: sys::Mat, x: sys::Vec, y: sys::Vec) -> sys::PetscErrorCode {
+    // SAFETY: PETSc calls this on the shell made in `operator`.
+    match unsafe { shell_state(a) } {
+        Some(s) => code(s.mult(x, y)),
+        None => sys::PETSC_ERR_LIB,
     }
-    // SAFETY: as above.
-    code(unsafe { state(ctx) }.mult(x, y))
 }
 
 /// Aᵀ x with the contact tangent (what SNES asks when its line search has
@@ -180,12 +183,10 @@ unsafe extern "C" fn shell_mult_transpose(
     x: sys::Vec,
     y: sys::Vec,
 ) -> sys::PetscErrorCode {
-    let mut ctx: *mut c_void = std::ptr::null_mut();
     // SAFETY: as in `shell_mult`.
-    if unsafe { sys::MatShellGetContext(a, &mut ctx as *mut *mut c_void as *mut c_void) } != 0 {
+    let Some(s) = (unsafe { shell_state(a) }) else {
         return sys::PETSC_ERR_LIB;
-    }
-    // SAFETY: as above; the tangent is assembled.
-    let s = unsafe { state(ctx) };
+    };
+    // SAFETY: the tangent is the solve's Jacobian matrix, assembled.
     code(unsafe { petsc_call!(MatMultTranspose(s.tangent, x, y)) })
 }
