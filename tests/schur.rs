@@ -311,27 +311,16 @@ fn schur_path() {
     // A frictional mortar pair, whose second step's line search cuts the
     // Newton step: the same step lengths as on the full factorisation
     // (the line search's slope from the whole system, `petsc::slope`).
-    same_run(
-        &rt,
-        "hertz-cylinder",
-        &[
-            "mesh.fine_size=0.4",
-            "contact.friction=0.2",
-            "steps.count=2",
-            "contact.formulation=\"mortar\"",
-        ],
-    );
+    let frictional = [
+        "mesh.fine_size=0.4",
+        "contact.friction=0.2",
+        "steps.count=2",
+    ];
+    let frictional_mortar = [&frictional[..], &["contact.formulation=\"mortar\""]].concat();
+    same_run(&rt, "hertz-cylinder", &frictional_mortar);
     whole_newton_same_iterates(&rt);
     // Coulomb friction (LU), two load steps (a second search and pattern).
-    same_run(
-        &rt,
-        "hertz-cylinder",
-        &[
-            "mesh.fine_size=0.4",
-            "contact.friction=0.2",
-            "steps.count=2",
-        ],
-    );
+    same_run(&rt, "hertz-cylinder", &frictional);
 }
 
 /// The Schur path with Newton on the whole vector (`condensed_newton =
