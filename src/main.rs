@@ -312,6 +312,13 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         h.width_exact,
                         100.0 * h.width_error()
                     );
+                    if let Some((ep, ew)) = h.averaged_errors() {
+                        println!(
+                            "  Hertz, nodal pressures read as nodal averages: p0 {:+.3} %, half-width/radius {:+.3} %",
+                            100.0 * ep,
+                            100.0 * ew
+                        );
+                    }
                 }
                 match &summary.output {
                     Some(p) => println!(

@@ -12,8 +12,9 @@ use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
 use crate::solve::{PairFields, RunReport, Simulation, StepReport, StepSink};
-use crate::verify::{HertzCheck, HertzComparison};
+use crate::verify::{HertzCheck, HertzComparison, NodalSample};
 use mpi::traits::CommunicatorCollectives;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// How to run a scene.
@@ -254,6 +255,38 @@ impl HertzObserver {
     }
 }
 
+impl HertzObserver {
+    /// Collective: the shape-function samples of every loaded slave node
+    /// (pressure > 0), from all ranks, for the nodal-average fit.
+    fn loaded_node_samples(
+        &self,
+        pair: &crate::contact::ContactPair,
+        points: &[[f64; 3]],
+        pressure: &[f64],
+    ) -> Vec<NodalSample> {
+        let key = |x: &[f64; 3]| x.map(f64::to_bits);
+        let loaded: HashSet<[u64; 3]> = points
+            .iter()
+            .zip(pressure)
+            .filter(|(_, &p)| p > 0.0)
+            .map(|(x, _)| key(x))
+            .collect();
+        let mine: Vec<f64> = pair
+            .nodal_samples(&|x| loaded.contains(&key(x)))
+            .iter()
+            .flat_map(|s| s.node.into_iter().chain(s.at).chain([s.weight]))
+            .collect();
+        gather_all(&self.world, &mine)
+            .chunks_exact(7)
+            .map(|c| NodalSample {
+                node: [c[0], c[1], c[2]],
+                at: [c[3], c[4], c[5]],
+                weight: c[6],
+            })
+            .collect()
+    }
+}
+
 impl StepSink for HertzObserver {
     fn step(
         &mut self,
@@ -286,8 +319,9 @@ impl StepSink for HertzObserver {
         let points = gather_all(&self.world, &points);
         let pressure = gather_all(&self.world, &pressure);
         let points: Vec<[f64; 3]> = points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let samples = self.loaded_node_samples(fields.pair, &points, &pressure);
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
-        self.last = crate::verify::compare(check, &points, &pressure, force);
+        self.last = crate::verify::compare(check, &points, &pressure, &samples, force);
         Ok(())
     }
 }

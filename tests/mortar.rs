@@ -509,3 +509,59 @@ fn mortar_search_follows_a_contact_zone_that_grows_past_the_steps_margin() {
         "nodal pressures differ by {p_diff:.3e} of {p_max:.3e}"
     );
 }
+
+/// The percentages of a run's two Hertz lines: (p0, width) read as point
+/// values ("Hertz: ... (e %) ... (e %)") and read as nodal averages.
+fn hertz_errors(run_text: &str) -> [(f64, f64); 2] {
+    let percents = |marker: &str| -> (f64, f64) {
+        let line = run_text
+            .lines()
+            .find(|l| l.contains(marker))
+            .unwrap_or_else(|| panic!("no {marker:?} line in:\n{run_text}"));
+        let values: Vec<f64> = line
+            .split(" %")
+            .filter_map(|part| part.rsplit([' ', '(']).next()?.parse().ok())
+            .collect();
+        assert_eq!(values.len(), 2, "two percentages in {line:?}");
+        (values[0], values[1])
+    };
+    [percents("Hertz: load"), percents("read as nodal averages")]
+}
+
+/// Hertz line contact (`hertz-cylinder`, h = 0.2, 1 rank): the mortar's
+/// errors in p0 and the half-width are no worse than the links' on the same
+/// mesh, whether the nodal pressures are read as point values or as what
+/// both formulations write, nodal averages ∫N_j p dA / ∫N_j dA (the larger
+/// of the two errors per reading). Measured: point reading mortar +0.224 /
+/// −0.549 %, links +0.228 / −0.612 %; nodal averages mortar +0.476 /
+/// +0.272 %, links +0.482 / +0.201 %.
+#[test]
+fn mortar_hertz_line_errors_are_no_worse_than_the_links() {
+    let errors = |formulation: &str| {
+        let set = format!("contact.formulation={formulation}");
+        let o = run(&[
+            "run",
+            "hertz-cylinder",
+            "--set",
+            "mesh.fine_size=0.2",
+            "--set",
+            &set,
+        ]);
+        assert!(o.status.success(), "{formulation} failed:\n{}", text(&o));
+        hertz_errors(&text(&o))
+    };
+    let (links, mortar) = (errors("links"), errors("mortar"));
+    println!("point reading, nodal averages (p0 %, width %): links {links:?}, mortar {mortar:?}");
+    let worst = |(p0, w): (f64, f64)| p0.abs().max(w.abs());
+    for (reading, (l, m)) in ["point", "nodal average"]
+        .iter()
+        .zip(links.iter().zip(&mortar))
+    {
+        assert!(
+            worst(*m) <= worst(*l),
+            "{reading} reading: mortar {m:?} against links {l:?}"
+        );
+        // Both within the 0.3 % … 0.7 % a 16k-DOF mesh gives.
+        assert!(worst(*m) < 0.7 && worst(*l) < 0.7, "{reading}: {m:?} {l:?}");
+    }
+}

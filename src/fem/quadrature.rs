@@ -196,6 +196,57 @@ impl QuadRule {
         }
     }
 
+    /// Composite rule on a facet: the reference facet cut into `cells` ×
+    /// `cells` equal parts (squares for quad4, triangles for tri3), each
+    /// with the 4×4 Gauss or the 6-point rule. For integrands with a kink
+    /// inside the facet (a pressure profile's edge), where one rule of any
+    /// degree converges slowly.
+    pub fn composite_for_facet(facet: FacetType, cells: usize) -> Self {
+        let m = cells.max(1);
+        let mut rule = Self::with_capacity(16 * m * m);
+        match facet {
+            FacetType::Quad4 => {
+                let base = Self::quad_4x4();
+                let h = 2.0 / m as f64;
+                for j in 0..m {
+                    for i in 0..m {
+                        let c = [-1.0 + h * (i as f64 + 0.5), -1.0 + h * (j as f64 + 0.5)];
+                        for (p, w) in base.points.iter().zip(&base.weights) {
+                            rule.push(
+                                [c[0] + 0.5 * h * p[0], c[1] + 0.5 * h * p[1], 0.0],
+                                w * 0.25 * h * h,
+                            );
+                        }
+                    }
+                }
+            }
+            FacetType::Tri3 => {
+                let base = Self::tri_6();
+                let h = 1.0 / m as f64;
+                let mut cell = |o: [f64; 2], e1: [f64; 2], e2: [f64; 2]| {
+                    for (p, w) in base.points.iter().zip(&base.weights) {
+                        let x = [
+                            o[0] + h * (e1[0] * p[0] + e2[0] * p[1]),
+                            o[1] + h * (e1[1] * p[0] + e2[1] * p[1]),
+                        ];
+                        rule.push([x[0], x[1], 0.0], w * h * h);
+                    }
+                };
+                for j in 0..m {
+                    for i in 0..m - j {
+                        let o = [h * i as f64, h * j as f64];
+                        cell(o, [1.0, 0.0], [0.0, 1.0]);
+                        if i + j + 1 < m {
+                            // The downward triangle between two upward ones.
+                            cell([o[0] + h, o[1] + h], [-1.0, 0.0], [0.0, -1.0]);
+                        }
+                    }
+                }
+            }
+        }
+        rule
+    }
+
     /// Nodal (Lobatto / vertex) rule on a facet: the points are the facet's
     /// nodes, exact for linear integrands. Contact uses it to put one
     /// constraint at each slave node instead of several per facet.
@@ -316,6 +367,24 @@ mod tests {
         }
         assert!(QuadRule::hex_gauss(5).is_err());
         assert!(QuadRule::quad_gauss(0).is_err());
+    }
+
+    #[test]
+    fn composite_facet_rules_keep_their_cells_degree_and_integrate_a_kink() {
+        for m in 1..=3 {
+            let quad = QuadRule::composite_for_facet(FacetType::Quad4, m);
+            let tri = QuadRule::composite_for_facet(FacetType::Tri3, m);
+            assert_eq!((quad.len(), tri.len()), (16 * m * m, 6 * m * m));
+            quad.check().unwrap();
+            tri.check().unwrap();
+            assert!(tensor_error(&quad, 2, 7) < 1e-13, "quad m={m}");
+            assert!(simplex_error(&tri, 2, 4) < 1e-13, "tri m={m}");
+        }
+        // |x| has its kink on a cell boundary of the 2 × 2 split: exact there,
+        // not with one cell.
+        let kink = |r: &QuadRule| (apply(r, |x| x[0].abs()) - 2.0).abs();
+        assert!(kink(&QuadRule::composite_for_facet(FacetType::Quad4, 2)) < 1e-13);
+        assert!(kink(&QuadRule::composite_for_facet(FacetType::Quad4, 1)) > 1e-3);
     }
 
     #[test]

@@ -172,6 +172,30 @@ pub fn facet_area(facet: FacetType, x: &[[f64; 3]]) -> Result<f64, FemError> {
         .sum())
 }
 
+/// Samples of each corner's shape function over the facet through `x`:
+/// (corner, point, N_corner · dA) at every point of `rule`.
+pub fn shape_samples(
+    facet: FacetType,
+    x: &[[f64; 3]],
+    rule: &QuadRule,
+) -> Result<Vec<(usize, [f64; 3], f64)>, FemError> {
+    check_facet(facet, "x", x)?;
+    let mut out = Vec::with_capacity(rule.len() * x.len());
+    for (p, w) in rule.points.iter().zip(&rule.weights) {
+        let s = shape::facet_shape(facet, surface_point(p));
+        let (t1, t2) = tangents(&s, x);
+        let da = t1.cross(&t2).norm() * w;
+        let mut at = [0.0; 3];
+        for (na, xa) in s.n.iter().zip(x) {
+            for k in 0..3 {
+                at[k] += na * xa[k];
+            }
+        }
+        out.extend((0..x.len()).map(|a| (a, at, s.n[a] * da)));
+    }
+    Ok(out)
+}
+
 /// Unit outward normal at the facet centre (`ξ = (0,0)` for quad4,
 /// `(⅓,⅓)` for tri3).
 pub fn facet_normal_at_centre(facet: FacetType, x: &[[f64; 3]]) -> Result<[f64; 3], FemError> {
@@ -381,6 +405,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn shape_samples_split_the_area_and_the_first_moment_among_the_corners() {
+        for facet in [FacetType::Quad4, FacetType::Tri3] {
+            let x = warped(facet, 7);
+            let rule = QuadRule::composite_for_facet(facet, 3);
+            let samples = shape_samples(facet, &x, &rule).unwrap();
+            assert_eq!(samples.len(), rule.len() * x.len());
+            let area: f64 = samples.iter().map(|s| s.2).sum();
+            let exact = facet_area(facet, &x).unwrap();
+            assert!(
+                rel_err(&[area], &[exact]) < 1e-6,
+                "{facet:?}: {area} vs {exact}"
+            );
+            // Σ_a N_a x_a = x at every sample: the corners' weighted positions
+            // add up to the facet's first moment.
+            let moment = |k: usize| -> (f64, f64) {
+                let by_corner: f64 = samples.iter().map(|s| s.2 * x[s.0][k]).sum();
+                let by_point: f64 = samples.iter().map(|s| s.2 * s.1[k]).sum();
+                (by_corner, by_point)
+            };
+            for k in 0..3 {
+                let (c, p) = moment(k);
+                assert!(
+                    (c - p).abs() < 1e-12 * (1.0 + p.abs()),
+                    "{facet:?} {k}: {c} vs {p}"
+                );
+            }
+        }
+        assert!(shape_samples(FacetType::Quad4, &[[0.0; 3]; 3], &QuadRule::quad_2x2()).is_err());
     }
 
     #[test]

@@ -48,7 +48,7 @@ pub fn plot(path: &Path, output: &Path, step: Option<usize>) -> Result<PlotRepor
     let profile = Profile::new(&check, &pair, &nodal);
     // The same comparison `run` prints on its Hertz line: the profile fitted
     // to the nodal pressures at the reference node positions.
-    let comparison = verify::compare(&check, &nodal.points, &nodal.pressure, pair.force);
+    let comparison = verify::compare(&check, &nodal.points, &nodal.pressure, &[], pair.force);
     let font = load_font();
     let with_text = match &font {
         Ok(()) => true,
