@@ -215,6 +215,11 @@ impl ContactPair {
         self.main_part_tangent = on;
     }
 
+    /// Whether the pair is a mortar pair (`formulation = "mortar"`).
+    pub fn is_mortar(&self) -> bool {
+        self.mortar.is_some()
+    }
+
     /// Whether the pair computes friction.
     pub fn has_friction(&self) -> bool {
         self.friction.is_some()
