@@ -3,7 +3,8 @@
 //! distorted mesh, hex and tet cells) under a fixed-direction traction,
 //! with the links measured on the same cases; 1, 2 and 3 ranks agree; bad
 //! `formulation` input is one scene error naming the line; a contact zone
-//! that grows past the step's search margin is searched again.
+//! that grows past the step's search margin is searched again; Hertz
+//! errors of both formulations in both readings of the nodal pressures.
 mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
@@ -569,4 +570,22 @@ fn mortar_hertz_line_errors_match_the_links() {
         );
         assert!(worst(*m) < 0.7 && worst(*l) < 0.7, "{reading}: {m:?} {l:?}");
     }
+}
+
+/// The nodal-average Hertz fit gathers each loaded node's shape-function
+/// samples from the ranks that hold its facets: 1 and 3 ranks print the
+/// same figures.
+#[test]
+fn nodal_average_hertz_fit_is_the_same_on_one_and_three_ranks() {
+    let errors = |ranks: usize| {
+        let o = mpirun(
+            ranks,
+            &["run", "hertz-cylinder", "--set", "mesh.fine_size=0.2"],
+        );
+        assert!(o.status.success(), "{ranks} ranks failed:\n{}", text(&o));
+        hertz_errors(&text(&o))
+    };
+    let (one, three) = (errors(1), errors(3));
+    println!("point reading, nodal averages: 1 rank {one:?}, 3 ranks {three:?}");
+    assert_eq!(one, three);
 }
