@@ -455,8 +455,15 @@ fn plot(file: &str, cli: &Cli) -> ExitCode {
     match contactlink::results::plot::plot(path, &output, cli.step) {
         Ok(r) => {
             let errors = r.comparison.map_or(String::new(), |c| {
+                let averaged = c.averaged_errors().map_or(String::new(), |(p, w)| {
+                    format!(
+                        " (read as nodal averages: p0 {:+.3} %, half-width/radius {:+.3} %)",
+                        100.0 * p,
+                        100.0 * w
+                    )
+                });
                 format!(
-                    ": p0 {:+.3} %, half-width/radius {:+.3} % against the closed form",
+                    ": p0 {:+.3} %, half-width/radius {:+.3} % against the closed form{averaged}",
                     100.0 * c.p0_error(),
                     100.0 * c.width_error()
                 )

@@ -161,6 +161,17 @@ fn summary_and_plot_of_a_hertz_run() {
     let png = dir.join("profile.png");
     let o = run_cmd(&["plot", file, "-o", png.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
+    // Of the last step, as the run's Hertz lines: both readings, the
+    // nodal-average one from the file's own slave facets.
+    let averaged = last_line(&run, "read as nodal averages:")
+        .split_once("nodal averages: ")
+        .expect("averaged figures")
+        .1;
+    assert!(
+        text(&o).contains(&format!("(read as nodal averages: {averaged})")),
+        "plot {:?} against the run's {averaged:?}",
+        text(&o)
+    );
     let bytes = std::fs::read(&png).expect("plot wrote no PNG");
     assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
     assert!(bytes.len() > 10_000, "suspiciously small PNG");

@@ -153,6 +153,66 @@ pub fn slave_nodes(path: &Path, pair: &str) -> Result<Option<Vec<NaturalNode>>, 
     Ok(Some(nodes))
 }
 
+/// Shape-function samples of the nodes `wanted` picks (by reference
+/// position), over the facets of the pair's slave set that have one of
+/// them as a corner, as `run` gathers them for its nodal-average Hertz fit
+/// (the same rule, on the file's reference nodes). None for a file without
+/// the pair → slave set map.
+pub fn nodal_samples(
+    path: &Path,
+    pair: &str,
+    wanted: &dyn Fn(&[f64; 3]) -> bool,
+) -> Result<Option<Vec<crate::verify::NodalSample>>, ResultsError> {
+    use crate::fem::{surface::shape_samples, FacetType, QuadRule};
+    let Some(set) = crate::output::read_string_attr(path, layout::CONTACT_PAIRS, pair)? else {
+        return Ok(None);
+    };
+    let object = format!("{}/{}", layout::facet_set(&set), layout::FACET_NODES);
+    let (ids, shape) = crate::output::read_dataset::<i64>(path, &object)?;
+    let (coords, _) = crate::output::read_dataset::<f64>(path, layout::MESH_NODES)?;
+    let facet_type = match shape.get(1) {
+        Some(4) => FacetType::Quad4,
+        Some(3) => FacetType::Tri3,
+        _ => {
+            return Err(ResultsError::file(
+                path,
+                format!("{object} has shape {shape:?}"),
+            ))
+        }
+    };
+    let rule = QuadRule::composite_for_facet(facet_type, 3);
+    let position = |id: &i64| -> Option<[f64; 3]> {
+        let n = usize::try_from(*id).ok()?;
+        let x = coords.get(3 * n..3 * n + 3)?;
+        Some([x[0], x[1], x[2]])
+    };
+    let mut out = Vec::new();
+    for (f, corners) in ids.chunks_exact(facet_type.nodes()).enumerate() {
+        let x: Option<Vec<[f64; 3]>> = corners.iter().map(position).collect();
+        let x = x.ok_or_else(|| {
+            ResultsError::file(
+                path,
+                format!("{object}: facet {f} names a node the mesh lacks"),
+            )
+        })?;
+        if !x.iter().any(wanted) {
+            continue;
+        }
+        let samples = shape_samples(facet_type, &x, &rule)
+            .map_err(|e| ResultsError::file(path, format!("{object}: facet {f}: {e}")))?;
+        for (a, at, weight) in samples {
+            if wanted(&x[a]) {
+                out.push(crate::verify::NodalSample {
+                    node: x[a],
+                    at,
+                    weight,
+                });
+            }
+        }
+    }
+    Ok(Some(out))
+}
+
 /// Whether `/steps/<step>/<rel>` exists (optional datasets).
 fn has_dataset(path: &Path, step: usize, rel: &str) -> bool {
     let object = layout::step_dataset(step, rel);

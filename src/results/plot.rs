@@ -7,6 +7,7 @@ use crate::dofs::NaturalNode;
 use crate::output::{layout, read_dataset, read_f64_attr, read_nodal, read_string_attr};
 use crate::verify::{self, HertzCheck, HertzKind};
 use plotters::prelude::*;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// Where `plot` looks for a TrueType font (Debian's fonts-dejavu-core);
@@ -46,9 +47,15 @@ pub fn plot(path: &Path, output: &Path, step: Option<usize>) -> Result<PlotRepor
     let pair = PairPoints::read(path, step, &check.pair)?;
     let nodal = NodalPressure::read(path, step, &check.pair)?;
     let profile = Profile::new(&check, &pair, &nodal);
-    // The same comparison `run` prints on its Hertz line: the profile fitted
-    // to the nodal pressures at the reference node positions.
-    let comparison = verify::compare(&check, &nodal.points, &nodal.pressure, &[], pair.force);
+    // The same comparison `run` prints on its Hertz lines: the profile fitted
+    // to the nodal pressures at the reference node positions, read as point
+    // values and as nodal averages.
+    let loaded: HashSet<[u64; 3]> = nodal.points.iter().map(|x| x.map(f64::to_bits)).collect();
+    let samples = super::nodal_samples(path, &check.pair, &|x| {
+        loaded.contains(&x.map(f64::to_bits))
+    })?
+    .unwrap_or_default();
+    let comparison = verify::compare(&check, &nodal.points, &nodal.pressure, &samples, pair.force);
     let font = load_font();
     let with_text = match &font {
         Ok(()) => true,
