@@ -164,7 +164,9 @@ pub fn fit_nodal_averages(
     }
     let w = 0.5 * (lo + hi);
     let p0 = averaged_fit(&supports, w).0;
-    (p0 > 0.0 && w > 0.0).then_some((p0, w))
+    // An answer on the edge of the searched range is no minimum.
+    let inside = w > 0.5 * w0 * (1.0 + 1e-6) && w < 1.5 * w0 * (1.0 - 1e-6);
+    (p0 > 0.0 && inside).then_some((p0, w))
 }
 
 /// Per fitted node: its value and its samples as (s², weight).
