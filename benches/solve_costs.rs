@@ -4,7 +4,8 @@
 //! An MPI program (harness = false; `make bench` runs it on 1 and 2 ranks).
 //! The contact solves are the `hertz-cylinder` scene as shipped (one load
 //! step, Uzawa around Newton, sparse direct solver) at two sizes and
-//! `hertz-sphere` at h = 0.35 (97,803 DOFs, GMRES + GAMG; timed once). The
+//! `hertz-sphere` at h = 0.35 (97,803 DOFs, GMRES + GAMG; timed once, with
+//! the links and with a mortar pair). The
 //! plain solve uses the same mesh, materials, conditions and solver without
 //! the contact pair: one linear-elastic step. Both are timed in this one
 //! process (median of 3, slowest rank), so the ratio does not depend on the
@@ -126,6 +127,15 @@ fn main() {
             "sphere h=0.35",
             "hertz-sphere",
             vec!["mesh.fine_size=0.35".to_string()],
+            1,
+        ));
+        cases.push((
+            "sphere h=0.35 mortar",
+            "hertz-sphere",
+            vec![
+                "mesh.fine_size=0.35".to_string(),
+                "contact.formulation=mortar".to_string(),
+            ],
             1,
         ));
     }
