@@ -1,5 +1,6 @@
 //! Closed-form answers (docs/formulation.md §12) and the post-processing that compares a
 //! run against them: Hertz line and point contact.
+use crate::fem::{surface::shape_samples, FacetType, FemError, QuadRule};
 use std::f64::consts::PI;
 
 /// Which Hertz problem a scene reproduces.
@@ -123,6 +124,35 @@ pub fn fit_profile(kind: &HertzKind, points: &[[f64; 3]], pressure: &[f64]) -> O
     }
     let p0 = intercept.sqrt();
     Some((p0, (intercept / -slope).sqrt()))
+}
+
+/// Samples of the shape functions of the nodes `wanted` picks (by reference
+/// position) over every facet in `facets` (corner positions) that has one of
+/// them as a corner: 3 × 3 cells of a Gauss rule per facet, what
+/// [`fit_nodal_averages`] integrates the profile with. A facet the samples
+/// cannot be taken on fails with its index in `facets`.
+pub fn facet_samples<'a>(
+    facet_type: FacetType,
+    facets: impl IntoIterator<Item = &'a [[f64; 3]]>,
+    wanted: &dyn Fn(&[f64; 3]) -> bool,
+) -> Result<Vec<NodalSample>, (usize, FemError)> {
+    let rule = QuadRule::composite_for_facet(facet_type, 3);
+    let mut out = Vec::new();
+    for (f, x) in facets.into_iter().enumerate() {
+        if !x.iter().any(wanted) {
+            continue;
+        }
+        for (a, at, weight) in shape_samples(facet_type, x, &rule).map_err(|e| (f, e))? {
+            if wanted(&x[a]) {
+                out.push(NodalSample {
+                    node: x[a],
+                    at,
+                    weight,
+                });
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Fits the Hertz profile to nodal pressures read as what they are: a nodal

@@ -163,7 +163,7 @@ pub fn nodal_samples(
     pair: &str,
     wanted: &dyn Fn(&[f64; 3]) -> bool,
 ) -> Result<Option<Vec<crate::verify::NodalSample>>, ResultsError> {
-    use crate::fem::{surface::shape_samples, FacetType, QuadRule};
+    use crate::fem::FacetType;
     let Some(set) = crate::output::read_string_attr(path, layout::CONTACT_PAIRS, pair)? else {
         return Ok(None);
     };
@@ -180,36 +180,29 @@ pub fn nodal_samples(
             ))
         }
     };
-    let rule = QuadRule::composite_for_facet(facet_type, 3);
     let position = |id: &i64| -> Option<[f64; 3]> {
         let n = usize::try_from(*id).ok()?;
         let x = coords.get(3 * n..3 * n + 3)?;
         Some([x[0], x[1], x[2]])
     };
-    let mut out = Vec::new();
-    for (f, corners) in ids.chunks_exact(facet_type.nodes()).enumerate() {
-        let x: Option<Vec<[f64; 3]>> = corners.iter().map(position).collect();
-        let x = x.ok_or_else(|| {
-            ResultsError::file(
-                path,
-                format!("{object}: facet {f} names a node the mesh lacks"),
-            )
-        })?;
-        if !x.iter().any(wanted) {
-            continue;
-        }
-        let samples = shape_samples(facet_type, &x, &rule)
-            .map_err(|e| ResultsError::file(path, format!("{object}: facet {f}: {e}")))?;
-        for (a, at, weight) in samples {
-            if wanted(&x[a]) {
-                out.push(crate::verify::NodalSample {
-                    node: x[a],
-                    at,
-                    weight,
-                });
-            }
-        }
-    }
+    let facets = ids
+        .chunks_exact(facet_type.nodes())
+        .enumerate()
+        .map(|(f, corners)| {
+            corners
+                .iter()
+                .map(position)
+                .collect::<Option<Vec<_>>>()
+                .ok_or_else(|| {
+                    ResultsError::file(
+                        path,
+                        format!("{object}: facet {f} names a node the mesh lacks"),
+                    )
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let out = crate::verify::facet_samples(facet_type, facets.iter().map(Vec::as_slice), wanted)
+        .map_err(|(f, e)| ResultsError::file(path, format!("{object}: facet {f}: {e}")))?;
     Ok(Some(out))
 }
 

@@ -5,8 +5,7 @@ use crate::contact::dual::norm;
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::contact::outcome::PairForce;
 use crate::error::Result;
-use crate::fem::{surface::shape_samples, QuadRule};
-use crate::verify::NodalSample;
+use crate::verify::{facet_samples, NodalSample};
 
 /// Point values for output, for this rank's slave points.
 pub struct PointValues {
@@ -70,28 +69,15 @@ impl ContactPair {
 
     /// Samples of the shape functions of the slave nodes `wanted` picks, over
     /// every facet of this rank that has one of them as a corner (reference
-    /// configuration, 3 × 3 cells of a Gauss rule per facet), so that a
-    /// reader can form ∫N_j p dA / ∫N_j dA of a closed-form pressure p: what
-    /// the nodal pressure of [`Self::node_values`] approximates
-    /// (verify::fit_nodal_averages). Each facet is on one rank only, so the
-    /// samples of all ranks together cover each node's support once.
+    /// configuration), so that a reader can form ∫N_j p dA / ∫N_j dA of a
+    /// closed-form pressure p: what the nodal pressure of
+    /// [`Self::node_values`] approximates (verify::fit_nodal_averages). Each
+    /// facet is on one rank only, so the samples of all ranks together
+    /// cover each node's support once. (The facets were checked when the
+    /// surface was built, so none fails here.)
     pub fn nodal_samples(&self, wanted: &dyn Fn(&[f64; 3]) -> bool) -> Vec<NodalSample> {
-        let rule = QuadRule::composite_for_facet(self.slave.facet_type, 3);
-        let mut out = Vec::new();
-        for facet in &self.slave.facets {
-            if !facet.x_ref.iter().any(wanted) {
-                continue;
-            }
-            // A facet that fails here was checked when the surface was built.
-            let samples = shape_samples(self.slave.facet_type, &facet.x_ref, &rule);
-            for (a, at, weight) in samples.unwrap_or_default() {
-                let node = facet.x_ref[a];
-                if wanted(&node) {
-                    out.push(NodalSample { node, at, weight });
-                }
-            }
-        }
-        out
+        let facets = self.slave.facets.iter().map(|f| f.x_ref.as_slice());
+        facet_samples(self.slave.facet_type, facets, wanted).unwrap_or_default()
     }
 
     /// Point values at the current state for output (pressure from the
