@@ -173,30 +173,35 @@ pub fn fit_nodal_averages(
 ) -> Option<(f64, f64)> {
     let (_, w0) = fit_profile(kind, points, pressure)?;
     let supports = fitted_supports(kind, points, pressure, samples)?;
-    let misfit = |w: f64| averaged_fit(&supports, w).1;
-    let (mut lo, mut hi) = (0.5 * w0, 1.5 * w0);
-    // Golden-section search: the misfit is unimodal in w near the answer.
+    let (lo, hi) = (0.5 * w0, 1.5 * w0);
+    let w = golden_minimum(|w| averaged_fit(&supports, w).1, lo, hi);
+    let p0 = averaged_fit(&supports, w).0;
+    // An answer on the edge of the searched range is no minimum.
+    let inside = w > lo * (1.0 + 1e-6) && w < hi * (1.0 - 1e-6);
+    (p0 > 0.0 && inside).then_some((p0, w))
+}
+
+/// The minimum of `f` on [lo, hi] by golden-section search (100 steps,
+/// more than f64 can resolve a smooth minimum to, about √ε of the range):
+/// the misfit is unimodal in w near the answer.
+fn golden_minimum(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut fa, mut fb) = (misfit(a), misfit(b));
+    let (mut fa, mut fb) = (f(a), f(b));
     for _ in 0..100 {
         if fa < fb {
             hi = b;
             (b, fb) = (a, fa);
             a = hi - g * (hi - lo);
-            fa = misfit(a);
+            fa = f(a);
         } else {
             lo = a;
             (a, fa) = (b, fb);
             b = lo + g * (hi - lo);
-            fb = misfit(b);
+            fb = f(b);
         }
     }
-    let w = 0.5 * (lo + hi);
-    let p0 = averaged_fit(&supports, w).0;
-    // An answer on the edge of the searched range is no minimum.
-    let inside = w > 0.5 * w0 * (1.0 + 1e-6) && w < 1.5 * w0 * (1.0 - 1e-6);
-    (p0 > 0.0 && inside).then_some((p0, w))
+    0.5 * (lo + hi)
 }
 
 /// Per fitted node: its value and its samples as (s², weight).
@@ -391,6 +396,15 @@ mod tests {
         );
         // Without samples for the fitted nodes there is no averaged fit.
         assert!(fit_nodal_averages(&kind, &points, &values, &samples[..10]).is_none());
+    }
+
+    #[test]
+    fn golden_minimum_finds_the_minimum_of_a_unimodal_function() {
+        // To about √ε of the range: closer, f's values no longer differ.
+        let w = golden_minimum(|x| (x - 0.73).powi(2) + 1.0, 0.1, 2.0);
+        assert!((w - 0.73).abs() < 1e-7, "{w}");
+        // A minimum outside the range ends on its edge.
+        assert!((golden_minimum(|x| x, 0.5, 1.5) - 0.5).abs() < 1e-9);
     }
 
     #[test]
