@@ -52,9 +52,10 @@ pub struct SolverSettings {
     /// stiffness once with a Schur complement on the contact DOFs and solve
     /// each contact Jacobian through it (see `solve::schur`).
     pub contact_schur: bool,
-    /// On the one-rank contact Schur path, Newton on the condensed contact
-    /// system (the same iterates; the interior formed once per step, see
-    /// `petsc::condensed`).
+    /// On the contact Schur path, Newton on the condensed contact system
+    /// (the same iterates; the interior formed once per step, see
+    /// `petsc::condensed` on one rank, `petsc::low_rank::condensed` on
+    /// several).
     pub condensed_newton: bool,
     /// Depth of the Anderson acceleration of the frictionless pairs'
     /// Uzawa multiplier updates (0: off; see `solve::anderson`); None: the

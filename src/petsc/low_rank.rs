@@ -28,14 +28,18 @@
 //! others are still in.
 pub(super) use super::shell::install;
 mod bulk;
+mod condensed;
 mod gather;
 mod inverse;
 mod sparse;
 mod update;
 use super::shell::{error, ShellState};
 use super::{comm_world, petsc_call, sys, LogStage, Matrix, PetscInt, Result, Vector};
+pub use condensed::Reduced;
 use gather::gather_sorted;
 use sparse::Sparse;
+use std::cell::RefCell;
+use std::rc::Rc;
 
 /// Collective: true on every rank if the flag is true on any (the caller's
 /// parallel module provides it).
@@ -65,6 +69,38 @@ impl Drop for OwnedMat {
         unsafe {
             sys::MatDestroy(&mut self.0);
         }
+    }
+}
+
+/// A scatter released when it goes out of scope.
+struct OwnedScatter(sys::VecScatter);
+
+impl OwnedScatter {
+    /// Another reference to `s` (released by this one's drop).
+    fn reference(s: sys::VecScatter) -> Result<Self> {
+        // SAFETY: a valid scatter; the reference taken here is released
+        // once, in `drop`.
+        unsafe { petsc_call!(PetscObjectReference(s as sys::PetscObject))? };
+        Ok(OwnedScatter(s))
+    }
+}
+
+impl Drop for OwnedScatter {
+    fn drop(&mut self) {
+        // SAFETY: this handle's reference, released once.
+        unsafe {
+            sys::VecScatterDestroy(&mut self.0);
+        }
+    }
+}
+
+/// A sequential vector of `n` entries on this rank.
+fn seq_vector(n: usize) -> Result<Vector> {
+    let mut v: sys::Vec = std::ptr::null_mut();
+    // SAFETY: the new vector goes to an owning wrapper at once.
+    unsafe {
+        petsc_call!(VecCreateSeq(self_comm(), super::to_petsc_int(n)?, &mut v))?;
+        Ok(Vector::owned_from_raw(v))
     }
 }
 
@@ -106,6 +142,9 @@ pub struct LowRankPreconditioner {
     m: OwnedMat,
     m_rhs: Option<Vector>,
     m_sol: Option<Vector>,
+    /// Newton on the condensed system (`condensed`), shared with the
+    /// residual; None: every solve is a whole one.
+    reduced: Option<Rc<RefCell<Reduced>>>,
     /// `-log_view` stages of G's columns and of the dense set-ups.
     stages: [LogStage; 2],
     /// Sparse factorisations of K (one per run).
@@ -116,6 +155,14 @@ pub struct LowRankPreconditioner {
     pub inverse_columns: usize,
     /// Dense LU factorisations of M (one per set-up).
     pub dense_factorisations: usize,
+    /// Solves with K's factor (two per whole application; with the condensed
+    /// Newton one per step start and end, and one per widened column of
+    /// G), and the condensed Newton's dense steps.
+    pub sparse_solves: usize,
+    pub dense_steps: usize,
+    /// Of G's columns, those from whole solves (the same on every rank,
+    /// unlike `inverse_columns`, which is rank 0's).
+    pub solved_columns: usize,
     /// Times C had to grow.
     pub growths: usize,
     /// This rank's CPU seconds in forming G (all of them) and in the
@@ -174,6 +221,7 @@ impl LowRankPreconditioner {
             m: OwnedMat(std::ptr::null_mut()),
             m_rhs: None,
             m_sol: None,
+            reduced: None,
             stages: [
                 LogStage::register("low-rank G")?,
                 LogStage::register("low-rank dense")?,
@@ -182,6 +230,9 @@ impl LowRankPreconditioner {
             inverse_blocks: 0,
             inverse_columns: 0,
             dense_factorisations: 0,
+            sparse_solves: 0,
+            dense_steps: 0,
+            solved_columns: 0,
             growths: 0,
             inverse_cpu_seconds: 0.0,
             dense_cpu_seconds: 0.0,
@@ -211,6 +262,17 @@ impl LowRankPreconditioner {
         self.failed = None;
         let grow = self.c.is_empty() || !is_subset(&self.wanted, &self.c);
         if (self.any_rank)(grow) {
+            if self
+                .reduced
+                .as_ref()
+                .is_some_and(|r| r.borrow().is_active())
+            {
+                // The condensed state is in the old C's positions: a failed
+                // set-up (a cutback), and the step's retry grows C before
+                // its condensed Newton starts.
+                self.failed = Some("the contact DOFs grew inside a condensed Newton step".into());
+                return Ok(());
+            }
             if !self.c.is_empty() {
                 self.growths += 1;
             }
@@ -233,8 +295,14 @@ impl LowRankPreconditioner {
         self.d = d.shifted(&self.shift_c);
         self.u = self.d.touched();
         let t0 = cpu_seconds();
-        g_stage.scope(|| self.complete_inverse())?;
+        let grew = g_stage.scope(|| self.complete_inverse())?;
         self.inverse_cpu_seconds += cpu_seconds() - t0;
+        if let (true, Some(r)) = (grew, self.reduced.clone()) {
+            self.refresh_window(&mut r.borrow_mut().window)?;
+            if self.failed.is_some() {
+                return Ok(());
+            }
+        }
         let t0 = cpu_seconds();
         let local = dense_stage.scope(|| match self.root {
             true => self.factor_dense(),
@@ -285,6 +353,9 @@ impl LowRankPreconditioner {
         self.c = c;
         self.g = vec![0.0; if self.root { n * n } else { 0 }];
         self.known = vec![false; here];
+        if let Some(r) = &self.reduced {
+            r.borrow_mut().window = condensed::Window::default();
+        }
         self.ensure_work_vectors()?;
         let z = self
             .z
@@ -352,6 +423,15 @@ impl LowRankPreconditioner {
             // As MatSolve does with a failed MUMPS factor.
             return x.set_all(f64::INFINITY);
         }
+        if let Some(r) = self.reduced.clone() {
+            let armed = {
+                let r = r.borrow();
+                r.is_active() || r.awaits_first_solve()
+            };
+            if armed {
+                return self.condensed_apply(&r, b, x);
+            }
+        }
         let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
             return Err(error(
                 "LowRankPreconditioner::apply",
@@ -360,6 +440,7 @@ impl LowRankPreconditioner {
         };
         // SAFETY: valid factor and vectors of its size (PETSc checks).
         unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
+        self.sparse_solves += 1;
         scatter(self.pick, z.raw(), small.raw(), false)?;
         let update = update::Update {
             d: &self.d,
@@ -383,6 +464,7 @@ impl LowRankPreconditioner {
         small.scale(-1.0)?;
         t.copy_from(b)?;
         scatter(self.pick, small.raw(), t.raw(), true)?;
+        self.sparse_solves += 1;
         // SAFETY: as above.
         unsafe { petsc_call!(MatSolve(self.factor, t.raw(), x.raw())) }
     }

@@ -167,7 +167,7 @@ impl<'m> Simulation<'m> {
                 schur::install(&mut snes, k, mech.dirichlet, tangent, rt.size())?;
                 mech.always_rebuild = true;
                 if model.solver.condensed_newton {
-                    mech.condensed = snes.schur_mut().map(|s| s.condense());
+                    mech.condensed = schur::condensed_state(&mut snes);
                 }
             }
         }

@@ -12,13 +12,11 @@ use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::parallel::{self, fault, fault::FaultPhase};
-use crate::petsc::condensed::Condensation;
+use crate::petsc::condensed::Condensed;
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Vector};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::Communicator;
-use std::cell::RefCell;
-use std::rc::Rc;
 
 /// Everything the residual and Jacobian need, plus the work vectors that hold
 /// the ghosted state between callbacks.
@@ -48,10 +46,10 @@ pub struct Mechanics<'a> {
     /// tangent: K is in the preconditioner's factor, and nothing else
     /// reads the operator (the linear solve is the preconditioner alone).
     pub always_rebuild: bool,
-    /// Newton on the condensed contact system (the Schur path's; see
-    /// `petsc::condensed`): while its step is active the SNES vector is the
-    /// condensed one and so is the residual.
-    pub condensed: Option<Rc<RefCell<Condensation>>>,
+    /// Newton on the condensed contact system (the Schur paths'; see
+    /// `petsc::condensed` and `petsc::low_rank`): while its step is active
+    /// the SNES vector is the condensed one and so is the residual.
+    pub condensed: Option<Condensed>,
     stages: Stages,
     /// The callbacks agree their outcome over these ranks (PETSc's world).
     world: SimpleCommunicator,
@@ -348,7 +346,7 @@ impl<'a> Mechanics<'a> {
     fn residual_impl(&mut self, x: &Vector, r: &mut Vector) -> Result<()> {
         self.residual_evaluations += 1;
         if let Some(c) = self.condensed.clone() {
-            if c.borrow().is_active() {
+            if c.is_active() {
                 return self.condensed_residual(&c, x, r);
             }
         }
@@ -359,65 +357,66 @@ impl<'a> Mechanics<'a> {
         local
     }
 
-    /// The residual at the condensed vector `x` (one rank): the contact
-    /// residual assembled as in [`Self::bulk_residual`], the rest from the
-    /// condensed state (a dense product with S0 where the whole vector
-    /// needs one with K).
-    fn condensed_residual(
-        &mut self,
-        c: &RefCell<Condensation>,
-        x: &Vector,
-        r: &mut Vector,
-    ) -> Result<()> {
-        let base = c.borrow().base_wanted().map(|x0| -> Result<Vector> {
-            let mut copy = x0.duplicate()?;
-            copy.copy_from(x0)?;
-            Ok(copy)
-        });
-        if let Some(x0) = base {
+    /// The residual at the condensed vector `x`: the contact residual
+    /// assembled as in [`Self::bulk_residual`], the rest from the
+    /// condensed state (dense work on C where the whole vector needs a
+    /// product with K). Collective.
+    fn condensed_residual(&mut self, c: &Condensed, x: &Vector, r: &mut Vector) -> Result<()> {
+        if let Some(x0) = c.base_wanted() {
             let x0 = x0?;
             let mut rc0 = x0.duplicate()?;
             // Not a residual of its own: no fault visit.
-            self.contact_residual(&x0, &mut rc0, false)?;
-            c.borrow_mut().set_base_contact(&rc0)?;
+            let local = self.contact_residual(&x0, &mut rc0, false);
+            c.set_base_contact(&rc0)?;
+            local?;
         }
         let (stages, times) = (self.stages, &mut self.times);
-        stages.time(Phase::BulkAssembly, times, || {
+        let bulk = stages.time(Phase::BulkAssembly, times, || {
             fault::check(FaultPhase::BulkResidual)
-        })?;
+        });
         let mut rc = x.duplicate()?;
-        self.contact_residual(x, &mut rc, true)?;
+        let contact = self.contact_residual(x, &mut rc, true);
         let (stages, times) = (self.stages, &mut self.times);
-        stages.time(Phase::BulkAssembly, times, || {
-            c.borrow().residual(x, &rc, r)
-        })?;
+        let condensed = stages.time(Phase::BulkAssembly, times, || c.residual(x, &rc, r));
+        bulk.and(contact).and(condensed.map_err(Into::into))?;
         r.with_array(|a| first_nonfinite(a, "residual"))?
     }
 
-    /// The contact pairs' residual alone at `x` (one rank, no held master
-    /// tail: the Schur path's); `faults`: a visit of the contact-assembly
-    /// fault phase.
+    /// The contact pairs' residual alone at `x`, summed over the ranks
+    /// (held master nodes a rank does not see go to their owners);
+    /// `faults`: a visit of the contact-assembly fault phase. Collective:
+    /// a local failure is returned after the sums.
     fn contact_residual(&mut self, x: &Vector, out: &mut Vector, faults: bool) -> Result<()> {
         self.load_state(x)?;
         let (dofs, factor) = (self.dofs, self.factor);
-        let (u, contact) = (&self.u, &mut *self.contact);
+        let (u, u_tail, contact) = (&self.u, &self.u_tail, &mut *self.contact);
+        let mut r_tail = vec![0.0; u_tail.len()];
         let (stages, times) = (self.stages, &mut self.times);
-        stages.time(Phase::ContactAssembly, times, || {
+        let local = stages.time(Phase::ContactAssembly, times, || {
             self.r.with_local_mut(|r_local| -> Result<()> {
                 r_local.fill(0.0);
                 u.with_local(|u_local| -> Result<()> {
                     if faults {
                         fault::check(FaultPhase::ContactAssembly)?;
                     }
+                    let u_ext = extended(u_local, u_tail);
+                    let mut r_ext = extended(r_local, &r_tail);
                     for pair in contact.iter_mut() {
-                        pair.add_residual(dofs, u_local, factor, r_local)?;
+                        pair.add_residual(dofs, &u_ext, factor, &mut r_ext)?;
                     }
+                    let n = r_local.len();
+                    r_local.copy_from_slice(&r_ext[..n]);
+                    r_tail.copy_from_slice(&r_ext[n..]);
                     Ok(())
                 })?
             })?
-        })?;
+        });
+        let r = &mut self.r;
+        stages.time(Phase::HaloExchange, times, || r.accumulate_ghosts())?;
         out.copy_from(self.r.global())?;
-        Ok(())
+        let tail = &self.tail;
+        stages.time(Phase::HaloExchange, times, || tail.add_into(&r_tail, out))?;
+        local
     }
 
     /// The Jacobian at `x`. Collective, and like [`Self::raw_residual`] never

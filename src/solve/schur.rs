@@ -23,9 +23,10 @@ use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
 use crate::model::Model;
 use crate::parallel;
+use crate::petsc::condensed::Condensed;
 use crate::petsc::low_rank::LowRankPreconditioner;
 use crate::petsc::schur::SchurPreconditioner;
-use crate::petsc::{Matrix, PetscInt, Snes};
+use crate::petsc::{Matrix, PetscInt, Snes, Vector};
 
 /// What the run's report says of the Schur path.
 #[derive(Debug, Clone, Copy, Default)]
@@ -43,9 +44,10 @@ pub struct SchurSummary {
     pub trailing_factorisations: usize,
     pub largest_trailing: usize,
     pub leading_factorisations: usize,
-    /// One rank: solves with the sparse factor (condensation and
-    /// expansion), and with the dense Schur complement alone (the
-    /// condensed Newton steps).
+    /// Solves with the sparse factor (one rank: condensation and
+    /// expansion; several: see `LowRankPreconditioner::sparse_solves`), and
+    /// the condensed Newton steps (one rank: with the dense Schur
+    /// complement alone; several: dense work on rank 0).
     pub sparse_solves: usize,
     pub dense_solves: usize,
     /// Several ranks: K's factor with a low-rank update (`schur_factorisations`
@@ -54,6 +56,8 @@ pub struct SchurSummary {
     pub low_rank: bool,
     pub inverse_blocks: usize,
     pub inverse_columns: usize,
+    /// Of them, those from whole solves (every rank's count).
+    pub solved_columns: usize,
     /// Low-rank path, rank 0's CPU seconds: forming G, and the dense
     /// set-ups (D gathered, M formed and factored).
     pub inverse_cpu_seconds: f64,
@@ -110,6 +114,56 @@ pub(super) fn install(
     let pc = SchurPreconditioner::new(k.share()?, dirichlet.global_rows(), tangent.symmetric);
     snes.install_schur(pc)?;
     Ok(())
+}
+
+/// Whether Newton may run on the condensed contact system: a Schur path
+/// (one rank or several) is installed.
+pub(super) fn condenses(snes: &Snes) -> bool {
+    snes.schur().is_some() || snes.low_rank().is_some()
+}
+
+/// A load step starts at `x0` (condensed Newton only; see
+/// `petsc::condensed` and `petsc::low_rank`).
+pub(super) fn arm(snes: &mut Snes, x0: &Vector) -> Result<()> {
+    if let Some(s) = snes.schur_mut() {
+        s.arm(x0)?;
+    }
+    if let Some(s) = snes.low_rank_mut() {
+        s.arm(x0)?;
+    }
+    Ok(())
+}
+
+/// The step converged: its condensed vector `x` becomes the whole state.
+/// Collective.
+pub(super) fn expand(snes: &mut Snes, x: &mut Vector) -> Result<()> {
+    if let Some(s) = snes.schur_mut() {
+        s.expand(x)?;
+    }
+    if let Some(s) = snes.low_rank_mut() {
+        s.expand(x)?;
+    }
+    Ok(())
+}
+
+/// The step ended: its condensed state is dropped.
+pub(super) fn disarm(snes: &mut Snes) {
+    if let Some(s) = snes.schur_mut() {
+        s.disarm();
+    }
+    if let Some(s) = snes.low_rank_mut() {
+        s.disarm();
+    }
+}
+
+/// The condensed Newton state the residual reads, when the run's Schur
+/// path condenses.
+pub(super) fn condensed_state(snes: &mut Snes) -> Option<Condensed> {
+    if let Some(s) = snes.schur_mut() {
+        return Some(Condensed::One(s.condense()));
+    }
+    snes.low_rank_mut()
+        .map(|s| Condensed::Several(s.condense()))
 }
 
 /// Records the DOFs a square pattern block touches.
@@ -237,6 +291,9 @@ pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
         inverse_columns: s.inverse_columns,
         inverse_cpu_seconds: s.inverse_cpu_seconds,
         dense_cpu_seconds: s.dense_cpu_seconds,
+        sparse_solves: s.sparse_solves,
+        dense_solves: s.dense_steps,
+        solved_columns: s.solved_columns,
         ..SchurSummary::default()
     });
     snes.schur()

@@ -11,6 +11,7 @@ use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
 use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
+use super::schur;
 use super::tolerance;
 use crate::contact::{ContactPair, UzawaStats};
 use crate::error::Result;
@@ -80,11 +81,9 @@ pub(super) fn uzawa_loop(
         ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
     // The condensed Newton iterates are the whole vector's only with no
     // step-length test (stol compares norms of the whole x and step).
-    let condensed = stol == 0.0 && ctx.snes.schur().is_some();
+    let condensed = stol == 0.0 && schur::condenses(ctx.snes);
     if condensed {
-        if let Some(s) = ctx.snes.schur_mut() {
-            s.arm(ctx.x)?;
-        }
+        schur::arm(ctx.snes, ctx.x)?;
     }
     let mut result = uzawa_rounds(
         world,
@@ -95,17 +94,17 @@ pub(super) fn uzawa_loop(
         (stol, max_it, condensed),
         (&mut softened, &mut main_part),
     );
-    if let Some(s) = ctx.snes.schur_mut() {
+    if schur::condenses(ctx.snes) {
         // The converged step's interior, formed once (a failed one is
         // dropped: the step starts again from the last converged state; an
         // uncovered one goes on from this state).
         if matches!(result, Ok(Ok(_) | Err(StepFailure::Uncovered { .. }))) {
-            let expanded = s.expand(ctx.x);
+            let expanded = schur::expand(ctx.snes, ctx.x);
             if let Err(e) = expanded {
-                result = Err(e.into());
+                result = Err(e);
             }
         }
-        s.disarm();
+        schur::disarm(ctx.snes);
     }
     if condensed {
         // The condensed iterates hold the true state on the contact DOFs

@@ -11,26 +11,48 @@ use super::{LowRankPreconditioner, OwnedMat};
 /// memory (455 MiB).
 const INVERSE_BLOCK: PetscInt = 1024;
 
+/// Up to this many columns of G at every row of C come from whole solves
+/// with K's factor: MUMPS's selected inverse is slow on few columns at many
+/// rows (hertz-cylinder h = 0.2, 2 ranks, 972 rows: one column 1.5 s, seven
+/// 0.24 s, against 2 ms for one whole solve).
+const WHOLE_SOLVES: usize = 32;
+
 impl LowRankPreconditioner {
-    /// G valid on U × U: the columns of U not yet known, at the rows of
-    /// every known position and theirs; K being symmetric, G is too, so
-    /// the same entries fill the new rows of the known columns. Rank 0
-    /// decides whether any column is new, agreed. Collective.
-    pub(super) fn complete_inverse(&mut self) -> Result<()> {
+    /// G valid on U × U: the columns of U not yet known. Rank 0 decides
+    /// whether any column is new, agreed; whether any was. Collective.
+    pub(super) fn complete_inverse(&mut self) -> Result<bool> {
         let new: Vec<usize> = match self.root {
             true => self.u.iter().copied().filter(|&i| !self.known[i]).collect(),
             false => Vec::new(),
         };
         if !(self.any_rank)(!new.is_empty()) {
-            return Ok(());
+            return Ok(false);
         }
-        for &i in &new {
+        self.request_columns(&new)?;
+        Ok(true)
+    }
+
+    /// G's columns at the positions `new` (rank 0's; some on every rank's
+    /// word): at the rows of every known position and theirs, or at every
+    /// row of C for the condensed Newton; K being symmetric, G is too, so
+    /// the same entries fill the new rows of the known columns.
+    /// Collective.
+    pub(super) fn request_columns(&mut self, new: &[usize]) -> Result<()> {
+        for &i in new {
             if let Some(k) = self.known.get_mut(i) {
                 *k = true;
             }
         }
-        let rows: Vec<usize> = (0..self.known.len()).filter(|&i| self.known[i]).collect();
-        self.inverse_entries(&new, &rows)?;
+        let every_row = self.reduced.is_some();
+        let many = (self.any_rank)(new.len() > WHOLE_SOLVES);
+        if every_row && !many {
+            self.solved_columns(new)?;
+        } else {
+            let rows: Vec<usize> = (0..self.known.len())
+                .filter(|&i| every_row || self.known[i])
+                .collect();
+            self.inverse_entries(new, &rows)?;
+        }
         self.inverse_blocks += 1;
         self.inverse_columns += new.len();
         Ok(())
@@ -123,6 +145,42 @@ impl LowRankPreconditioner {
             ));
         }
         Ok(())
+    }
+
+    /// G's columns `new` (rank 0's) at every row of C, one whole solve
+    /// K⁻¹ e each; by symmetry also G's rows `new`. Collective: the ranks
+    /// go on while rank 0 has a column left.
+    fn solved_columns(&mut self, new: &[usize]) -> Result<()> {
+        let n = self.c.len();
+        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
+            return Err(error("G's columns", "no work vectors".into()));
+        };
+        let mut next = new.iter();
+        loop {
+            let col = next.next().copied();
+            if !(self.any_rank)(col.is_some()) {
+                return Ok(());
+            }
+            t.set_all(0.0)?;
+            small.with_array_mut(|a| {
+                a.iter_mut().for_each(|v| *v = 0.0);
+                if let Some(j) = col {
+                    a[j] = 1.0;
+                }
+            })?;
+            super::scatter(self.pick, small.raw(), t.raw(), true)?;
+            // SAFETY: valid factor and vectors of its size (PETSc checks).
+            unsafe { petsc_call!(MatSolve(self.factor, t.raw(), z.raw()))? };
+            self.sparse_solves += 1;
+            self.solved_columns += 1;
+            let values = super::at_c(self.pick, z, small)?;
+            if let Some(j) = col {
+                for (r, &v) in values.iter().enumerate() {
+                    self.g[j * n + r] = v;
+                    self.g[r * n + j] = v;
+                }
+            }
+        }
     }
 
     /// MUMPS's blocking of right-hand sides (ICNTL(27)) for a request:
