@@ -529,7 +529,7 @@ impl LowRankPreconditioner {
         if !(self.any_rank)(!new.is_empty()) {
             return Ok(false);
         }
-        self.request_columns(new)?;
+        self.request_columns(new, true)?;
         Ok(true)
     }
 

@@ -11,10 +11,12 @@ use super::{LowRankPreconditioner, OwnedMat};
 /// memory (455 MiB).
 const INVERSE_BLOCK: PetscInt = 1024;
 
-/// Up to this many columns of G at every row of C come from whole solves
-/// with K's factor: MUMPS's selected inverse is slow on few columns at many
-/// rows (hertz-cylinder h = 0.2, 2 ranks, 972 rows: one column 1.5 s, seven
-/// 0.24 s, against 2 ms for one whole solve).
+/// Up to this many columns of G that a condensed Newton step finds missing
+/// come from whole solves with K's factor: there MUMPS's selected inverse
+/// was slow (hertz-cylinder h = 0.2, 2 ranks, all 972 rows of C: one column
+/// 1.5 s, seven 0.24 s, against 0.016 and 0.088 s by whole solves), while
+/// on the set-up's requests it is the faster (line b/5, 2 ranks, 52 columns
+/// at 366 rows in two requests: 0.02 CPU s against 0.14 s by whole solves).
 const WHOLE_SOLVES: usize = 32;
 
 impl LowRankPreconditioner {
@@ -28,16 +30,17 @@ impl LowRankPreconditioner {
         if !(self.any_rank)(!new.is_empty()) {
             return Ok(false);
         }
-        self.request_columns(&new)?;
+        self.request_columns(&new, false)?;
         Ok(true)
     }
 
     /// G's columns at the positions `new` (rank 0's; some on every rank's
     /// word): at the rows of every known position and theirs, or at every
     /// row of C for the condensed Newton; K being symmetric, G is too, so
-    /// the same entries fill the new rows of the known columns.
-    /// Collective.
-    pub(super) fn request_columns(&mut self, new: &[usize]) -> Result<()> {
+    /// the same entries fill the new rows of the known columns. A
+    /// condensed Newton step's few new columns (`in_step`) come from whole
+    /// solves (see [`WHOLE_SOLVES`]). Collective.
+    pub(super) fn request_columns(&mut self, new: &[usize], in_step: bool) -> Result<()> {
         for &i in new {
             if let Some(k) = self.known.get_mut(i) {
                 *k = true;
@@ -45,7 +48,7 @@ impl LowRankPreconditioner {
         }
         let every_row = self.reduced.is_some();
         let many = (self.any_rank)(new.len() > WHOLE_SOLVES);
-        if every_row && !many {
+        if every_row && in_step && !many {
             self.solved_columns(new)?;
         } else {
             let rows: Vec<usize> = (0..self.known.len())
