@@ -546,3 +546,53 @@ impl LowRankPreconditioner {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// G column-major n × n from a row-major listing.
+    fn column_major(rows: &[&[f64]]) -> Vec<f64> {
+        let n = rows.len();
+        (0..n * n).map(|k| rows[k % n][k / n]).collect()
+    }
+
+    #[test]
+    fn the_window_recovers_forces_from_g_ww() {
+        // W = {0, 2} of a 3 × 3 G: G_WW = [[4, 1], [1, 3]].
+        let g = column_major(&[&[4.0, 9.0, 1.0], &[9.0, 7.0, 9.0], &[1.0, 9.0, 3.0]]);
+        let w = Window::new(vec![0, 2], &g, 3).unwrap();
+        let s = w.solve(vec![4.0 * 2.0 + 1.0 * -1.0, 2.0 - 3.0]).unwrap();
+        assert!(
+            (s[0] - 2.0).abs() < 1e-14 && (s[1] + 1.0).abs() < 1e-14,
+            "{s:?}"
+        );
+    }
+
+    #[test]
+    fn an_indefinite_g_ww_falls_back_to_lu_and_a_singular_one_is_an_error() {
+        let g = column_major(&[&[1.0, 2.0], &[2.0, 1.0]]);
+        let w = Window::new(vec![0, 1], &g, 2).unwrap();
+        let s = w.solve(vec![3.0, 3.0]).unwrap();
+        assert!(
+            (s[0] - 1.0).abs() < 1e-14 && (s[1] - 1.0).abs() < 1e-14,
+            "{s:?}"
+        );
+        let singular = column_major(&[&[1.0, 1.0], &[1.0, 1.0]]);
+        let e = Window::new(vec![0, 1], &singular, 2).err().unwrap();
+        assert!(e.to_string().contains("singular"), "{e}");
+    }
+
+    #[test]
+    fn an_empty_window_gives_no_forces() {
+        assert!(Window::default().solve(Vec::new()).unwrap().is_empty());
+    }
+
+    #[test]
+    fn outside_lists_the_loaded_free_unknown_positions() {
+        let v = [0.0, 1.0, 2.0, 3.0, -1.0];
+        let fixed = [false, false, true, false, false];
+        let known = [false, true, false, false, false];
+        assert_eq!(outside(&v, &fixed, &known), vec![3, 4]);
+    }
+}
