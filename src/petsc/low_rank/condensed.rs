@@ -562,7 +562,8 @@ mod tests {
         // W = {0, 2} of a 3 × 3 G: G_WW = [[4, 1], [1, 3]].
         let g = column_major(&[&[4.0, 9.0, 1.0], &[9.0, 7.0, 9.0], &[1.0, 9.0, 3.0]]);
         let w = Window::new(vec![0, 2], &g, 3).unwrap();
-        let s = w.solve(vec![4.0 * 2.0 + 1.0 * -1.0, 2.0 - 3.0]).unwrap();
+        // G_WW (2, −1) = (7, −1).
+        let s = w.solve(vec![7.0, -1.0]).unwrap();
         assert!(
             (s[0] - 2.0).abs() < 1e-14 && (s[1] + 1.0).abs() < 1e-14,
             "{s:?}"
