@@ -2,6 +2,7 @@
 //! rest of the program uses. This is the only place with `unsafe` besides MPI
 //! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
 pub mod condensed;
+pub mod condensed_state;
 pub mod dense;
 pub mod heap;
 pub mod log;

@@ -12,7 +12,7 @@ use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::parallel::{self, fault, fault::FaultPhase};
-use crate::petsc::condensed::Condensed;
+use crate::petsc::condensed_state::Condensed;
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Vector};
 use mpi::topology::SimpleCommunicator;

@@ -23,7 +23,7 @@ use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
 use crate::model::Model;
 use crate::parallel;
-use crate::petsc::condensed::Condensed;
+use crate::petsc::condensed_state::Condensed;
 use crate::petsc::low_rank::LowRankPreconditioner;
 use crate::petsc::schur::SchurPreconditioner;
 use crate::petsc::{Matrix, PetscInt, Snes, Vector};
