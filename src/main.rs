@@ -256,7 +256,7 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                 if let Some(s) = r.schur.as_ref().filter(|s| s.low_rank) {
                     let linear: usize = r.steps.iter().map(|s| s.linear_iterations).sum();
                     println!(
-                        "  solver: {} Uzawa iterations, {} linear iterations, contact low-rank update on {} DOFs (MUMPS, {} ranks): bulk stiffness factored {} time(s), {} columns of G = PᵀK⁻¹P in {} request(s) (C grew {} time(s); {:.2} CPU s on rank 0), I + D·G factored {} time(s) ({:.2} CPU s on rank 0); {} solve(s) with K's factor, {} condensed Newton step(s)",
+                        "  solver: {} Uzawa iterations, {} linear iterations, contact low-rank update on {} DOFs (MUMPS, {} ranks): bulk stiffness factored {} time(s), {} columns of G = PᵀK⁻¹P in {} request(s) (C grew {} time(s); {:.2} CPU s on rank 0), I + D·G factored {} time(s) ({:.2} CPU s on rank 0); {} solve(s) with K's factor, {} condensed Newton step(s); G's entries probed by {} whole solve(s), {} request(s) redone by whole solves",
                         r.steps.iter().map(|s| s.uzawa_iterations).sum::<usize>(),
                         linear,
                         s.dofs,
@@ -269,7 +269,9 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
                         s.schur_factorisations,
                         s.dense_cpu_seconds,
                         s.sparse_solves,
-                        s.dense_solves
+                        s.dense_solves,
+                        s.probe_solves,
+                        s.inverse_redone
                     );
                 }
                 if let Some(s) = r.schur.as_ref().filter(|s| !s.low_rank) {

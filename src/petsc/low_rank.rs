@@ -163,6 +163,11 @@ pub struct LowRankPreconditioner {
     /// Of G's columns, those from whole solves (the same on every rank,
     /// unlike `inverse_columns`, which is rank 0's).
     pub solved_columns: usize,
+    /// Whole solves that probed the selected inverse's entries, and the
+    /// requests whose entries failed the probe and were redone by whole
+    /// solves.
+    pub probe_solves: usize,
+    pub inverse_redone: usize,
     /// Times C had to grow.
     pub growths: usize,
     /// This rank's CPU seconds in forming G (all of them) and in the
@@ -233,6 +238,8 @@ impl LowRankPreconditioner {
             sparse_solves: 0,
             dense_steps: 0,
             solved_columns: 0,
+            probe_solves: 0,
+            inverse_redone: 0,
             growths: 0,
             inverse_cpu_seconds: 0.0,
             dense_cpu_seconds: 0.0,

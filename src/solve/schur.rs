@@ -56,8 +56,12 @@ pub struct SchurSummary {
     pub low_rank: bool,
     pub inverse_blocks: usize,
     pub inverse_columns: usize,
-    /// Of them, those from whole solves (every rank's count).
+    /// Of them, those from whole solves (every rank's count); whole solves
+    /// that probed the selected inverse, and requests redone because its
+    /// entries failed the probe.
     pub solved_columns: usize,
+    pub probe_solves: usize,
+    pub inverse_redone: usize,
     /// Low-rank path, rank 0's CPU seconds: forming G, and the dense
     /// set-ups (D gathered, M formed and factored).
     pub inverse_cpu_seconds: f64,
@@ -294,6 +298,8 @@ pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
         sparse_solves: s.sparse_solves,
         dense_solves: s.dense_steps,
         solved_columns: s.solved_columns,
+        probe_solves: s.probe_solves,
+        inverse_redone: s.inverse_redone,
         ..SchurSummary::default()
     });
     snes.schur()

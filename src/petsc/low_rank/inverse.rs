@@ -19,6 +19,11 @@ const INVERSE_BLOCK: PetscInt = 1024;
 /// at 366 rows in two requests: 0.02 CPU s against 0.14 s by whole solves).
 const WHOLE_SOLVES: usize = 32;
 
+/// The selected inverse's entries must match a whole solve to this
+/// fraction of the column's largest entry (both are the same factor's;
+/// they differ by rounding, 1e-15 or so, when right).
+const PROBE_TOLERANCE: f64 = 1e-8;
+
 impl LowRankPreconditioner {
     /// G valid on U × U: the columns of U not yet known. Rank 0 decides
     /// whether any column is new, agreed; whether any was. Collective.
@@ -55,6 +60,10 @@ impl LowRankPreconditioner {
                 .filter(|&i| every_row || self.known[i])
                 .collect();
             self.inverse_entries(new, &rows)?;
+            if !self.entries_pass_probe(new, &rows)? {
+                self.inverse_redone += 1;
+                self.solved_columns(new)?;
+            }
         }
         self.inverse_blocks += 1;
         self.inverse_columns += new.len();
@@ -155,28 +164,15 @@ impl LowRankPreconditioner {
     /// go on while rank 0 has a column left.
     fn solved_columns(&mut self, new: &[usize]) -> Result<()> {
         let n = self.c.len();
-        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
-            return Err(error("G's columns", "no work vectors".into()));
-        };
         let mut next = new.iter();
         loop {
             let col = next.next().copied();
             if !(self.any_rank)(col.is_some()) {
                 return Ok(());
             }
-            t.set_all(0.0)?;
-            small.with_array_mut(|a| {
-                a.iter_mut().for_each(|v| *v = 0.0);
-                if let Some(j) = col {
-                    a[j] = 1.0;
-                }
-            })?;
-            super::scatter(self.pick, small.raw(), t.raw(), true)?;
-            // SAFETY: valid factor and vectors of its size (PETSc checks).
-            unsafe { petsc_call!(MatSolve(self.factor, t.raw(), z.raw()))? };
+            let values = self.whole_column(col)?;
             self.sparse_solves += 1;
             self.solved_columns += 1;
-            let values = super::at_c(self.pick, z, small)?;
             if let Some(j) = col {
                 for (r, &v) in values.iter().enumerate() {
                     self.g[j * n + r] = v;
@@ -184,6 +180,53 @@ impl LowRankPreconditioner {
                 }
             }
         }
+    }
+
+    /// K'⁻¹ e_j at C's positions (rank 0's `col`; None elsewhere, and the
+    /// result empty there). Collective.
+    fn whole_column(&mut self, col: Option<usize>) -> Result<Vec<f64>> {
+        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
+            return Err(error("G's columns", "no work vectors".into()));
+        };
+        t.set_all(0.0)?;
+        small.with_array_mut(|a| {
+            a.iter_mut().for_each(|v| *v = 0.0);
+            if let Some(j) = col {
+                a[j] = 1.0;
+            }
+        })?;
+        super::scatter(self.pick, small.raw(), t.raw(), true)?;
+        // SAFETY: valid factor and vectors of its size (PETSc checks).
+        unsafe { petsc_call!(MatSolve(self.factor, t.raw(), z.raw()))? };
+        super::at_c(self.pick, z, small)
+    }
+
+    /// Whether the selected inverse's columns `new` (at `rows`) agree with
+    /// whole solves of the first and the last of them, to [`PROBE_TOLERANCE`]
+    /// of the column's largest entry. On the Hertz sphere at 80k DOFs on 2
+    /// ranks (`fine_size` 0.42) MUMPS's entries were wrong (every Newton
+    /// iteration after the second diverged; whole solves converged in 18),
+    /// so every request is probed. Agreed. Collective.
+    fn entries_pass_probe(&mut self, new: &[usize], rows: &[usize]) -> Result<bool> {
+        let n = self.c.len();
+        let probes = [new.first().copied(), new.last().copied()];
+        let mut bad = false;
+        for col in probes {
+            let values = self.whole_column(col)?;
+            self.probe_solves += 1;
+            if let Some(j) = col {
+                let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let off = rows
+                    .iter()
+                    .map(|&r| (self.g[j * n + r] - values[r]).abs())
+                    .fold(0.0f64, f64::max);
+                // f64::max drops NaN: non-finite entries are their own test.
+                let finite = values.iter().all(|v| v.is_finite())
+                    && rows.iter().all(|&r| self.g[j * n + r].is_finite());
+                bad |= !finite || off > PROBE_TOLERANCE * scale;
+            }
+        }
+        Ok(!(self.any_rank)(bad))
     }
 
     /// MUMPS's blocking of right-hand sides (ICNTL(27)) for a request:
