@@ -80,6 +80,10 @@ const CASES: &[Case] = &[
         low_rank::the_contact_schur_path_matches_the_full_factorisation,
     ),
     (
+        "the_fine_sphere_solves_on_the_direct_low_rank_path",
+        low_rank::the_fine_sphere_solves_on_the_direct_low_rank_path,
+    ),
+    (
         "a_mortar_pair_holds_only_the_master_near_its_slave_facets",
         mortar_halo::a_mortar_pair_holds_only_the_master_near_its_slave_facets,
     ),
