@@ -129,6 +129,17 @@ fn main() {
             vec!["mesh.fine_size=0.35".to_string()],
             1,
         ));
+        // The same mesh on the direct path (MUMPS; the contact Schur or
+        // low-rank path, Newton on the condensed contact system).
+        cases.push((
+            "sphere h=0.35 direct",
+            "hertz-sphere",
+            vec![
+                "mesh.fine_size=0.35".to_string(),
+                "solver.direct_max_dofs=200000".to_string(),
+            ],
+            1,
+        ));
         cases.push((
             "sphere h=0.35 mortar",
             "hertz-sphere",
