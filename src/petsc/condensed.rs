@@ -85,32 +85,24 @@ impl Layout {
     }
 }
 
-/// The condensed Newton state of one load step (one rank).
-#[derive(Default)]
-pub struct Condensation {
-    /// The step's start x0, from `arm` until the step ends.
-    x0: Option<Vector>,
-    /// From the step's first linear solve on.
-    step: Option<Step>,
+/// A condensed Newton load step's life, on either path (this one rank's
+/// and `low_rank::condensed`): its start x0 from `arm` until the step
+/// ends, and the path's `S` from the step's first linear solve on.
+pub struct Armed<S> {
+    pub(super) x0: Option<Vector>,
+    pub(super) step: Option<S>,
 }
 
-struct Step {
-    layout: std::rc::Rc<Layout>,
-    /// R(x0) off C (zero on C) and its squared norm.
-    q: Vector,
-    qq: f64,
-    /// R(x0) on C and h, in Schur positions.
-    f0: Vec<f64>,
-    h: Vec<f64>,
-    /// L0 = R_C(x0) − r_c(x0) (Schur positions), once the residual has
-    /// given r_c(x0).
-    lin0: Option<Vec<f64>>,
-    /// Work vectors of |C| entries for the dense solves.
-    rhs: Vector,
-    sol: Vector,
+impl<S> Default for Armed<S> {
+    fn default() -> Self {
+        Armed {
+            x0: None,
+            step: None,
+        }
+    }
 }
 
-impl Condensation {
+impl<S> Armed<S> {
     /// A step starts at `x0`: the next linear solve is a whole one.
     pub fn arm(&mut self, x0: &Vector) -> Result<()> {
         let mut copy = x0.duplicate()?;
@@ -131,24 +123,71 @@ impl Condensation {
         self.x0.is_some() && self.step.is_none()
     }
 
-    /// The SNES vector is the condensed one (residuals and steps below).
+    /// The SNES vector is the condensed one.
     pub fn is_active(&self) -> bool {
         self.step.is_some()
+    }
+
+    /// Before the first condensed residual: x0, when the step's state
+    /// still `needs` the contact residual there.
+    pub fn base_wanted(&self, needs: impl Fn(&S) -> bool) -> Option<&Vector> {
+        match &self.step {
+            Some(s) if needs(s) => self.x0.as_ref(),
+            _ => None,
+        }
+    }
+}
+
+/// The condensed Newton state of one load step (one rank).
+#[derive(Default)]
+pub struct Condensation {
+    armed: Armed<Step>,
+}
+
+struct Step {
+    layout: std::rc::Rc<Layout>,
+    /// R(x0) off C (zero on C) and its squared norm.
+    q: Vector,
+    qq: f64,
+    /// R(x0) on C and h, in Schur positions.
+    f0: Vec<f64>,
+    h: Vec<f64>,
+    /// L0 = R_C(x0) − r_c(x0) (Schur positions), once the residual has
+    /// given r_c(x0).
+    lin0: Option<Vec<f64>>,
+    /// Work vectors of |C| entries for the dense solves.
+    rhs: Vector,
+    sol: Vector,
+}
+
+impl Condensation {
+    pub fn arm(&mut self, x0: &Vector) -> Result<()> {
+        self.armed.arm(x0)
+    }
+
+    pub fn disarm(&mut self) {
+        self.armed.disarm()
+    }
+
+    pub fn awaits_first_solve(&self) -> bool {
+        self.armed.awaits_first_solve()
+    }
+
+    /// The SNES vector is the condensed one (residuals and steps below).
+    pub fn is_active(&self) -> bool {
+        self.armed.is_active()
     }
 
     /// Before the first condensed residual: the state whose contact
     /// residual L0 needs (None when it has it).
     pub fn base_wanted(&self) -> Option<&Vector> {
-        match &self.step {
-            Some(s) if s.lin0.is_none() => self.x0.as_ref(),
-            _ => None,
-        }
+        self.armed.base_wanted(|s| s.lin0.is_none())
     }
 
     /// Gives L0 the contact residual `rc0` at x0 (whole vector; its
     /// constrained entries are ignored).
     pub fn set_base_contact(&mut self, rc0: &Vector) -> Result<()> {
-        let Some(s) = self.step.as_mut() else {
+        let Some(s) = self.armed.step.as_mut() else {
             return Ok(());
         };
         let rc = rc0.with_array(|a| s.layout.gather(a))?;
@@ -184,7 +223,7 @@ impl Condensation {
         y.copy_from(&q)?;
         y.with_array_mut(|a| layout.scatter(&yc, a))?;
         let n = layout.c.len();
-        self.step = Some(Step {
+        self.armed.step = Some(Step {
             layout: layout.clone(),
             q,
             qq,
@@ -198,7 +237,7 @@ impl Condensation {
     }
 
     fn parts(&self) -> Result<(&Vector, &Step)> {
-        match (&self.x0, &self.step) {
+        match (&self.armed.x0, &self.armed.step) {
             (Some(x0), Some(s)) => Ok((x0, s)),
             _ => Err(super::shell::error(
                 "Condensation",
@@ -267,7 +306,7 @@ impl Condensation {
         b: &Vector,
         y: &mut Vector,
     ) -> Result<()> {
-        let Some(s) = self.step.as_mut() else {
+        let Some(s) = self.armed.step.as_mut() else {
             return Err(super::shell::error(
                 "Condensation::step",
                 "no condensed step".into(),

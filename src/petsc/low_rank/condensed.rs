@@ -22,6 +22,7 @@
 //! convergence tests are Newton's on the whole vector; s is read back from
 //! x_W as G_WW⁻¹ (x_W − x0_W − (θ − 1) z_W). The interior is formed once,
 //! when the step ends (one solve for K⁻¹ P s).
+use super::super::condensed::Armed;
 use super::super::shell::error;
 use super::super::{petsc_call, sys, Result, Vector};
 use super::{at_c, scatter, seq_vector, LowRankPreconditioner, OwnedScatter};
@@ -85,8 +86,7 @@ impl Window {
 /// on rank 0, empty elsewhere).
 #[derive(Default)]
 pub struct Reduced {
-    x0: Option<Vector>,
-    pub(super) step: Option<Step>,
+    armed: Armed<Step>,
     pub(super) window: Window,
 }
 
@@ -154,43 +154,32 @@ impl Step {
 }
 
 impl Reduced {
-    /// A step starts at `x0`: the next linear solve is a whole one.
     pub fn arm(&mut self, x0: &Vector) -> Result<()> {
-        let mut copy = x0.duplicate()?;
-        copy.copy_from(x0)?;
-        self.x0 = Some(copy);
-        self.step = None;
-        Ok(())
+        self.armed.arm(x0)
     }
 
-    /// The step ended without `expand` (failed, or cut back).
     pub fn disarm(&mut self) {
-        self.x0 = None;
-        self.step = None;
+        self.armed.disarm()
     }
 
     pub fn awaits_first_solve(&self) -> bool {
-        self.x0.is_some() && self.step.is_none()
+        self.armed.awaits_first_solve()
     }
 
-    /// The SNES vector is the condensed one.
     pub fn is_active(&self) -> bool {
-        self.step.is_some()
+        self.armed.is_active()
     }
 
     /// Before the first condensed residual: the state whose contact
     /// residual ρ0 needs (None when it has it).
     pub fn base_wanted(&self) -> Option<&Vector> {
-        match &self.step {
-            Some(s) if s.rc0.is_none() => self.x0.as_ref(),
-            _ => None,
-        }
+        self.armed.base_wanted(|s| s.rc0.is_none())
     }
 
     /// Gives ρ0 the contact residual `rc0` at x0 (whole vector).
     /// Collective.
     pub fn set_base_contact(&mut self, rc0: &Vector) -> Result<()> {
-        if let Some(s) = self.step.as_mut() {
+        if let Some(s) = self.armed.step.as_mut() {
             s.rc0 = Some(s.gather(rc0)?);
         }
         Ok(())
@@ -208,6 +197,7 @@ impl Reduced {
         fixed: &[bool],
     ) -> Result<()> {
         let x0 = self
+            .armed
             .x0
             .as_ref()
             .ok_or_else(|| error("Reduced::start", "not armed".into()))?;
@@ -224,7 +214,7 @@ impl Reduced {
         let qq = q.dot(&q)?;
         let mut zz = z.duplicate()?;
         zz.copy_from(z)?;
-        self.step = Some(Step {
+        self.armed.step = Some(Step {
             work: q.duplicate()?,
             q,
             qq,
@@ -245,7 +235,7 @@ impl Reduced {
     /// `rc` there (whole vector, constrained entries ignored). Collective;
     /// a failure on rank 0 leaves non-finite entries and is returned there.
     pub fn residual(&mut self, x: &Vector, rc: &Vector, out: &mut Vector) -> Result<()> {
-        let (Some(x0), Some(s)) = (&self.x0, self.step.as_mut()) else {
+        let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
             return Err(error("Reduced::residual", "no condensed step".into()));
         };
         let theta = s.theta(x0, x)?;
@@ -298,7 +288,7 @@ impl Reduced {
     /// Ends the step, first part: θ of the condensed vector `x` and x_C
     /// (rank 0). Collective.
     pub(super) fn theta_and_c(&mut self, x: &Vector) -> Result<(f64, Vec<f64>)> {
-        let (Some(x0), Some(s)) = (&self.x0, self.step.as_mut()) else {
+        let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
             return Err(error("Reduced::expand", "no condensed step".into()));
         };
         let theta = s.theta(x0, x)?;
@@ -308,6 +298,7 @@ impl Reduced {
     /// Rank 0: s at C's positions (zero off W) for θ and x_C.
     pub(super) fn forces_on_c(&self, theta: f64, xc: &[f64]) -> Result<Vec<f64>> {
         let s = self
+            .armed
             .step
             .as_ref()
             .ok_or_else(|| error("Reduced::expand", "no condensed step".into()))?;
@@ -328,7 +319,7 @@ impl Reduced {
         w: &Vector,
         xc: &[f64],
     ) -> Result<()> {
-        let (Some(x0), Some(s)) = (&self.x0, self.step.as_mut()) else {
+        let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
             return Err(error("Reduced::expand", "no condensed step".into()));
         };
         x.copy_from(x0)?;
@@ -432,8 +423,9 @@ impl LowRankPreconditioner {
             let fixed: &[bool] = if self.root { &self.fixed } else { &[] };
             red.start(b, z, self.pick, &self.shift_c, fixed)?;
         }
-        let Reduced { step, window, .. } = &mut *red;
-        let s = step
+        let Reduced { armed, window } = &mut *red;
+        let s = armed
+            .step
             .as_mut()
             .ok_or_else(|| error("condensed Newton", "no condensed step".into()))?;
         let theta = s.theta_of(b)?;
