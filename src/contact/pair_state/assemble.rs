@@ -5,6 +5,7 @@ use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::kernel::{self, Friction, LinkInput, LinkMaster, LinkState, SlipRate};
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
+use std::collections::BTreeSet;
 
 /// Scratch space for one link's input (no allocation per link).
 #[derive(Default)]
@@ -20,33 +21,42 @@ const MAX_LINK_NODES: usize = 8;
 const MAX_LINK_DOFS: usize = DIM * MAX_LINK_NODES;
 
 impl ContactPair {
-    /// Records every entry the links of this step may couple: each slave
-    /// facet with itself and with every master node in its links' patches.
+    /// Records every entry the links of this step may couple. A link
+    /// couples its slave facet with the one master facet it projects onto,
+    /// which may be any facet of its patch, so the pattern is the union of
+    /// (slave facet + one patch facet) squares: the nodes of two different
+    /// patch facets are never coupled through a link. (One square over the
+    /// slave facet and its whole patch stored 1.3 million zeros beyond the
+    /// bulk stiffness's 7.4 million on the Hertz sphere at h = 0.35, each
+    /// a multiply in every product and smoother sweep; now 0.7 million.)
     pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
         if let Some(m) = &self.mortar {
             return m.add_pattern(dofs, pattern);
         }
-        let mut by_facet: std::collections::BTreeMap<usize, Vec<u32>> =
-            std::collections::BTreeMap::new();
-        for l in &self.links {
-            let entry = by_facet.entry(l.qp_index() / self.slave.nqp).or_default();
-            if let MasterSide::Deformable(m) = &self.master {
-                for &f in &l.patch {
-                    entry.extend_from_slice(m.facet_nodes(f));
-                }
-            }
+        let facets: BTreeSet<usize> = self
+            .links
+            .iter()
+            .map(|l| l.qp_index() / self.slave.nqp)
+            .collect();
+        for &facet in &facets {
+            pattern.add_square(&self.slave.facets[facet].dofs)?;
         }
+        let MasterSide::Deformable(m) = &self.master else {
+            return Ok(());
+        };
+        let pairs: BTreeSet<(usize, u32)> = self
+            .links
+            .iter()
+            .flat_map(|l| {
+                let facet = l.qp_index() / self.slave.nqp;
+                l.patch.iter().map(move |&f| (facet, f))
+            })
+            .collect();
         let mut d: Vec<GlobalDof> = Vec::new();
-        for (facet, mut master_nodes) in by_facet {
+        for (facet, f) in pairs {
             d.clear();
             d.extend_from_slice(&self.slave.facets[facet].dofs);
-            if let MasterSide::Deformable(m) = &self.master {
-                master_nodes.sort_unstable();
-                master_nodes.dedup();
-                for &n in &master_nodes {
-                    d.extend_from_slice(m.held_node_dofs(n));
-                }
-            }
+            m.facet_dofs(f, &mut d);
             pattern.add_square(&d)?;
         }
         Ok(())
