@@ -26,7 +26,7 @@ export OMPI_MCA_btl OMPI_MCA_btl_vader_single_copy_mechanism OMPI_MCA_pml
 # (not its human-readable output): $(call cargo_exe,KIND,NAME,CARGO ARGS).
 cargo_exe = $$($(CARGO) $(3) --message-format=json | $(PYTHON) scripts/cargo_executable.py $(1) $(2))
 
-.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing ironing-compare mortar-cost friction-figures lint fmt clean
+.PHONY: deps build demo test test-mpi test-examples bench bench-peers work-precision scaling memory hertz-study ironing ironing-compare mortar-cost contact-cost friction-figures lint fmt clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -172,6 +172,13 @@ ironing-compare: build
 mortar-cost: build
 	@mkdir -p out
 	$(PYTHON) scripts/mortar_cost.py target/release/contactlink $(or $(REPEATS),3)
+
+# Contact solve against the plain elastic solve of the same mesh (README's
+# table): the graded line meshes on 1 and 2 ranks, the 98k-DOF sphere.
+contact-cost: build
+	@bash scripts/install-deps.sh --peers
+	$(PYTHON) scripts/bench_peers.py --cases line --dry-run --out bench-results/lines
+	$(PYTHON) scripts/contact_cost.py target/release/contactlink $(or $(REPEATS),3) --lines bench-results/lines
 
 # The friction and dynamics figures of docs/verification.md (block-slide, ironing, impact).
 friction-figures: ironing
