@@ -2,11 +2,21 @@
 //! option table at the end of the run, defaults included).
 mod common;
 use common::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The option table a run ended with.
+/// The option table a run ended with. Each run writes its own result file:
+/// the tests run in parallel, and two runs of one scene writing the scene's
+/// output path at once made MPI-IO fail to open it.
 fn option_table(args: &[&str]) -> String {
+    static RUNS: AtomicUsize = AtomicUsize::new(0);
+    let dir = scratch(&format!(
+        "solver_defaults_{}",
+        RUNS.fetch_add(1, Ordering::Relaxed)
+    ));
+    let out = dir.join("out.h5");
     let mut all = vec!["run"];
     all.extend_from_slice(args);
+    all.extend(["-o", out.to_str().expect("scratch path is UTF-8")]);
     all.push("-options_view");
     let o = run(&all);
     let t = text(&o);
