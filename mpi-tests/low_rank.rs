@@ -22,19 +22,24 @@ fn newton(r: &RunReport) -> usize {
     r.steps.iter().map(|s| s.newton_iterations).sum()
 }
 
+/// The run report of `scene` with `overrides` (`--set` lines).
+fn run_scene(rt: &Runtime, scene: &str, overrides: &[&str]) -> Result<RunReport, String> {
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let model = pipeline::load_model(scene, &o)
+        .map_err(|e| e.to_string())?
+        .0;
+    pipeline::run_model(rt, &model, None, false)
+        .map(|s| s.report)
+        .map_err(|e| e.to_string())
+}
+
 /// Displacement (rank 0 holds it), reactions and contact forces with and
 /// without the path, to `tol`; and that the path was the one this rank
 /// count takes.
 fn same_run(rt: &Runtime, scene: &str, overrides: &[&str], tol: f64) -> Result<(), String> {
     let run = |schur: bool| -> Result<RunReport, String> {
-        let mut o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        o.push(format!("solver.contact_schur={schur}"));
-        let model = pipeline::load_model(scene, &o)
-            .map_err(|e| e.to_string())?
-            .0;
-        pipeline::run_model(rt, &model, None, false)
-            .map(|s| s.report)
-            .map_err(|e| e.to_string())
+        let path = format!("solver.contact_schur={schur}");
+        run_scene(rt, scene, &[overrides, &[path.as_str()]].concat())
     };
     let (on, off) = (run(true)?, run(false)?);
     let what = format!("{scene} {overrides:?}");
@@ -258,20 +263,15 @@ pub fn the_fine_sphere_solves_on_the_direct_low_rank_path(rt: &Runtime) -> Resul
     if rt.size() != 2 {
         return Ok(());
     }
-    let overrides: Vec<String> = [
-        "mesh.fine_size=0.42",
-        "solver.direct_max_dofs=200000",
-        "solver.max_cutbacks=0",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let model = pipeline::load_model("hertz-sphere", &overrides)
-        .map_err(|e| e.to_string())?
-        .0;
-    let r = pipeline::run_model(rt, &model, None, false)
-        .map(|s| s.report)
-        .map_err(|e| e.to_string())?;
+    let r = run_scene(
+        rt,
+        "hertz-sphere",
+        &[
+            "mesh.fine_size=0.42",
+            "solver.direct_max_dofs=200000",
+            "solver.max_cutbacks=0",
+        ],
+    )?;
     let s = r.schur.ok_or("the Schur path was not taken")?;
     let n = newton(&r);
     if !s.low_rank || s.inverse_redone != 0 || r.steps.len() != 1 || n > 25 {
