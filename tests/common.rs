@@ -17,7 +17,8 @@ pub fn scratch(name: &str) -> PathBuf {
 }
 
 pub fn mpi_env(cmd: &mut Command) -> &mut Command {
-    cmd.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    cmd.env("OMPI_MCA_orte_tmpdir_base", session_base())
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_btl", "self,vader")
         .env("OMPI_MCA_btl_vader_single_copy_mechanism", "none")
@@ -25,27 +26,59 @@ pub fn mpi_env(cmd: &mut Command) -> &mut Command {
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1")
 }
 
+/// A directory of its own for each test thread's Open MPI session files. In the
+/// shared default (/tmp/ompi.<host>.<uid>) a launch that ends removes the
+/// directory another test thread's launch is just creating its own in, and
+/// that one dies in orte_init ("mkdir ... No such file or directory",
+/// seen in contact_scenes_same_on_1_3_4_8_ranks).
+fn session_base() -> PathBuf {
+    // Per test thread: a thread runs one launch at a time.
+    let thread = format!("{:?}", std::thread::current().id());
+    let thread: String = thread.chars().filter(char::is_ascii_digit).collect();
+    let dir =
+        std::env::temp_dir().join(format!("contactlink-ompi-{}-{thread}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("create an Open MPI session directory");
+    dir
+}
+
 /// `contactlink ARGS` without mpirun (one rank, MPI singleton).
 pub fn run(args: &[&str]) -> Output {
-    mpi_env(&mut Command::new(binary()))
-        .args(args)
+    output(
+        mpi_env(&mut Command::new(binary())).args(args),
+        "contactlink",
+    )
+}
+
+/// Runs `cmd` to its end, then removes its session directory (left empty by
+/// Open MPI).
+pub fn output(cmd: &mut Command, what: &str) -> Output {
+    let o = cmd
         .output()
-        .expect("spawn contactlink")
+        .unwrap_or_else(|e| panic!("spawn {what}: {e} (is openmpi-bin installed? `make deps`)"));
+    let base = cmd
+        .get_envs()
+        .find(|(k, _)| *k == "OMPI_MCA_orte_tmpdir_base")
+        .and_then(|(_, v)| v);
+    if let Some(dir) = base {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    o
 }
 
 /// `mpirun -n N contactlink ARGS`.
 pub fn mpirun(n: usize, args: &[&str]) -> Output {
-    mpi_env(&mut Command::new("mpirun"))
-        .args([
-            "--allow-run-as-root",
-            "--oversubscribe",
-            "-n",
-            &n.to_string(),
-            binary(),
-        ])
-        .args(args)
-        .output()
-        .expect("spawn mpirun (is openmpi-bin installed? `make deps`)")
+    output(
+        mpi_env(&mut Command::new("mpirun"))
+            .args([
+                "--allow-run-as-root",
+                "--oversubscribe",
+                "-n",
+                &n.to_string(),
+                binary(),
+            ])
+            .args(args),
+        "mpirun",
+    )
 }
 
 pub fn text(o: &Output) -> String {

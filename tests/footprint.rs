@@ -8,18 +8,19 @@ use std::process::{Command, Output};
 
 /// `mpirun -n N contactlink ARGS` with the set-up checkpoints on.
 fn mpirun_with_checkpoints(n: usize, args: &[&str]) -> Output {
-    mpi_env(&mut Command::new("mpirun"))
-        .env("CONTACTLINK_MEMORY", "1")
-        .args([
-            "--allow-run-as-root",
-            "--oversubscribe",
-            "-n",
-            &n.to_string(),
-            binary(),
-        ])
-        .args(args)
-        .output()
-        .expect("spawn mpirun")
+    output(
+        mpi_env(&mut Command::new("mpirun"))
+            .env("CONTACTLINK_MEMORY", "1")
+            .args([
+                "--allow-run-as-root",
+                "--oversubscribe",
+                "-n",
+                &n.to_string(),
+                binary(),
+            ])
+            .args(args),
+        "mpirun",
+    )
 }
 
 /// The two MiB figures of the `memory: peak resident` summary line.
