@@ -20,11 +20,16 @@ mod lagging;
 mod low_rank;
 mod manufactured;
 mod mortar_halo;
+mod pattern;
 mod rank0;
 
 type Case = (&'static str, fn(&Runtime) -> Result<(), String>);
 
 const CASES: &[Case] = &[
+    (
+        "the_pattern_holds_every_ranks_couplings",
+        pattern::the_pattern_holds_every_ranks_couplings,
+    ),
     (
         "halo_exchange_refreshes_ghosts",
         halo_exchange_refreshes_ghosts,

@@ -9,6 +9,7 @@ pub mod log;
 pub mod low_rank;
 pub mod matrix;
 pub mod options;
+mod pattern;
 pub mod reason;
 pub mod scatter;
 pub mod schur;
@@ -21,7 +22,8 @@ pub mod sys;
 pub mod vector;
 
 pub use log::LogStage;
-pub use matrix::{Matrix, PatternBuilder};
+pub use matrix::Matrix;
+pub use pattern::PatternBuilder;
 pub use reason::{KspReason, SnesReason};
 pub use scatter::Scatter;
 pub use snes::{NonlinearProblem, Snes, SnesOutcome};
