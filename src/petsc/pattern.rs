@@ -9,7 +9,8 @@
 //! (143,694 DOFs) and 0.38 s of the 98k-DOF sphere's, once for set-up and
 //! once more when the first contact search adds the links' couplings.
 //! Rows other ranks own are sent to them when the matrix is built; each
-//! rank then hands its own rows to PETSc as compressed rows in one call.
+//! rank then gives PETSc exact row counts and fills its own rows with
+//! zeros (one rank: the column indices in one copy).
 use super::matrix::{check_block, final_assembly, Matrix};
 use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result};
 use mpi::topology::SimpleCommunicator;
@@ -73,15 +74,13 @@ impl PatternBuilder {
         let rank = self.world.rank() as usize;
         let (start, end) = (self.row_starts[rank], self.row_starts[rank + 1]);
         let record = self.record.gather_owned(&self.world, &self.row_starts)?;
-        let (offsets, mut cols) = record.compressed_rows(start, end)?;
         let n = to_petsc_int(end - start)?;
         let mut raw: sys::Mat = std::ptr::null_mut();
         // SAFETY: PETSc is initialised; out-pointer valid; `m` owns the new
-        // matrix and destroys it on every exit. `offsets` holds one entry per
-        // owned row plus one, starting at 0 and non-decreasing; `cols` holds
-        // the rows' column indices, sorted and distinct per row and below
-        // the global size, which is what both preallocation calls read
-        // (PETSc copies them; a null value array inserts zeros).
+        // matrix and destroys it on every exit. `lengths` holds one count per
+        // owned row and `cols` their column indices, sorted and distinct per
+        // row and below the global size, which is what
+        // MatSeqAIJSetColumnIndices reads (PETSc copies them).
         unsafe {
             petsc_call!(MatCreate(comm_world(), &mut raw))?;
             let m = Matrix::owned(raw);
@@ -95,15 +94,14 @@ impl PatternBuilder {
             petsc_call!(MatSetBlockSize(raw, to_petsc_int(self.block_size)?))?;
             petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
             if self.world.size() == 1 {
-                // Exact row lengths, then the column indices in one copy
-                // (the CSR call would insert them entry by entry).
-                let lengths: Vec<PetscInt> = offsets.windows(2).map(|w| w[1] - w[0]).collect();
+                // Exact row lengths, then the column indices in one copy.
+                let (lengths, mut cols) = record.compressed_rows(start, end)?;
                 petsc_call!(MatSeqAIJSetPreallocation(raw, 0, lengths.as_ptr()))?;
                 petsc_call!(MatSeqAIJSetColumnIndices(raw, cols.as_mut_ptr()))?;
                 final_assembly(raw)?;
                 petsc_call!(MatZeroEntries(raw))?;
             } else {
-                set_split_rows(raw, &offsets, &cols, start, end)?;
+                set_rows(raw, &record, start, end)?;
             }
             // Inserting outside the recorded pattern is a bug, not a slowdown.
             petsc_call!(MatSetOption(
@@ -124,45 +122,30 @@ impl PatternBuilder {
 }
 
 /// Preallocates the several-rank matrix `raw` (created, sized, typed,
-/// not yet preallocated) for the compressed rows `offsets`/`cols` of its
-/// rows `start..end` and fixes that pattern with explicit zeros. The
-/// columns go straight into PETSc's two local blocks (the diagonal block in
-/// local, the off-diagonal one in global column numbers until assembly
-/// compacts it), so nothing is inserted entry by entry (MatMPIAIJ's CSR
-/// preallocation took 0.10 s of 0.17 s for 72k rows of the graded line
-/// contact on each of 2 ranks).
-fn set_split_rows(
-    raw: sys::Mat,
-    offsets: &[PetscInt],
-    cols: &[PetscInt],
-    start: usize,
-    end: usize,
-) -> Result<()> {
+/// not yet preallocated) for `record`'s rows `start..end` and fixes that
+/// pattern with explicit zeros, a row at a time: a whole local copy of the
+/// column indices (what MatSeqAIJSetColumnIndices on PETSc's two local
+/// blocks needs, 0.05 s faster per build on the 2-rank graded line) raised
+/// the largest rank's set-up peak by 42 MiB (1.28M DOFs on 8 ranks,
+/// 339.4 -> 381.5 MiB).
+fn set_rows(raw: sys::Mat, record: &NodePattern, start: usize, end: usize) -> Result<()> {
     let (first, stop) = (to_petsc_int(start)?, to_petsc_int(end)?);
     let rows = end - start;
     let mut on = Vec::with_capacity(rows);
     let mut off = Vec::with_capacity(rows);
-    let mut diagonal = Vec::with_capacity(cols.len());
-    let mut beyond = Vec::new();
-    for w in offsets.windows(2) {
-        let row = &cols[w[0] as usize..w[1] as usize];
-        let (d0, d1) = (
-            row.partition_point(|&c| c < first),
-            row.partition_point(|&c| c < stop),
-        );
-        diagonal.extend(row[d0..d1].iter().map(|&c| c - first));
-        beyond.extend_from_slice(&row[..d0]);
-        beyond.extend_from_slice(&row[d1..]);
-        on.push(to_petsc_int(d1 - d0)?);
-        off.push(to_petsc_int(row.len() - (d1 - d0))?);
-    }
+    let mut widest = 0;
+    record.for_each_row(start, end, |_, cols| {
+        let inside = cols.partition_point(|&c| c < stop) - cols.partition_point(|&c| c < first);
+        on.push(to_petsc_int(inside)?);
+        off.push(to_petsc_int(cols.len() - inside)?);
+        widest = widest.max(cols.len());
+        Ok(())
+    })?;
+    let zeros = vec![0.0; widest];
     // SAFETY: `raw` is a valid, not yet preallocated MPIAIJ matrix of
-    // `rows` local rows and columns; `on`/`off` hold one count per row,
-    // and `diagonal`/`beyond` exactly those many column indices per row,
-    // sorted and distinct (local in the diagonal block, global in the
-    // off-diagonal one, which has the global column count until the first
-    // assembly), as MatSeqAIJSetColumnIndices reads them; PETSc copies both.
-    // The blocks are borrowed from `raw` and not destroyed here.
+    // `rows` local rows; `on`/`off` hold one count per row, and each row
+    // then gets exactly those columns (sorted, distinct, in range) with as
+    // many zeros, which MatSetValues reads and copies.
     unsafe {
         petsc_call!(MatMPIAIJSetPreallocation(
             raw,
@@ -171,13 +154,20 @@ fn set_split_rows(
             0,
             off.as_ptr()
         ))?;
-        let (mut a, mut b): (sys::Mat, sys::Mat) = (std::ptr::null_mut(), std::ptr::null_mut());
-        let mut colmap: *const PetscInt = std::ptr::null();
-        petsc_call!(MatMPIAIJGetSeqAIJ(raw, &mut a, &mut b, &mut colmap))?;
-        petsc_call!(MatSeqAIJSetColumnIndices(a, diagonal.as_mut_ptr()))?;
-        petsc_call!(MatSeqAIJSetColumnIndices(b, beyond.as_mut_ptr()))?;
-        final_assembly(raw)?;
-        petsc_call!(MatZeroEntries(raw))
+        record.for_each_row(start, end, |row, cols| {
+            let row = to_petsc_int(row)?;
+            let n = to_petsc_int(cols.len())?;
+            petsc_call!(MatSetValues(
+                raw,
+                1,
+                &row,
+                n,
+                cols.as_ptr(),
+                zeros.as_ptr(),
+                sys::InsertMode_INSERT_VALUES
+            ))
+        })?;
+        final_assembly(raw)
     }
 }
 
@@ -319,17 +309,19 @@ impl NodePattern {
         Ok(self)
     }
 
-    /// Row offsets (one per row of `start..end`, plus one) and the sorted,
-    /// distinct global column indices of every row, from a compacted
-    /// record that holds only rows of `start..end`.
-    fn compressed_rows(&self, start: usize, end: usize) -> Result<(Vec<PetscInt>, Vec<PetscInt>)> {
+    /// Calls `f` with each row of `start..end` and its sorted, distinct
+    /// global column indices, from a compacted record that holds only rows
+    /// of `start..end`.
+    fn for_each_row(
+        &self,
+        start: usize,
+        end: usize,
+        mut f: impl FnMut(usize, &[PetscInt]) -> Result<()>,
+    ) -> Result<()> {
         let bs = self.bs;
-        let mut offsets = Vec::with_capacity(end - start + 1);
-        offsets.push(0);
-        let mut cols: Vec<PetscInt> = Vec::with_capacity(self.nodes.len() * bs * bs);
         let (mut ni, mut ei) = (0, 0);
         let mut row_nodes: &[(u32, u32)] = &[];
-        let mut merged: Vec<PetscInt> = Vec::new();
+        let mut cols: Vec<PetscInt> = Vec::new();
         for row in start..end {
             if row.is_multiple_of(bs) {
                 let node = (row / bs) as u32;
@@ -344,21 +336,33 @@ impl NodePattern {
                 ei += 1;
             }
             let extra = &self.entries[first..ei];
-            let expanded = row_nodes
-                .iter()
-                .flat_map(|&(_, m)| (0..bs).map(move |c| (m as usize * bs + c) as PetscInt));
-            if extra.is_empty() {
-                cols.extend(expanded);
-            } else {
-                merged.clear();
-                merged.extend(expanded);
-                merged.extend(extra.iter().map(|&(_, c)| c));
-                merged.sort_unstable();
-                merged.dedup();
-                cols.extend_from_slice(&merged);
+            cols.clear();
+            cols.extend(
+                row_nodes
+                    .iter()
+                    .flat_map(|&(_, m)| (0..bs).map(move |c| (m as usize * bs + c) as PetscInt)),
+            );
+            if !extra.is_empty() {
+                cols.extend(extra.iter().map(|&(_, c)| c));
+                cols.sort_unstable();
+                cols.dedup();
             }
-            offsets.push(to_petsc_int(cols.len())?);
+            f(row, &cols)?;
         }
-        Ok((offsets, cols))
+        Ok(())
+    }
+
+    /// Row lengths and the rows' column indices one after another (as
+    /// `for_each_row` gives them); the record is freed before PETSc
+    /// allocates.
+    fn compressed_rows(self, start: usize, end: usize) -> Result<(Vec<PetscInt>, Vec<PetscInt>)> {
+        let mut lengths = Vec::with_capacity(end - start);
+        let mut all: Vec<PetscInt> = Vec::with_capacity(self.nodes.len() * self.bs * self.bs);
+        self.for_each_row(start, end, |_, cols| {
+            lengths.push(to_petsc_int(cols.len())?);
+            all.extend_from_slice(cols);
+            Ok(())
+        })?;
+        Ok((lengths, all))
     }
 }
