@@ -23,6 +23,7 @@ pub mod contact;
 pub mod distribution;
 pub mod dofs;
 pub mod error;
+pub mod exchange;
 pub mod fem;
 pub mod footprint;
 pub mod mesh;

@@ -14,15 +14,14 @@
 //! outcome of work only one rank does (success or error) to every rank.
 //! [`fault`] makes one rank fail on purpose (tests only).
 pub mod agree;
-mod exchange;
 pub mod fault;
 mod gather;
 mod relay;
 
+pub use crate::exchange::all_to_all;
 pub use agree::{
     agree, agree_failure, all_ranks, any_rank, broadcast_text, lowest_rank, max, sum, sum_usize,
     RankFailure,
 };
-pub use exchange::all_to_all;
 pub use gather::{gather_all, gather_equal, gather_root};
 pub use relay::from_root;

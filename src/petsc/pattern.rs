@@ -301,8 +301,8 @@ impl NodePattern {
             entries[r].extend(self.entries[ei..stop].iter().flat_map(|&(a, b)| [a, b]));
             ei = stop;
         }
-        let nodes = crate::parallel::all_to_all(world, &nodes);
-        let entries = crate::parallel::all_to_all(world, &entries);
+        let nodes = crate::exchange::all_to_all(world, &nodes);
+        let entries = crate::exchange::all_to_all(world, &entries);
         self.nodes = nodes.chunks_exact(2).map(|p| (p[0], p[1])).collect();
         self.entries = entries.chunks_exact(2).map(|p| (p[0], p[1])).collect();
         self.compact();

@@ -1,4 +1,6 @@
 //! Personalised exchange: every rank sends its own array to every other rank.
+//! A leaf: `parallel` re-exports it, and the PETSc layer's pattern builder,
+//! which sits below `parallel`, sends rows to their owners with it.
 
 use mpi::datatype::{Equivalence, Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
