@@ -119,17 +119,21 @@ impl LowRankPreconditioner {
                 std::ptr::null(),
                 &mut bt.0
             ))?;
-            for &c in cols {
-                petsc_call!(MatSetValues(
-                    bt.0,
-                    1,
-                    &self.c[c],
-                    nr,
-                    at.as_ptr(),
-                    ones.as_ptr(),
-                    sys::InsertMode_INSERT_VALUES
-                ))?;
-            }
+            let set = (|| -> Result<()> {
+                for &c in cols {
+                    petsc_call!(MatSetValues(
+                        bt.0,
+                        1,
+                        &self.c[c],
+                        nr,
+                        at.as_ptr(),
+                        ones.as_ptr(),
+                        sys::InsertMode_INSERT_VALUES
+                    ))?;
+                }
+                Ok(())
+            })();
+            all_or_none(&self.any_rank, set, "requesting G's entries")?;
             petsc_call!(MatAssemblyBegin(
                 bt.0,
                 sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
@@ -222,20 +226,24 @@ impl LowRankPreconditioner {
                 std::ptr::null_mut(),
                 &mut b.0
             ))?;
-            for (i, entries) in rhs.iter().enumerate() {
-                let col = to_petsc_int(i)?;
-                for &(j, v) in entries {
-                    petsc_call!(MatSetValues(
-                        b.0,
-                        1,
-                        &self.c[j],
-                        1,
-                        &col,
-                        &v,
-                        sys::InsertMode_INSERT_VALUES
-                    ))?;
+            let set = (|| -> Result<()> {
+                for (i, entries) in rhs.iter().enumerate() {
+                    let col = to_petsc_int(i)?;
+                    for &(j, v) in entries {
+                        petsc_call!(MatSetValues(
+                            b.0,
+                            1,
+                            &self.c[j],
+                            1,
+                            &col,
+                            &v,
+                            sys::InsertMode_INSERT_VALUES
+                        ))?;
+                    }
                 }
-            }
+                Ok(())
+            })();
+            all_or_none(&self.any_rank, set, "setting G's right-hand sides")?;
             petsc_call!(MatAssemblyBegin(
                 b.0,
                 sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
@@ -345,6 +353,17 @@ impl LowRankPreconditioner {
     }
 }
 
+/// Rank 0's own work before a collective call, agreed: every rank goes on,
+/// or every rank returns an error (the failing rank its own), so none waits
+/// in the collective for a rank that left. Collective.
+fn all_or_none(any_rank: &AnyRank, local: Result<()>, what: &'static str) -> Result<()> {
+    if !any_rank(local.is_err()) {
+        return Ok(());
+    }
+    local?;
+    Err(error(what, "failed on another rank".into()))
+}
+
 /// Rank 0's `local` (< 2^32) on every rank (the others pass 0): its bits
 /// OR-ed over the ranks, one agreement each, as `any_rank` is the
 /// preconditioner's only collective (32 reductions of a flag cost
@@ -369,5 +388,17 @@ mod tests {
         // A rank passing ones everywhere would set every bit.
         let with_ones: AnyRank = Box::new(|_| true);
         assert_eq!(agreed_count(&with_ones, 37), (1 << 32) - 1);
+    }
+
+    #[test]
+    fn a_failure_on_one_rank_stops_every_rank() {
+        let alone: AnyRank = Box::new(|f| f);
+        assert!(all_or_none(&alone, Ok(()), "x").is_ok());
+        let own = all_or_none(&alone, Err(error("MatSetValues", "bad row".into())), "x");
+        assert!(own.unwrap_err().to_string().contains("bad row"));
+        // Another rank failed: this one's Ok turns into an error too.
+        let other_failed: AnyRank = Box::new(|_| true);
+        let e = all_or_none(&other_failed, Ok(()), "requesting G's entries").unwrap_err();
+        assert!(e.to_string().contains("another rank"), "{e}");
     }
 }
