@@ -36,7 +36,7 @@ pub(super) struct StepContext<'s> {
     pub(super) reuse_preconditioner: bool,
     /// Newton's relative forcing in non-final Uzawa iterations.
     pub(super) forcing: f64,
-    /// The GMRES floor of non-final solves (`tolerance::LINEAR_FLOOR`;
+    /// The GMRES floor of a contact step's solves (`tolerance::LINEAR_FLOOR`;
     /// 0: none).
     pub(super) linear_floor: f64,
     /// Penalty divisor of a contact-free step's first Uzawa iteration
@@ -189,7 +189,8 @@ fn uzawa_rounds(
         let tol = inner.for_solve(solve_tight);
         snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
         if linear_floor > 0.0 {
-            snes.set_linear_floor(if solve_tight { 0.0 } else { linear_floor })?;
+            let contact = !mech.contact.is_empty();
+            snes.set_linear_floor(if contact { linear_floor } else { 0.0 })?;
         }
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
