@@ -404,6 +404,13 @@ def main():
     for tool in ("gmsh",) * ("line" in cases) + (() if a.dry_run else ("ccx",)):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
             sys.exit(f"{tool} not found: run `bash scripts/install-deps.sh --peers`")
+    if "sphere" in cases:
+        try:
+            import h5py  # noqa: F401 (the sphere's mesh is read from a result file)
+        except ImportError:
+            sys.exit(f"--cases sphere reads contactlink's result file with h5py, which "
+                     f"{sys.executable} lacks: run it with /usr/bin/python3 (Debian's "
+                     f"python3-h5py, which `make bench-peers` uses)")
     os.makedirs(a.out, exist_ok=True)
     plan = [("line", one_line, [int(v) for v in a.sizes.split(",")], a.repeats,
              "Hertz line contact, half model, b ≈ 0.1 R"),
