@@ -17,10 +17,12 @@ const INVERSE_BLOCK: PetscInt = 1024;
 /// 1.5 s, seven 0.24 s, against 0.016 and 0.088 s by whole solves), while
 /// on the set-up's requests it is the faster (line b/5, 2 ranks, 52 columns
 /// at 366 rows in two requests: 0.02 CPU s against 0.14 s by whole solves).
+/// Also the most right-hand sides of one solve with K's factor when
+/// columns are redone by whole solves (a dense block of N × 32 per solve).
 const WHOLE_SOLVES: usize = 32;
 
 /// The selected inverse's entries must match a whole solve to this
-/// fraction of the column's largest entry (both are the same factor's;
+/// fraction of the probe's largest entry (both are the same factor's;
 /// they differ by rounding, 1e-15 or so, when right).
 const PROBE_TOLERANCE: f64 = 1e-8;
 
