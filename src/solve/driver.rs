@@ -443,6 +443,7 @@ impl LoadSteps<'_> {
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
             acceleration: super::tolerance::inner_acceleration(solver.uzawa_acceleration, krylov),
+            rate_rule: super::tolerance::rate_rule(krylov),
         };
         self.stage_solve
             .scope(|| uzawa_loop(world, &mut ctx, mech, target))

@@ -23,7 +23,8 @@ pub(super) const PENALTY_RAISE: f64 = 10.0;
 /// one by one) a larger penalty is what makes it converge, and the
 /// augmented Lagrangian's solution does not depend on the penalty. Raising
 /// it from the start costs Newton iterations where Uzawa is fast (finer
-/// meshes), so the rule raises it only where the loop measurably stalls.
+/// meshes), so the rule raises it only where the loop measurably stalls,
+/// and only on the direct path (`tolerance::rate_rule`).
 pub(super) const RATE_LIMIT: f64 = 0.5;
 pub(super) const RATE_RAISE: f64 = 10.0;
 pub(super) const RATE_RAISES: usize = 1;

@@ -48,6 +48,9 @@ pub(super) struct StepContext<'s> {
     /// Anderson depth of the frictionless pairs' multiplier updates (0:
     /// off; see `anderson`).
     pub(super) acceleration: usize,
+    /// Whether the rate rule may raise a stalled pair's penalty
+    /// (`penalty::RATE_LIMIT`; `tolerance::rate_rule`).
+    pub(super) rate_rule: bool,
 }
 
 /// The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with λ fixed, then
@@ -158,6 +161,7 @@ fn uzawa_rounds(
 ) -> Result<StepResult> {
     let softening = ctx.softening;
     let linear_floor = ctx.linear_floor;
+    let rate_rule = ctx.rate_rule;
     let mut accel = Anderson::new(ctx.acceleration);
     let StepContext {
         snes,
@@ -273,7 +277,8 @@ fn uzawa_rounds(
                 }
             }
         }
-        if rate_raises < RATE_RAISES
+        if rate_rule
+            && rate_raises < RATE_RAISES
             && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
         {
             rate_raises += 1;
