@@ -38,6 +38,11 @@ def cases(lines):
                 ["hertz-sphere", *SPHERE, "--set", "contact.formulation=mortar"]))
     out.append(("sphere h=0.35", 2, "direct",
                 [PLAIN_SPHERE, *SPHERE_DIRECT], ["hertz-sphere", *SPHERE_DIRECT]))
+    # The built-in sphere's own mesh (h = 0.25, 167,013 DOFs), links and mortar.
+    for ranks in (1, 2):
+        out.append(("sphere default", ranks, "Krylov", [PLAIN_SPHERE], ["hertz-sphere"]))
+        out.append(("sphere default mortar", ranks, "Krylov", [PLAIN_SPHERE],
+                    ["hertz-sphere", "--set", "contact.formulation=mortar"]))
     return out
 
 
