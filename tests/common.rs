@@ -65,20 +65,23 @@ pub fn output(cmd: &mut Command, what: &str) -> Output {
     o
 }
 
+/// `mpirun -n N contactlink` in the test environment ([`mpi_env`]), for the
+/// caller to add its arguments and environment to.
+pub fn mpirun_command(n: usize) -> Command {
+    let mut cmd = Command::new("mpirun");
+    mpi_env(&mut cmd).args([
+        "--allow-run-as-root",
+        "--oversubscribe",
+        "-n",
+        &n.to_string(),
+        binary(),
+    ]);
+    cmd
+}
+
 /// `mpirun -n N contactlink ARGS`.
 pub fn mpirun(n: usize, args: &[&str]) -> Output {
-    output(
-        mpi_env(&mut Command::new("mpirun"))
-            .args([
-                "--allow-run-as-root",
-                "--oversubscribe",
-                "-n",
-                &n.to_string(),
-                binary(),
-            ])
-            .args(args),
-        "mpirun",
-    )
+    output(mpirun_command(n).args(args), "mpirun")
 }
 
 pub fn text(o: &Output) -> String {

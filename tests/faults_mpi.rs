@@ -98,16 +98,8 @@ impl Run {
 /// test when the run does not end within [`LIMIT`] (after stopping it).
 fn bounded_run(n: usize, fault: Option<&str>, args: &[&str]) -> Run {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let mut cmd = Command::new("mpirun");
-    mpi_env(&mut cmd)
-        .env_remove("CONTACTLINK_FAULT")
-        .args([
-            "--allow-run-as-root",
-            "--oversubscribe",
-            "-n",
-            &n.to_string(),
-            binary(),
-        ])
+    let mut cmd = mpirun_command(n);
+    cmd.env_remove("CONTACTLINK_FAULT")
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());

@@ -4,21 +4,12 @@
 //! `contactlink summary`.
 mod common;
 use common::*;
-use std::process::{Command, Output};
+use std::process::Output;
 
 /// `mpirun -n N contactlink ARGS` with the set-up checkpoints on.
 fn mpirun_with_checkpoints(n: usize, args: &[&str]) -> Output {
     output(
-        mpi_env(&mut Command::new("mpirun"))
-            .env("CONTACTLINK_MEMORY", "1")
-            .args([
-                "--allow-run-as-root",
-                "--oversubscribe",
-                "-n",
-                &n.to_string(),
-                binary(),
-            ])
-            .args(args),
+        mpirun_command(n).env("CONTACTLINK_MEMORY", "1").args(args),
         "mpirun",
     )
 }

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_nodal};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
 
 fn run_ok(ranks: usize, args: &[&str]) -> String {
@@ -97,14 +97,7 @@ fn hertz_cylinder_continues_exactly() {
 /// `mpirun -n N contactlink ARGS`, killed after `limit` (a rank that fails
 /// alone must not leave the others waiting).
 fn bounded_mpirun(n: usize, args: &[&str], limit: Duration) -> Output {
-    let mut child = mpi_env(&mut Command::new("mpirun"))
-        .args([
-            "--allow-run-as-root",
-            "--oversubscribe",
-            "-n",
-            &n.to_string(),
-            binary(),
-        ])
+    let mut child = mpirun_command(n)
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
