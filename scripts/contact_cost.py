@@ -8,7 +8,8 @@ Dirichlet conditions without the contact pair) and the contact scene in
 turn, REPEATS times (default 3), and prints one markdown row per case: DOFs,
 ranks, path, the medians of the solve seconds of the `done:` lines, their
 ratio, the per-round ratios, and the contact run's Newton / Uzawa / linear
-iterations. CASE names (prefixes of the names below) select cases. The line
+iterations. CASE names (prefixes of the names below) select cases ("line b"
+the links' line cases, "line mortar" the same meshes with a mortar pair). The line
 cases read the graded meshes that `python3 scripts/bench_peers.py --cases
 line --dry-run --out DIR` writes (DIR defaults to /tmp/lines). Several ranks
 run under mpirun (as root with --allow-run-as-root).
@@ -30,6 +31,13 @@ def cases(lines):
         for b in (5, 10, 20, 40):
             out.append((f"line b/{b}", ranks, "direct",
                         [f"{lines}/line-b{b}-plain.toml"], [f"{lines}/line-b{b}.toml"]))
+    # The same meshes with a mortar pair (what the default formulation
+    # would cost on the direct path if it were the mortar).
+    for ranks in (1, 2):
+        for b in (5, 10, 20, 40):
+            out.append((f"line mortar b/{b}", ranks, "direct",
+                        [f"{lines}/line-b{b}-plain.toml"],
+                        [f"{lines}/line-b{b}.toml", "--set", "contact.formulation=mortar"]))
     for ranks in (1, 2):
         out.append(("sphere h=0.35", ranks, "Krylov",
                     [PLAIN_SPHERE, *SPHERE], ["hertz-sphere", *SPHERE]))
