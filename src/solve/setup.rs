@@ -162,6 +162,18 @@ pub(super) fn set_solver_defaults(
             petsc::options::set_default("-matptap_via", "hypre")?;
         }
     }
+    if contact && linear_bulk && settings.reuse.preconditioner && settings.reuse.active_set {
+        // The contact Jacobian's AMG hierarchy is built once a step and kept
+        // while it works (`lagging`), so its Galerkin products' intermediate
+        // data waits for a refresh that rarely comes: freed, as on the
+        // plain path (hertz-sphere, 167k DOFs, one run each: largest of 4
+        // ranks 331.4 -> 304.1 MiB, of 2 581.4 -> 534.0, 1 rank 818.2 ->
+        // 818.3; the same 20 / 7 / 201 Newton / Uzawa / GMRES iterations).
+        // A rebuild forms them again from scratch. hypre's product, the
+        // plain path's other saving, moved the trajectory here (2 ranks:
+        // 31 / 10 / 333 iterations, 451 MiB), so contact keeps PETSc's.
+        petsc::options::set_default("-mat_product_clear", "true")?;
+    }
     if contact && !mortar {
         // Eisenstat–Walker: each linear solve only as tight as Newton's
         // progress needs (hertz-sphere h = 0.35, 2 ranks: 977 -> 152 GMRES
