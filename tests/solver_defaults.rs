@@ -38,6 +38,25 @@ fn a_plain_linear_iterative_run_frees_the_galerkin_intermediates() {
 }
 
 #[test]
+fn a_linear_iterative_contact_run_frees_the_galerkin_intermediates() {
+    // Linear bodies with contact: the AMG hierarchy is built once a step
+    // and kept while it works, so its products are not refreshed either.
+    let cylinder = [
+        "scenes/hertz-cylinder.toml",
+        "--set",
+        "solver.direct_max_dofs=0",
+    ];
+    let t = option_table(&cylinder);
+    assert!(t.contains("-pc_type gamg"), "{t}");
+    assert!(t.contains("-mat_product_clear true"), "{t}");
+    // Without the preconditioner reuse every Newton iteration rebuilds it.
+    let mut rebuilt = cylinder.to_vec();
+    rebuilt.extend(["--set", "solver.lag_preconditioner=false"]);
+    let t = option_table(&rebuilt);
+    assert!(!t.contains("-mat_product_clear"), "{t}");
+}
+
+#[test]
 fn runs_whose_matrix_changes_keep_the_galerkin_intermediates() {
     // Contact, a hyperelastic body, the stiffness assembled every time:
     // GAMG reuses its interpolation and refreshes the products numerically.
