@@ -207,6 +207,27 @@ fn hertz_cylinder_mortar_on_the_krylov_path() {
 }
 
 #[test]
+fn mortar_candidates_cover_a_thin_cylinders_contact_zone_in_one_solve() {
+    // One cell 0.05 thick: the slave facets' shortest edge, the mortar
+    // search's own margin, is a quarter of the step's 0.2 approach, and
+    // the outer part of the contact zone was found only by a second search
+    // after Uzawa had converged on the first candidates (20 Newton, 10
+    // Uzawa). With the step's prescribed motion as the margin: 7 / 4.
+    let scene = "hertz-cylinder, 0.05 thick, mortar";
+    let c = counts(&[
+        "hertz-cylinder",
+        "--set",
+        "mesh.thickness=0.05",
+        "--set",
+        "hertz.thickness=0.05",
+        "--set",
+        "contact.formulation=mortar",
+    ]);
+    within("Newton iterations", scene, c.newton, (6, 9));
+    within("Uzawa iterations", scene, c.uzawa, (3, 5));
+}
+
+#[test]
 fn block_slide_with_friction() {
     // Measured: 60 Newton, 43 Uzawa, 60 GMRES over 20 steps (friction keeps
     // every Newton solve tight; loose ones cost 74 / 63).

@@ -88,6 +88,15 @@ impl Dirichlet {
         }
     }
 
+    /// The largest change of a prescribed displacement component on this
+    /// rank's constrained DOFs from load factor `from` to `to`.
+    pub fn largest_increment(&self, from: f64, to: f64) -> f64 {
+        self.with_amplitude(to)
+            .zip(self.with_amplitude(from))
+            .map(|((d, a), (_, b))| ((a - b) * d.value).abs())
+            .fold(0.0, f64::max)
+    }
+
     /// Replaces constrained residual entries by x − ū(factor).
     pub fn constrain_residual(&self, x: &[f64], r: &mut [f64], factor: f64) {
         for (d, a) in self.with_amplitude(factor) {

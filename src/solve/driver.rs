@@ -320,6 +320,9 @@ impl LoadSteps<'_> {
     fn search_contact(&mut self, target: f64) -> Result<()> {
         if !self.mech.contact.is_empty() {
             let mark = PhaseMark::new(&self.mech.times, self.mech.contact);
+            // The step's prescribed motion: a mortar pair's search margin.
+            let step = self.mech.dirichlet.largest_increment(self.done, target);
+            let [motion] = parallel::max(&self.world, [step]);
             let (mech, x, x_prev) = (&mut self.mech, &self.x, &self.x_prev);
             let offset = self.stepper.as_ref().map(|s| s.slip_offset());
             let searched = self.stages.scope(Phase::ContactSearch, || {
@@ -355,7 +358,9 @@ impl LoadSteps<'_> {
                     mech.extend_slip_rates(offset)?;
                 }
                 mech.with_state(x, |u, pairs| {
-                    let changed = pairs.iter_mut().fold(false, |c, p| p.search(u, target) | c);
+                    let changed = pairs
+                        .iter_mut()
+                        .fold(false, |c, p| p.search(u, target, motion) | c);
                     fault::check(FaultPhase::Search)?;
                     Ok(changed)
                 })

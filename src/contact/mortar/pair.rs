@@ -161,13 +161,22 @@ impl MortarPair {
     /// The search of a load step: every (evaluated slave, master) facet pair
     /// whose bounding boxes, grown by the search distance, meet. Returns
     /// whether the candidates changed.
-    pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
+    ///
+    /// `motion` is the step's largest prescribed displacement (agreed over
+    /// the ranks): the bodies may approach by as much within the step while
+    /// the predicted state has not moved them yet, so the margin is at least
+    /// that (within the links' search distance). With one element size
+    /// alone the graded Hertz line at h_c = b/40 (one cell thick, so its
+    /// facets' shortest edge is the thickness) found the outer third of its
+    /// contact zone only after Uzawa had converged, and solved again.
+    pub fn search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
         if self.rigid.is_some() {
             return self.rigid_search(u_local, factor);
         }
         let x = self.positions(u_local);
         self.reserve = self.nodes_within(&x, self.reach);
-        let candidates = self.facet_pairs(&x, self.search_distance);
+        let margin = self.search_distance.max(motion.min(self.reach));
+        let candidates = self.facet_pairs(&x, margin);
         // Compared by set index: the held master's numbering changes
         // with each exchange.
         let key: Vec<(u32, u32)> = candidates

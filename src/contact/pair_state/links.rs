@@ -148,9 +148,9 @@ impl ContactPair {
     /// node through the spatial index) and inner search (projection onto the
     /// facets around it) for every slave point. Returns true when the coupling
     /// pattern differs from the previous step's.
-    pub fn search(&mut self, u_local: &[f64], factor: f64) -> bool {
+    pub fn search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
         if let Some(m) = &mut self.mortar {
-            return m.search(u_local, factor);
+            return m.search(u_local, factor, motion);
         }
         let nq = self.slave.num_qps();
         let points: Vec<[f64; 3]> = (0..nq)
