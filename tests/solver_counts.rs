@@ -228,6 +228,25 @@ fn mortar_candidates_cover_a_thin_cylinders_contact_zone_in_one_solve() {
 }
 
 #[test]
+fn mortar_candidates_cover_a_thin_cylinder_on_a_rigid_plane_in_one_solve() {
+    // The same against a rigid plane: slave facets 0.02 thick, the
+    // cylinder pushed 0.1 onto the plane in one step. Before the step's
+    // motion was the margin: 11 Newton / 8 Uzawa and a second search.
+    let scene = "hertz-cylinder-rigid, 0.02 thick, mortar";
+    let c = counts(&[
+        "scripts/scenes/hertz-cylinder-rigid.toml",
+        "--set",
+        "mesh.thickness=0.02",
+        "--set",
+        "hertz.thickness=0.02",
+        "--set",
+        "contact.formulation=mortar",
+    ]);
+    within("Newton iterations", scene, c.newton, (6, 9));
+    within("Uzawa iterations", scene, c.uzawa, (3, 5));
+}
+
+#[test]
 fn block_slide_with_friction() {
     // Measured: 60 Newton, 43 Uzawa, 60 GMRES over 20 steps (friction keeps
     // every Newton solve tight; loose ones cost 74 / 63).

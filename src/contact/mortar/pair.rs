@@ -171,7 +171,7 @@ impl MortarPair {
     /// contact zone only after Uzawa had converged, and solved again.
     pub fn search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
         if self.rigid.is_some() {
-            return self.rigid_search(u_local, factor);
+            return self.rigid_search(u_local, factor, motion);
         }
         let x = self.positions(u_local);
         self.reserve = self.nodes_within(&x, self.reach);

@@ -54,10 +54,12 @@ impl MortarPair {
     }
 
     /// The search of a load step: the evaluated facets with a node within
-    /// the search distance of the surface placed at `factor`. Returns
-    /// whether the candidates changed.
-    pub(super) fn rigid_search(&mut self, u_local: &[f64], factor: f64) -> bool {
-        let candidates = self.facets_near_rigid(u_local, factor, self.search_distance);
+    /// the margin (as `search`'s: at least the step's prescribed `motion`)
+    /// of the surface placed at `factor`. Returns whether the candidates
+    /// changed.
+    pub(super) fn rigid_search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
+        let margin = self.search_distance.max(motion.min(self.reach));
+        let candidates = self.facets_near_rigid(u_local, factor, margin);
         let nf = self.facet_type.nodes();
         let mut reserve: Vec<u32> = self
             .facets_near_rigid(u_local, factor, self.reach)
