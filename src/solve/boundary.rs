@@ -123,3 +123,36 @@ impl Dirichlet {
         sums
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dof(owned_index: usize, value: f64) -> ConstrainedDof {
+        ConstrainedDof {
+            owned_index,
+            global: owned_index as i32,
+            value,
+        }
+    }
+
+    #[test]
+    fn largest_increment_follows_each_sets_amplitude() {
+        // Set 0 ramps (a(f) = f), set 1 holds still until f = 0.5 and then
+        // reaches 1 at f = 1.
+        let late = Amplitude::from_table(&[[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]).unwrap();
+        let d = Dirichlet {
+            dofs: vec![dof(0, -0.2), dof(1, 0.05), dof(2, 1.0)],
+            set_of_dof: vec![0, 0, 1],
+            set_names: vec!["top".into(), "side".into()],
+            amplitudes: vec![Amplitude::ramp(), late],
+        };
+        // 0 -> 0.5: only the ramp moves, |−0.2| · 0.5.
+        assert!((d.largest_increment(0.0, 0.5) - 0.1).abs() < 1e-15);
+        // 0.5 -> 1: the late set moves 1.0, the ramp 0.1.
+        assert!((d.largest_increment(0.5, 1.0) - 1.0).abs() < 1e-15);
+        // No step, no motion; none without constrained DOFs.
+        assert_eq!(d.largest_increment(0.7, 0.7), 0.0);
+        assert_eq!(Dirichlet::default().largest_increment(0.0, 1.0), 0.0);
+    }
+}
