@@ -16,10 +16,10 @@
 //! Another MESH.msh (format 4.1) works when it has the same physical names:
 //! volumes `block` and `sphere`, surfaces `block.bottom`, `block.top`,
 //! `sphere.top` and `sphere.curved`.
-use contactlink::fem::{FacetType, Material};
+use contactlink::fem::Material;
 use contactlink::mesh::{read_gmsh, Mesh};
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
-use contactlink::model::{MasterSpec, PairSpec, SlaveQuadrature};
+use contactlink::model::{MasterSpec, PairSpec};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
 use std::path::{Path, PathBuf};
@@ -114,11 +114,12 @@ fn run(rt: &Runtime, path: &Path) -> Result<bool, String> {
                 .sum::<usize>()
         );
         println!(
-            "  contact force on the ball [{:.5}, {:.5}, {:.5}], {} active points, max penetration {:.2e}",
+            "  contact force on the ball [{:.5}, {:.5}, {:.5}], {} active {}, max penetration {:.2e}",
             contact.force[0],
             contact.force[1],
             contact.force[2],
             contact.active_points,
+            contact.active_what,
             contact.max_penetration
         );
         println!(
@@ -152,19 +153,15 @@ fn model(mesh: Mesh) -> Result<Model, String> {
             [0.0, 0.0, -PUSH],
         ),
     ];
-    let mut pair = PairSpec::new(
+    // The default formulation, the mortar: one multiplier per slave node on
+    // quads and triangles alike.
+    let pair = PairSpec::new(
         "sphere-block",
         "sphere.curved",
         MasterSpec::Surface {
             set: "block.top".into(),
         },
     );
-    // Links at the slave nodes on triangles: three Gauss points per
-    // triangle put more constraints on a linear tet surface than it can
-    // meet, and the Uzawa loop stalls.
-    if mesh.cell_type.facet_type() == FacetType::Tri3 {
-        pair.quadrature = SlaveQuadrature::Nodal;
-    }
     let bodies = mesh.bodies.len();
     Ok(Model {
         name: "gmsh_mesh example".into(),

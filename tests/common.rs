@@ -4,6 +4,19 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// `--set contact.formulation=links`: what a test of the links formulation
+/// adds to a scene without `formulation` (the default is the mortar).
+pub const LINKS: [&str; 2] = ["--set", "contact.formulation=links"];
+
+/// `extra` with the links asked for, unless it names a formulation itself.
+pub fn links_unless_set<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = extra.to_vec();
+    if !extra.iter().any(|a| a.starts_with("contact.formulation=")) {
+        args.extend(LINKS);
+    }
+    args
+}
+
 pub fn binary() -> &'static str {
     env!("CARGO_BIN_EXE_contactlink")
 }

@@ -20,9 +20,12 @@ fn dataset(path: &Path, step: usize, rel: &str) -> Vec<f64> {
         .0
 }
 
+/// Runs `scene` with the links formulation unless `extra` names another:
+/// this file checks the links end to end (tests/mortar*.rs the mortar, the
+/// default).
 fn run_scene(ranks: usize, scene: &str, out: &Path, extra: &[&str]) -> String {
     let mut args = vec!["run", scene, "-o", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    args.extend(links_unless_set(extra));
     let o = mpirun(ranks, &args);
     let t = text(&o);
     assert!(o.status.success(), "{scene} on {ranks} ranks failed:\n{t}");

@@ -8,9 +8,12 @@ use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
 use std::collections::HashMap;
 use std::path::Path;
 
+/// Runs `scene` with the links formulation unless `extra` names another:
+/// this file checks the links' friction and dynamics end to end
+/// (tests/mortar_friction.rs the mortar's, the default).
 fn run_scene(ranks: usize, scene: &str, out: &Path, extra: &[&str]) -> String {
     let mut args = vec!["run", scene, "-q", "-o", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    args.extend(links_unless_set(extra));
     let o = mpirun(ranks, &args);
     let t = text(&o);
     assert!(o.status.success(), "{scene} on {ranks} ranks failed:\n{t}");
@@ -249,6 +252,8 @@ fn slip_heavy_step_that_cannot_converge_reports_its_link_states() {
             "solver.max_newton=2",
             "--set",
             "solver.max_cutbacks=0",
+            LINKS[0],
+            LINKS[1],
         ],
     );
     let t = text(&o);

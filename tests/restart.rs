@@ -40,12 +40,13 @@ fn field(path: &Path, step: usize, name: &str) -> Vec<f64> {
 }
 
 /// Runs `scene` whole, cuts the file after `keep` steps, continues from it
-/// on `ranks` ranks and compares the last steps.
+/// on `ranks` ranks and compares the last steps. With the links unless
+/// `extra` names a formulation (tests/restart_mortar.rs: the mortar's).
 fn continued_run_matches(scene: &str, extra: &[&str], keep: usize, ranks: usize, pair: &str) {
     let dir = scratch(&format!("restart-{scene}-{ranks}"));
     let full = dir.join("full.h5");
     let mut args = vec!["run", scene, "-q", "-o", full.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    args.extend(links_unless_set(extra));
     run_ok(1, &args);
     let steps = list_steps(&full).unwrap();
     let last = *steps.last().unwrap();
@@ -57,7 +58,7 @@ fn continued_run_matches(scene: &str, extra: &[&str], keep: usize, ranks: usize,
     let cut = cut_after(&full, keep, "cut.h5");
     let cont = dir.join("continued.h5");
     let mut args = vec!["run", scene, "-q", "-o", cont.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    args.extend(links_unless_set(extra));
     args.extend_from_slice(&["--restart", cut.to_str().unwrap()]);
     run_ok(ranks, &args);
 

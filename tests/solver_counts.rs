@@ -7,8 +7,10 @@
 //!
 //! Counts are summed over the steps of one serial run (`-v` step lines and
 //! the summary's solver line). Small meshes only: the whole file runs in
-//! seconds.
+//! seconds. Each scene is pinned with the links (`LINKS`, their counts
+//! since these pins were set) and with the mortar, the default.
 mod common;
+use common::LINKS;
 
 /// What one run did, summed over its steps.
 #[derive(Debug, Default)]
@@ -109,11 +111,49 @@ const NO_SCHUR: [&str; 2] = ["--set", "solver.contact_schur=false"];
 fn hertz_cylinder_schur() {
     // Measured: 13 Newton, 7 Uzawa (the Uzawa rate rule raises the penalty
     // once; without it 14 and 11), 13 exact solves; bulk factored once.
-    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.4"];
+    let args = [
+        "hertz-cylinder",
+        "--set",
+        "mesh.fine_size=0.4",
+        LINKS[0],
+        LINKS[1],
+    ];
     schur_path("hertz-cylinder h = 0.4, Schur", &args, (11, 15), (6, 8));
-    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.2"];
+    let args = [
+        "hertz-cylinder",
+        "--set",
+        "mesh.fine_size=0.2",
+        LINKS[0],
+        LINKS[1],
+    ];
     schur_path("hertz-cylinder h = 0.2, Schur", &args, (6, 9), (3, 6));
-    schur_path("patch-test, Schur", &["patch-test"], (5, 8), (3, 6));
+    schur_path(
+        "patch-test, Schur",
+        &["patch-test", LINKS[0], LINKS[1]],
+        (5, 8),
+        (3, 6),
+    );
+}
+
+#[test]
+fn mortar_hertz_cylinder_schur() {
+    // The default formulation. Measured: h = 0.4 7 Newton, 4 Uzawa; h = 0.2
+    // 6 / 4; the patch test 5 / 5; bulk factored once each.
+    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.4"];
+    schur_path(
+        "hertz-cylinder h = 0.4, mortar, Schur",
+        &args,
+        (6, 9),
+        (3, 5),
+    );
+    let args = ["hertz-cylinder", "--set", "mesh.fine_size=0.2"];
+    schur_path(
+        "hertz-cylinder h = 0.2, mortar, Schur",
+        &args,
+        (5, 8),
+        (3, 5),
+    );
+    schur_path("patch-test, mortar, Schur", &["patch-test"], (4, 7), (4, 6));
 }
 
 #[test]
@@ -129,6 +169,7 @@ fn hertz_cylinder_coarse() {
         &[
             &["hertz-cylinder", "--set", "mesh.fine_size=0.4"][..],
             &NO_SCHUR,
+            &LINKS,
         ]
         .concat(),
     );
@@ -149,6 +190,7 @@ fn hertz_cylinder_medium() {
         &[
             &["hertz-cylinder", "--set", "mesh.fine_size=0.2"][..],
             &NO_SCHUR,
+            &LINKS,
         ]
         .concat(),
     );
@@ -171,26 +213,24 @@ fn hertz_cylinder_coarse_on_the_krylov_path() {
     // Eisenstat–Walker cap and the kept hierarchy the step was cut back 8
     // times and the run failed at load factor 0.996 (30 Newton iterations
     // without convergence).
-    coarse_krylov_cylinder("", [(12, 19), (5, 7), (110, 150), (1, 1)]);
+    coarse_krylov_cylinder("links", [(12, 19), (5, 7), (110, 150), (1, 1)]);
 }
 
-/// hertz-cylinder h = 0.4 on GMRES + GAMG (serial) with `formulation` ("":
-/// the default) in one step without cutback, its Newton, Uzawa and linear
+/// hertz-cylinder h = 0.4 on GMRES + GAMG (serial) with `formulation` in
+/// one step without cutback, its Newton, Uzawa and linear
 /// iterations and preconditioner builds within `bands`.
 fn coarse_krylov_cylinder(formulation: &str, bands: [(usize, usize); 4]) {
     let scene = format!("hertz-cylinder h = 0.4, {formulation} GMRES + GAMG");
     let set = format!("contact.formulation={formulation}");
-    let mut args = vec![
+    let c = counts(&[
         "hertz-cylinder",
         "--set",
         "mesh.fine_size=0.4",
         "--set",
         "solver.direct_max_dofs=0",
-    ];
-    if !formulation.is_empty() {
-        args.extend(["--set", set.as_str()]);
-    }
-    let c = counts(&args);
+        "--set",
+        &set,
+    ]);
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", &scene, c.newton, bands[0]);
     within("Uzawa iterations", &scene, c.uzawa, bands[1]);
@@ -247,7 +287,7 @@ fn block_slide_with_friction() {
     // Measured: 60 Newton, 43 Uzawa, 60 GMRES over 20 steps (friction keeps
     // every Newton solve tight; loose ones cost 74 / 63).
     let scene = "block-slide";
-    let c = counts(&["block-slide"]);
+    let c = counts(&["block-slide", LINKS[0], LINKS[1]]);
     assert_eq!((c.steps, c.cutbacks), (20, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (55, 66));
     within("Uzawa iterations", scene, c.uzawa, (38, 48));
@@ -263,7 +303,7 @@ fn patch_test() {
     // Measured: 6 Newton, 5 Uzawa, 32 GMRES, one factorisation kept for the
     // whole step (before: 9, 4, 29).
     let scene = "patch-test";
-    let c = counts(&[&["patch-test"][..], &NO_SCHUR].concat());
+    let c = counts(&[&["patch-test"][..], &NO_SCHUR, &LINKS].concat());
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (5, 8));
     within("Uzawa iterations", scene, c.uzawa, (3, 6));
@@ -277,7 +317,7 @@ fn block_on_a_rigid_plane() {
     // active-set watch stays off and SNES's own lag decides. Measured: 12
     // Newton, 10 Uzawa, 28 GMRES over 2 steps (before: 16, 8, 26).
     let scene = "block-on-plane";
-    let c = counts(&["block-on-plane"]);
+    let c = counts(&["block-on-plane", LINKS[0], LINKS[1]]);
     assert_eq!((c.steps, c.cutbacks), (2, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (10, 14));
     within("Uzawa iterations", scene, c.uzawa, (8, 12));
@@ -302,6 +342,8 @@ fn tight_switches_restore_the_old_counts() {
         "solver.uzawa_forcing=0",
         "--set",
         "solver.lag_active_set=false",
+        LINKS[0],
+        LINKS[1],
     ]);
     within("Newton iterations", scene, c.newton, (18, 22));
     assert_eq!(c.builds, 0, "{scene}: the watch ran while switched off");
@@ -319,7 +361,76 @@ fn consistent_first_contact_tangent_restores_the_old_counts() {
         "mesh.fine_size=0.2",
         "--set",
         "solver.first_contact_main_tangent=false",
+        LINKS[0],
+        LINKS[1],
     ]);
     assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
     within("Newton iterations", scene, c.newton, (8, 11));
+}
+
+#[test]
+fn mortar_main_scenes() {
+    // The default formulation on the factor-per-rebuild path and on the
+    // frictional and hyperelastic scenes. Measured: hertz-cylinder h = 0.4
+    // 7 Newton, 4 Uzawa, 18 GMRES, 5 factorisations; the patch test 5 / 5 /
+    // 5 / 1; block-slide 59 / 44 / 59 over 20 steps; block-on-plane 12 /
+    // 10 / 28 over 2 steps.
+    let scene = "hertz-cylinder h = 0.4, mortar";
+    let args = [
+        &["hertz-cylinder", "--set", "mesh.fine_size=0.4"][..],
+        &NO_SCHUR,
+    ]
+    .concat();
+    let c = counts(&args);
+    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
+    within("Newton iterations", scene, c.newton, (6, 9));
+    within("Uzawa iterations", scene, c.uzawa, (3, 5));
+    within("linear iterations", scene, c.ksp, (12, 28));
+    within("preconditioner builds", scene, c.builds, (3, 7));
+    let scene = "patch-test, mortar";
+    let c = counts(&[&["patch-test"][..], &NO_SCHUR].concat());
+    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
+    within("Newton iterations", scene, c.newton, (4, 7));
+    within("Uzawa iterations", scene, c.uzawa, (4, 6));
+    within("linear iterations", scene, c.ksp, (4, 10));
+    within("preconditioner builds", scene, c.builds, (1, 2));
+    let scene = "block-slide, mortar";
+    let c = counts(&["block-slide"]);
+    assert_eq!((c.steps, c.cutbacks), (20, 0), "{scene}: {c:?}");
+    within("Newton iterations", scene, c.newton, (54, 65));
+    within("Uzawa iterations", scene, c.uzawa, (40, 49));
+    within("linear iterations", scene, c.ksp, (50, 75));
+    let scene = "block-on-plane, mortar";
+    let c = counts(&["block-on-plane"]);
+    assert_eq!((c.steps, c.cutbacks), (2, 0), "{scene}: {c:?}");
+    within("Newton iterations", scene, c.newton, (10, 14));
+    within("Uzawa iterations", scene, c.uzawa, (8, 12));
+    within("linear iterations", scene, c.ksp, (20, 40));
+}
+
+#[test]
+fn mortar_levers_off_and_consistent_first_tangent() {
+    // Both levers off, mortar, h = 0.4: 16 Newton where the default takes
+    // 7; the full consistent tangent in the first Uzawa iteration, h = 0.2:
+    // 11 where the default takes 6.
+    let scene = "hertz-cylinder h = 0.4, mortar, levers off";
+    let c = counts(&[
+        "hertz-cylinder",
+        "--set",
+        "mesh.fine_size=0.4",
+        "--set",
+        "solver.uzawa_forcing=0",
+        "--set",
+        "solver.lag_active_set=false",
+    ]);
+    within("Newton iterations", scene, c.newton, (14, 18));
+    let scene = "hertz-cylinder h = 0.2, mortar, consistent first tangent";
+    let c = counts(&[
+        "hertz-cylinder",
+        "--set",
+        "mesh.fine_size=0.2",
+        "--set",
+        "solver.first_contact_main_tangent=false",
+    ]);
+    within("Newton iterations", scene, c.newton, (10, 13));
 }

@@ -87,14 +87,25 @@ fn runs_whose_matrix_changes_keep_the_galerkin_intermediates() {
 
 #[test]
 fn an_iterative_contact_run_caps_the_eisenstat_walker_forcing() {
-    // GMRES + GAMG with contact: Eisenstat–Walker, never looser than 0.1.
+    // GMRES + GAMG with a links pair: Eisenstat–Walker, never looser than
+    // 0.1 (a mortar pair solves GMRES to a fixed 1e-4 instead).
+    let t = option_table(&[
+        "scenes/block-on-plane.toml",
+        "--set",
+        "solver.direct_max_dofs=0",
+        "--set",
+        "contact.formulation=links",
+    ]);
+    assert!(t.contains("-snes_ksp_ew true"), "{t}");
+    assert!(t.contains("-snes_ksp_ew_rtolmax 0.1"), "{t}");
+    // The mortar, the default: GMRES to a fixed 1e-4, no Eisenstat–Walker.
     let t = option_table(&[
         "scenes/block-on-plane.toml",
         "--set",
         "solver.direct_max_dofs=0",
     ]);
-    assert!(t.contains("-snes_ksp_ew true"), "{t}");
-    assert!(t.contains("-snes_ksp_ew_rtolmax 0.1"), "{t}");
+    assert!(!t.contains("-snes_ksp_ew"), "{t}");
+    assert!(t.contains("-ksp_rtol 1e-4"), "{t}");
     // The direct path solves each Newton step to 1e-10 around the factors.
     let t = option_table(&["scenes/block-on-plane.toml"]);
     assert!(!t.contains("-snes_ksp_ew"), "{t}");

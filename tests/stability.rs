@@ -16,13 +16,15 @@ const PUSH: f64 = 0.01;
 const H_SLAVE: f64 = 1.0 / 3.0;
 const PENETRATION_TOL: f64 = 1e-3;
 
-/// Runs the patch test with `extra` overrides; returns the last step's
+/// Runs the patch test with `extra` overrides (with the links, whose
+/// figures docs/scaling.md tabulates, unless `extra` names a formulation);
+/// returns the last step's
 /// normal contact force and the iteration counts (Newton, Uzawa).
 fn patch(name: &str, extra: &[&str]) -> (f64, usize, usize) {
     let dir = scratch(&format!("stability-{name}"));
     let out = dir.join("p.h5");
     let mut args = vec!["run", "patch-test", "-q", "-o", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    args.extend(links_unless_set(extra));
     let o = mpirun(1, &args);
     let t = text(&o);
     assert!(o.status.success(), "{name}: did not converge:\n{t}");

@@ -72,6 +72,7 @@ pub const PAIR_HISTORY_IDS: &str = "history_ids";
 /// ...mortar nodal fields (mesh-node rows)...
 pub const PAIR_NODE_LAMBDA: &str = "node_lambda";
 pub const PAIR_NODE_WEIGHTED_GAP: &str = "node_weighted_gap";
+pub const PAIR_NODE_AREA: &str = "node_area";
 pub const PAIR_NODE_TRACTION: &str = "node_traction";
 /// A frictional mortar pair's history for `--restart` (N,3): λT_j, and
 /// where the next step measures slip from (the pair nodes' positions).

@@ -150,8 +150,8 @@ impl Hdf5Sink {
 
 impl Hdf5Sink {
     /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
-    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_traction`
-    /// and, with friction, `node_lambda_t` and `node_slip_origin`.
+    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_area`,
+    /// `node_traction` and, with friction, `node_lambda_t` and `node_slip_origin`.
     fn write_mortar_nodes(
         &mut self,
         step: usize,
@@ -166,6 +166,7 @@ impl Hdf5Sink {
         let mut fields = vec![
             (layout::PAIR_NODE_LAMBDA, 1, &m.lambda),
             (layout::PAIR_NODE_WEIGHTED_GAP, 1, &m.weighted_gap),
+            (layout::PAIR_NODE_AREA, 1, &m.area),
             (layout::PAIR_NODE_TRACTION, 3, &traction),
         ];
         if let (Some(l), Some(o)) = (&lambda_t, &origin) {

@@ -86,6 +86,17 @@ pub struct PairPoints {
     pub weight: Option<Vec<f64>>,
     /// Total contact force on the slave surface.
     pub force: [f64; 3],
+    /// A mortar pair's active slave nodes (λ_j > 0), the constraints its
+    /// Uzawa loop counts; None for a links pair, whose points are those.
+    pub active_nodes: Option<ActiveNodes>,
+}
+
+/// A mortar pair's active slave nodes: how many, and the slave area they
+/// carry, Σ A_j (NaN in files written before `node_area` was).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ActiveNodes {
+    pub count: usize,
+    pub area: f64,
 }
 
 impl PairPoints {
@@ -112,11 +123,28 @@ impl PairPoints {
                 ),
             ));
         }
+        let active_nodes = if has_dataset(path, step, &rel(layout::PAIR_NODE_LAMBDA)) {
+            let (lambda, _, _) = read_nodal(path, step, &rel(layout::PAIR_NODE_LAMBDA))?;
+            let area = if has_dataset(path, step, &rel(layout::PAIR_NODE_AREA)) {
+                let (a, _, _) = read_nodal(path, step, &rel(layout::PAIR_NODE_AREA))?;
+                let active = lambda.iter().zip(&a).filter(|(&l, _)| l > 0.0);
+                active.map(|(_, a)| a).sum()
+            } else {
+                f64::NAN
+            };
+            Some(ActiveNodes {
+                count: lambda.iter().filter(|&&l| l > 0.0).count(),
+                area,
+            })
+        } else {
+            None
+        };
         Ok(PairPoints {
             points: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
             pressure,
             weight: weight.map(|(w, _)| w),
             force: [force[0], force[1], force[2]],
+            active_nodes,
         })
     }
 

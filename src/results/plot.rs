@@ -394,6 +394,7 @@ mod tests {
             pressure,
             weight: None,
             force: [0.0, 0.0, 10.0],
+            active_nodes: None,
         }
     }
 

@@ -14,7 +14,8 @@ pub struct PairRow {
     pub force: [f64; 3],
     /// Σ pN·w (NaN when the file has no point weights).
     pub normal: f64,
-    /// Σ w over points with pN > 0 (NaN when the file has no point weights).
+    /// Σ w over points with pN > 0 (NaN when the file has no point
+    /// weights); a mortar pair: Σ A_j = ∫ N_j dA over its active slave nodes.
     pub area: f64,
     /// Largest nodal contact pressure on the pair's slave nodes: the field
     /// `run`'s Hertz comparison fits (NaN when the file lacks the
@@ -23,6 +24,9 @@ pub struct PairRow {
     /// Largest multiplier λN at a quadrature point. The point values of an
     /// over-constrained slave surface oscillate; their nodal sums do not.
     pub max_point_pressure: f64,
+    /// Active contact points (links) or active slave nodes (mortar: its
+    /// point values are interpolated from the nodes, so a point next to an
+    /// active node is positive without being a constraint).
     pub active: usize,
 }
 
@@ -77,6 +81,10 @@ fn pair_row(
         ),
         None => (f64::NAN, f64::NAN),
     };
+    // A mortar pair's point values are interpolated from its nodes, so
+    // every point of a facet with an active corner is positive: its area
+    // is that of the active nodes.
+    let area = p.active_nodes.map_or(area, |n| n.area);
     Ok(PairRow {
         name,
         force: p.force,
@@ -84,7 +92,7 @@ fn pair_row(
         area,
         max_pressure,
         max_point_pressure: p.pressure.iter().copied().fold(0.0, f64::max),
-        active: active.len(),
+        active: p.active_nodes.map_or(active.len(), |n| n.count),
     })
 }
 

@@ -169,13 +169,17 @@ pub(super) fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 
 /// The pair's `formulation`, checked against what the mortar formulation
 /// supports (quad4 or tri3 facets; a master facet set or a rigid surface).
+/// Without the key a pair is a mortar pair, unless it sets `quadrature`,
+/// which only places links' points: then it asked for links.
 pub(super) fn formulation(
     mesh: &Mesh,
     c: &ContactSection,
     at: &str,
 ) -> std::result::Result<Formulation, String> {
     let f = match c.formulation.as_deref() {
-        None | Some("links") => return Ok(Formulation::Links),
+        None if c.quadrature.is_some() => return Ok(Formulation::Links),
+        Some("links") => return Ok(Formulation::Links),
+        None => Formulation::default(),
         Some("mortar") => Formulation::Mortar,
         Some(other) => {
             return Err(format!(

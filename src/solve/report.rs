@@ -7,6 +7,7 @@ use crate::contact::pair_state::PairForce;
 use crate::contact::{ContactPair, UzawaStats};
 use crate::dofs::DofMap;
 use crate::error::Result;
+use crate::model::Formulation;
 use crate::parallel;
 use crate::petsc::Vector;
 use mpi::traits::*;
@@ -21,7 +22,10 @@ pub struct ContactReport {
     pub normal_force: f64,
     pub tangential_force: f64,
     pub max_penetration: f64,
+    /// Active points (links) or active slave nodes (mortar).
     pub active_points: usize,
+    /// What `active_points` counts: "points" or "nodes".
+    pub active_what: &'static str,
     /// Active points that slide (friction).
     pub sliding_points: usize,
     pub penalty: f64,
@@ -131,6 +135,10 @@ pub(super) fn contact_reports(
                 tangential_force: total.tangential,
                 max_penetration: s.max_penetration,
                 active_points: s.active,
+                active_what: match p.spec.formulation {
+                    Formulation::Links => "points",
+                    Formulation::Mortar => "nodes",
+                },
                 sliding_points: s.sliding,
                 penalty: p.penalty,
             }
@@ -178,8 +186,8 @@ pub(super) fn print_step(s: &StepReport) {
     }
     for c in &s.contact {
         println!(
-            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], normal {:.6e}, tangential {:.6e}, {} active points ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
-            c.name, c.force[0], c.force[1], c.force[2], c.normal_force, c.tangential_force, c.active_points, c.sliding_points, c.max_penetration, c.penalty
+            "     contact {}: force [{:.6e}, {:.6e}, {:.6e}], normal {:.6e}, tangential {:.6e}, {} active {} ({} sliding), max penetration {:.3e} h, penalty {:.3e}",
+            c.name, c.force[0], c.force[1], c.force[2], c.normal_force, c.tangential_force, c.active_points, c.active_what, c.sliding_points, c.max_penetration, c.penalty
         );
         if let Some([min, max, received, whole]) = c.master_held {
             println!(

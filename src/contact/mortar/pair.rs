@@ -32,6 +32,9 @@ pub struct NodeFields {
     pub lambda: Vec<f64>,
     /// Weighted gaps g̃_j = ∫ Φ_j g dA.
     pub weighted_gap: Vec<f64>,
+    /// The slave area each node carries, A_j = ∫ N_j dA (reference): Σ
+    /// over the active nodes is the contact area.
+    pub area: Vec<f64>,
     /// Contact traction on the slave at the node: −λ_j ν_j − λT_j, ν_j the
     /// D-weighted mean of its segments' normals (λT_j = 0 frictionless).
     pub traction: Vec<[f64; 3]>,

@@ -81,6 +81,7 @@ impl MortarPair {
         let mut out = NodeFields {
             lambda: vec![0.0; n],
             weighted_gap: vec![0.0; n],
+            area: vec![0.0; n],
             traction: vec![[0.0; 3]; n],
             lambda_t: self.friction.as_ref().map(|_| vec![[0.0; 3]; n]),
             // Every owned node of either surface (held here or not): where
@@ -103,6 +104,7 @@ impl MortarPair {
             }
             out.lambda[l] = self.nodal.lambda[j];
             out.weighted_gap[l] = states[j].weighted_gap;
+            out.area[l] = self.nodal.area[j];
             if let Some(lt) = &mut out.lambda_t {
                 lt[l] = *lambda_t(j);
             }
