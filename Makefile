@@ -163,9 +163,9 @@ ironing: build
 # ratio |Fx|/|Fz| over the drag (mean, max - min, std) side by side.
 ironing-compare: build
 	@mkdir -p out
-	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing.h5
+	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing-links.h5 --set contact.formulation=links
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing-mortar.h5 --set contact.formulation=mortar
-	$(PYTHON) scripts/ironing_ratio.py out/ironing.csv out/ironing-mortar.csv
+	$(PYTHON) scripts/ironing_ratio.py out/ironing-links.csv out/ironing-mortar.csv
 
 # Mortar against links on the same scenes, alternated, median of REPEATS
 # runs each, 1 rank (the mortar cost table of docs/performance.md).

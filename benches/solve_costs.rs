@@ -5,7 +5,7 @@
 //! The contact solves are the `hertz-cylinder` scene as shipped (one load
 //! step, Uzawa around Newton, sparse direct solver) at two sizes and
 //! `hertz-sphere` at h = 0.35 (97,803 DOFs, GMRES + GAMG; timed once, with
-//! the links and with a mortar pair). The
+//! the default mortar pair and with the links). The
 //! plain solve uses the same mesh, materials, conditions and solver without
 //! the contact pair: one linear-elastic step. Both are timed in this one
 //! process (median of 3, slowest rank), so the ratio does not depend on the
@@ -141,11 +141,11 @@ fn main() {
             1,
         ));
         cases.push((
-            "sphere h=0.35 mortar",
+            "sphere h=0.35 links",
             "hertz-sphere",
             vec![
                 "mesh.fine_size=0.35".to_string(),
-                "contact.formulation=mortar".to_string(),
+                "contact.formulation=links".to_string(),
             ],
             1,
         ));

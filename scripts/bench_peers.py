@@ -32,8 +32,8 @@ For each size the script
      slope 10 E / h_c, and runs `ccx` on one thread (OMP_NUM_THREADS=1);
   3. fits the Hertz profile p^2 = p0^2 (1 - s^2/w^2) to each code's contact
      pressures (the fit contactlink itself reports: least squares in
-     (s^2, p^2) over the inner 90 % of the loaded zone; contactlink's contact
-     points, CalculiX's CPRESS at the slave nodes) and compares p0 and the
+     (s^2, p^2) over the inner 90 % of the loaded zone; contactlink's nodal
+     contact pressures, CalculiX's CPRESS at the slave nodes) and compares p0 and the
      half-width b (line) or radius a (sphere) with Hertz for the load each
      code's reaction force gives;
 

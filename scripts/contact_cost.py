@@ -9,7 +9,8 @@ turn, REPEATS times (default 3), and prints one markdown row per case: DOFs,
 ranks, path, the medians of the solve seconds of the `done:` lines, their
 ratio, the per-round ratios, and the contact run's Newton / Uzawa / linear
 iterations. CASE names (prefixes of the names below) select cases ("line b"
-the links' line cases, "line mortar" the same meshes with a mortar pair). The line
+the links' line cases, "line mortar" the same meshes with a mortar pair, the
+default formulation; cases without "mortar" in their name ask for the links). The line
 cases read the graded meshes that `python3 scripts/bench_peers.py --cases
 line --dry-run --out DIR` writes (DIR defaults to /tmp/lines). Several ranks
 run under mpirun (as root with --allow-run-as-root).
@@ -22,6 +23,7 @@ import sys
 
 SPHERE = ["--set", "mesh.fine_size=0.35"]
 SPHERE_DIRECT = SPHERE + ["--set", "solver.direct_max_dofs=200000"]
+LINKS = ["--set", "contact.formulation=links"]
 PLAIN_SPHERE = "scripts/scenes/sphere-no-contact.toml"
 
 
@@ -30,9 +32,8 @@ def cases(lines):
     for ranks in (1, 2):
         for b in (5, 10, 20, 40):
             out.append((f"line b/{b}", ranks, "direct",
-                        [f"{lines}/line-b{b}-plain.toml"], [f"{lines}/line-b{b}.toml"]))
-    # The same meshes with a mortar pair (what the default formulation
-    # would cost on the direct path if it were the mortar).
+                        [f"{lines}/line-b{b}-plain.toml"], [f"{lines}/line-b{b}.toml", *LINKS]))
+    # The same meshes with a mortar pair (the default formulation).
     for ranks in (1, 2):
         for b in (5, 10, 20, 40):
             out.append((f"line mortar b/{b}", ranks, "direct",
@@ -40,15 +41,15 @@ def cases(lines):
                         [f"{lines}/line-b{b}.toml", "--set", "contact.formulation=mortar"]))
     for ranks in (1, 2):
         out.append(("sphere h=0.35", ranks, "Krylov",
-                    [PLAIN_SPHERE, *SPHERE], ["hertz-sphere", *SPHERE]))
+                    [PLAIN_SPHERE, *SPHERE], ["hertz-sphere", *SPHERE, *LINKS]))
     out.append(("sphere h=0.35 mortar", 2, "Krylov",
                 [PLAIN_SPHERE, *SPHERE],
                 ["hertz-sphere", *SPHERE, "--set", "contact.formulation=mortar"]))
     out.append(("sphere h=0.35", 2, "direct",
-                [PLAIN_SPHERE, *SPHERE_DIRECT], ["hertz-sphere", *SPHERE_DIRECT]))
+                [PLAIN_SPHERE, *SPHERE_DIRECT], ["hertz-sphere", *SPHERE_DIRECT, *LINKS]))
     # The built-in sphere's own mesh (h = 0.25, 167,013 DOFs), links and mortar.
     for ranks in (1, 2):
-        out.append(("sphere default", ranks, "Krylov", [PLAIN_SPHERE], ["hertz-sphere"]))
+        out.append(("sphere default", ranks, "Krylov", [PLAIN_SPHERE], ["hertz-sphere", *LINKS]))
         out.append(("sphere default mortar", ranks, "Krylov", [PLAIN_SPHERE],
                     ["hertz-sphere", "--set", "contact.formulation=mortar"]))
     return out

@@ -450,6 +450,31 @@ fn bad_formulation_is_a_scene_error_naming_the_line() {
     }
 }
 
+/// A pair without `formulation` is a mortar pair (nodal multipliers in the
+/// file); one that sets `quadrature`, which places links, is a links pair.
+#[test]
+fn the_default_is_the_mortar_unless_the_pair_places_links() {
+    let dir = scratch("mortar-default");
+    for (extra, mortar) in [
+        (&[][..], true),
+        (&["--set", "contact.quadrature=nodal"][..], false),
+        (&["--set", "contact.formulation=links"][..], false),
+    ] {
+        let out = dir.join("p.h5");
+        let mut args = vec!["run", "patch-test", "-q", "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{extra:?}: {}", text(&o));
+        let step = *list_steps(&out).unwrap().last().unwrap();
+        let nodal = layout::pair_dataset("interface", layout::PAIR_NODE_LAMBDA);
+        assert_eq!(
+            read_nodal(&out, step, &nodal).is_ok(),
+            mortar,
+            "{extra:?}: node_lambda present should be {mortar}"
+        );
+    }
+}
+
 /// The hertz-cylinder (h = 0.2) in one load step with the mortar pair's
 /// search margin cut to 0.01: the step's search, at the undeformed state,
 /// then finds master facets for the slave facets within 0.01 of the block
