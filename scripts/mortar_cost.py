@@ -28,6 +28,8 @@ SCENES = [
     ("patch-test", ["patch-test"]),
     ("block-slide-stacked", ["scripts/scenes/block-slide-stacked.toml"]),
     ("ironing", ["ironing"]),
+    ("sphere-block (tet4, Gmsh)", ["scenes/sphere-block.toml"]),
+    ("impact (dynamics)", ["impact"]),
 ]
 
 

@@ -571,6 +571,28 @@ pub fn facet_size<T: Scalar>(x: &[Vec3<T>]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// How far apart, in clipping tolerances, two projected facets' bounding
+/// boxes must be for [`overlap`] to skip the clip. The clip keeps points
+/// within the tolerance outside each master edge, which near a master
+/// corner of angle θ reaches tol / sin(θ/2) beyond the box (5.8 tol at θ =
+/// 20°); 1e3 leaves any facet a valid mesh has inside the margin.
+pub(super) const BOX_MARGIN: f64 = 1e3;
+
+/// Whether the bounding boxes of two projected facets are more than `tol`
+/// apart in some direction: then their clipped overlap is empty.
+pub(super) fn boxes_apart<T: Scalar>(a: &[Vec2<T>], b: &[Vec2<T>], tol: f64) -> bool {
+    let bounds = |p: &[Vec2<T>], k: usize| {
+        p.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v[k].re()), hi.max(v[k].re()))
+            })
+    };
+    (0..2).any(|k| {
+        let ((alo, ahi), (blo, bhi)) = (bounds(a, k), bounds(b, k));
+        alo > bhi + tol || blo > ahi + tol
+    })
+}
+
 /// Projects and clips a slave and a master facet (current positions). `None`
 /// when they do not overlap (or the geometry is degenerate: a slave facet
 /// without normal, a master projected edge-on or folded).
@@ -590,8 +612,17 @@ pub fn overlap<T: Scalar>(
     for (o, x) in master_nodes.iter_mut().zip(xm).take(master_type.nodes()) {
         *o = plane.coordinates(x);
     }
-    let subject = Polygon::from_points(&slave_nodes[..slave_type.nodes()]).counter_clockwise();
-    let clipper = Polygon::from_points(&master_nodes[..master_type.nodes()]).counter_clockwise();
+    let (slave_2d, master_2d) = (
+        &slave_nodes[..slave_type.nodes()],
+        &master_nodes[..master_type.nodes()],
+    );
+    if boxes_apart(slave_2d, master_2d, BOX_MARGIN * tol) {
+        // Most candidates of a slave facet lie beside it: their clip would
+        // be empty, at the cost of orienting and clipping.
+        return None;
+    }
+    let subject = Polygon::from_points(slave_2d).counter_clockwise();
+    let clipper = Polygon::from_points(master_2d).counter_clockwise();
     let area_tol = tol * facet_size(xs);
     if !clipper.is_convex_ccw(area_tol) || clipper.signed_area().re() <= area_tol {
         return None;

@@ -1,5 +1,7 @@
 //! Geometry, dual basis and the consistency of the mortar tangent.
-use super::geometry::{clip, inverse_map, overlap, shape_values, Plane, Polygon};
+use super::geometry::{
+    boxes_apart, clip, inverse_map, overlap, shape_values, Plane, Polygon, BOX_MARGIN, GEOMETRY_TOL,
+};
 use super::segment::{dual_coefficients, dual_values, segment_terms, MortarRules};
 use super::system::{
     node_states, residual, segments, tangent, weighted_gaps, Interface, NodalData, Segment,
@@ -527,4 +529,48 @@ fn main_part_is_the_tangent_along_the_normal_of_master_nodes() {
             }
         }
     }
+}
+
+/// The bounding-box early-out of `overlap` drops only pairs whose clip is
+/// empty: a unit square against a sharp (20°) triangle and a square slid
+/// past each of its sides and corners, down to a tenth of the clipping
+/// tolerance apart and overlapping by as little.
+#[test]
+fn box_early_out_skips_only_empty_clips() {
+    let slave = Polygon::from_points(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    let tol = GEOMETRY_TOL;
+    let sharp = |x: f64, y: f64| {
+        let (c, s) = (20f64.to_radians().cos(), 20f64.to_radians().sin());
+        vec![
+            [x, y],
+            [x + 0.5 * c, y + 0.5 * s],
+            [x + 0.5 * c, y - 0.5 * s],
+        ]
+    };
+    let square = |x: f64, y: f64| vec![[x, y], [x + 0.4, y], [x + 0.4, y + 0.4], [x, y + 0.4]];
+    let gaps = [-1e-10, 1e-10, 1e-9, 3e-9, 1e-8, 1e-7, 1e-6, 1e-3, 0.1];
+    let (mut skipped, mut kept) = (0, 0);
+    for &g in &gaps {
+        for corners in [
+            sharp(1.0 + g, 0.5),
+            sharp(1.0 + g, 1.0 + g),
+            square(1.0 + g, 0.3),
+            square(-0.4 - g, -0.4 - g),
+            square(0.3, 1.0 + g),
+        ] {
+            let master = Polygon::from_points(&corners).counter_clockwise();
+            if !boxes_apart(slave.points(), master.points(), BOX_MARGIN * tol) {
+                kept += 1;
+                continue;
+            }
+            skipped += 1;
+            let clipped = clip(&slave, &master, tol);
+            assert!(
+                clipped.len < 3 || clipped.signed_area() <= tol,
+                "gap {g:e}: skipped a clip of area {}",
+                clipped.signed_area()
+            );
+        }
+    }
+    assert!(skipped > 0 && kept > 0, "skipped {skipped}, kept {kept}");
 }
