@@ -196,9 +196,10 @@ fn partial_factorisations() {
     let d = pc.dense_counts();
     // The first and the indefinite one whole (LDLᵀ); the others on a
     // trailing block: the second touched the last 4 of the 12 DOFs (split
-    // at 4, room to double), the third reached 6 and the fifth kept it.
-    assert_eq!((d.whole, d.trailing, d.leading), (2, 3, 1), "{d:?}");
-    assert_eq!(d.largest_trailing, 8, "{d:?}");
+    // at 7, room for a quarter more), the third reached 8 (split again, at
+    // 2: trailing 10) and the fifth kept that split.
+    assert_eq!((d.whole, d.trailing, d.leading), (2, 3, 2), "{d:?}");
+    assert_eq!(d.largest_trailing, 10, "{d:?}");
     assert_eq!((pc.bulk_factorisations, pc.schur_factorisations), (1, 5));
 }
 

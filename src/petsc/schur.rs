@@ -547,13 +547,16 @@ impl SchurFactor {
 }
 
 /// Where S0's leading block ends for a tangent whose first touched Schur
-/// position is `first` (of `n`): room for the touched tail to double before
-/// the leading block must be factored again. A first touch grows (hertz
-/// line b/40: the tail from 324 to 504 DOFs between the first two
-/// tangents), and a trailing block of 2t DOFs still costs (2t/n)³ of the
-/// whole (6 % at t = n/5).
+/// position is `first` (of `n`): room for the touched tail t to grow by a
+/// quarter before the leading block must be factored again. A first touch
+/// grows (hertz line b/40: the tail from 324 to 504 DOFs between the first
+/// two tangents), which costs a refactorisation of the leading block, but
+/// every Jacobian pays the trailing block's (1.25 t)³: with room to double,
+/// sphere-block's mortar pair (t ≈ 600 of 1,317 DOFs) factored 1,188 DOFs
+/// per Newton iteration, 742 now, and took 1.28 against 1.12 CPU s; the
+/// line meshes and hertz-cylinder did not move (docs/performance.md).
 fn split_before(first: usize, n: usize) -> usize {
-    first.saturating_sub(n - first)
+    first.saturating_sub((n - first) / 4)
 }
 
 /// `f` on the array of the factored Schur matrix of `factor` (n × n), which
