@@ -4,7 +4,7 @@
 use crate::error::Result;
 use crate::fem::Material;
 use crate::mesh::Mesh;
-use crate::model::{FacetLoad, MasterSpec, Model};
+use crate::model::{FacetLoad, Formulation, MasterSpec, Model};
 use crate::scene::{self, MeshReport, SceneSource};
 
 /// A scene's model, its output path and what reading its mesh found.
@@ -86,8 +86,12 @@ pub fn summary(c: &Checked) -> String {
             Some(f) => format!("Coulomb friction μ = {}", f.mu),
             None => "frictionless".into(),
         };
+        let formulation = match p.formulation {
+            Formulation::Mortar => "mortar".to_string(),
+            Formulation::Links => format!("links ({:?} points)", p.quadrature).to_lowercase(),
+        };
         line(format!(
-            "  contact {}: slave {} ({} facets), {master}, {friction}",
+            "  contact {}: {formulation}, slave {} ({} facets), {master}, {friction}",
             p.name,
             p.slave,
             facets(m, &p.slave)

@@ -178,7 +178,7 @@ fn check_prints_sizes_conditions_and_pairs() {
         "DOFs 38760",
         "body block: linear-elastic, E = 1000, ν = 0.3; 3042 cells, 6320 nodes",
         "dirichlet block.bottom: 158 nodes, components x y z",
-        "contact hertz: slave cylinder.curved (86 facets), master block.top (78 facets), frictionless",
+        "contact hertz: mortar, slave cylinder.curved (86 facets), master block.top (78 facets), frictionless",
         "quasi-static",
         "steps 1, output out/hertz-cylinder.h5",
     ] {
