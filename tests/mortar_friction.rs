@@ -260,3 +260,41 @@ fn frictional_mortar_impact_conserves_momentum_and_never_creates_energy() {
     );
     assert!(last < 0.75 * e0, "friction dissipates ({last} of {e0})");
 }
+
+/// A mortar pair's failed Newton solve reports its slave nodes (not links)
+/// at the failing iterate: pressed, sliding, sticking and the deepest mean
+/// penetration; and the file keeps every converged step.
+#[test]
+fn a_failed_step_reports_the_mortar_pairs_nodes() {
+    let dir = scratch("mortar-friction-failure");
+    let out = dir.join("fail.h5");
+    // Two Newton iterations and no cutback: the first sliding step fails.
+    let o = run(&[
+        "run",
+        "block-slide",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "solver.max_newton=2",
+        "--set",
+        "solver.max_cutbacks=0",
+    ]);
+    let t = text(&o);
+    assert!(!o.status.success(), "the run should fail:\n{t}");
+    assert!(
+        !t.contains("panicked") && !t.contains("links of pair"),
+        "{t}"
+    );
+    for expect in [
+        "slave nodes of mortar pair 'floor'",
+        "pressed together (p > 0)",
+        "sliding",
+        "sticking",
+        "max mean penetration",
+    ] {
+        assert!(t.contains(expect), "message lacks {expect:?}:\n{t}");
+    }
+    assert_eq!(t.trim().lines().count(), 1, "one error line:\n{t}");
+    assert!(!list_steps(&out).expect("the file stays valid").is_empty());
+}

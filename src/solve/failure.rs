@@ -41,12 +41,14 @@ impl StepFailure {
 
 /// One pair's links at an iterate: points pressed together (gap < 0 or a
 /// positive multiplier), sliding, and the deepest penetration (totals and
-/// maxima over ranks).
+/// maxima over ranks). A mortar pair's are its slave nodes (p_j > 0) and
+/// their deepest mean penetration g̃_j / A_j relative to the element size.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct LinkSummary {
     pressed: usize,
     sliding: usize,
     max_penetration: f64,
+    mortar: bool,
 }
 
 /// Collective, on a failed Newton solve (the same on every rank): the link
@@ -91,6 +93,9 @@ fn links_at(
         pairs
             .iter_mut()
             .map(|p| {
+                if let Some(s) = p.mortar_census(u, factor) {
+                    return Ok((s.active, s.sliding, s.max_penetration));
+                }
                 let (v, _) = p.point_values(u, factor)?;
                 let pressed = v
                     .gap
@@ -116,6 +121,7 @@ fn links_at(
                 pressed,
                 sliding,
                 max_penetration,
+                mortar: p.is_mortar(),
             };
             (p.spec.name.clone(), summary)
         })
@@ -145,10 +151,18 @@ pub(super) fn failure_text(f: &StepFailure) -> String {
                 text += &format!(" ({j})");
             }
             for (name, s) in links {
-                text += &format!(
-                    "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, {} sticking, max penetration {:.3e}",
-                    s.pressed, s.sliding, s.pressed - s.sliding.min(s.pressed), s.max_penetration
-                );
+                let sticking = s.pressed - s.sliding.min(s.pressed);
+                text += &if s.mortar {
+                    format!(
+                        "; slave nodes of mortar pair '{name}' at the failing iterate: {} pressed together (p > 0), {} sliding, {sticking} sticking, max mean penetration {:.3e} of the element size",
+                        s.pressed, s.sliding, s.max_penetration
+                    )
+                } else {
+                    format!(
+                        "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, {sticking} sticking, max penetration {:.3e}",
+                        s.pressed, s.sliding, s.max_penetration
+                    )
+                };
             }
             text
         }

@@ -463,14 +463,8 @@ impl MortarPair {
         factor: f64,
     ) -> UzawaStats {
         let x = self.positions(u_local);
-        let (states, frictions) = match &self.rigid {
-            Some(_) => self.rigid_outcome(&x, u_local, rate, factor),
-            None => {
-                let e = self.evaluate::<f64>(&x, u_local, rate);
-                (e.states, e.frictions)
-            }
-        };
-        let mut stats = UzawaStats::default();
+        let (states, frictions) = self.trial(&x, u_local, rate, factor);
+        let mut stats = self.census_of(&states, &frictions);
         for (j, s) in states.iter().enumerate() {
             if !self.complete[j] {
                 continue;
@@ -489,19 +483,10 @@ impl MortarPair {
                 f.slip[j] = n.slip;
                 if self.owned[j] {
                     stats.max_change = stats.max_change.max(change * area);
-                    stats.sliding += usize::from(n.sliding);
                 }
             }
             if !self.owned[j] {
                 continue;
-            }
-            if s.pressure > 0.0 || s.closed {
-                stats.max_penetration = stats
-                    .max_penetration
-                    .max(-s.weighted_gap / area / self.h[j]);
-            }
-            if s.pressure > 0.0 {
-                stats.active += 1;
             }
             stats.max_multiplier = stats.max_multiplier.max(s.pressure);
             stats.max_change = stats.max_change.max((s.pressure - old).abs() * area);
@@ -512,6 +497,52 @@ impl MortarPair {
         }
         if let Some(r) = &mut self.rigid {
             r.last_factor = factor;
+        }
+        stats
+    }
+
+    /// The nodes' states at `u_local` as the Uzawa update would find
+    /// them, nothing changed: its statistics without the multiplier
+    /// changes (a failed Newton solve's report).
+    pub fn census(&self, u_local: &[f64], rate: Option<&Rate>, factor: f64) -> UzawaStats {
+        let x = self.positions(u_local);
+        let (states, frictions) = self.trial(&x, u_local, rate, factor);
+        self.census_of(&states, &frictions)
+    }
+
+    /// Node states and friction outcomes at the positions `x`.
+    fn trial(
+        &self,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        factor: f64,
+    ) -> (Vec<NodeState>, Vec<NodeFriction>) {
+        match &self.rigid {
+            Some(_) => self.rigid_outcome(x, u_local, rate, factor),
+            None => {
+                let e = self.evaluate::<f64>(x, u_local, rate);
+                (e.states, e.frictions)
+            }
+        }
+    }
+
+    /// Over the owned nodes whose weighted gap is complete here: pressed
+    /// (p_j > 0), sliding, and the deepest mean penetration g̃_j / A_j
+    /// relative to the node's element size.
+    fn census_of(&self, states: &[NodeState], frictions: &[NodeFriction]) -> UzawaStats {
+        let mut stats = UzawaStats::default();
+        for (j, s) in states.iter().enumerate() {
+            if !(self.complete[j] && self.owned[j]) {
+                continue;
+            }
+            if s.pressure > 0.0 || s.closed {
+                let mean = -s.weighted_gap / self.nodal.area[j];
+                stats.max_penetration = stats.max_penetration.max(mean / self.h[j]);
+            }
+            stats.active += usize::from(s.pressure > 0.0);
+            let slides = self.friction.is_some() && frictions.get(j).is_some_and(|n| n.sliding);
+            stats.sliding += usize::from(slides);
         }
         stats
     }

@@ -183,14 +183,7 @@ impl ContactPair {
 
     /// The dynamic slip rate in the mortar pair's terms (None quasi-static).
     pub(super) fn mortar_rate(&self) -> Option<crate::contact::mortar::friction::Rate<'_>> {
-        self.rate
-            .as_ref()
-            .map(|r| crate::contact::mortar::friction::Rate {
-                dt: r.dt,
-                dv_du: r.dv_du,
-                offset: &r.offset,
-                master_velocity: r.rigid_velocity,
-            })
+        self.rate.as_ref().map(mortar_rate)
     }
 
     /// Adds this pair's nodal contact pressure (owned nodes) into the field.
@@ -202,5 +195,15 @@ impl ContactPair {
             }
             None => self.multipliers.add_nodal_pressure(numerator, denominator),
         }
+    }
+}
+
+/// A pair's slip-rate map in the mortar pair's terms.
+pub(super) fn mortar_rate(r: &super::SlipRateMap) -> crate::contact::mortar::friction::Rate<'_> {
+    crate::contact::mortar::friction::Rate {
+        dt: r.dt,
+        dv_du: r.dv_du,
+        offset: &r.offset,
+        master_velocity: r.rigid_velocity,
     }
 }

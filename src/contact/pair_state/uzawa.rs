@@ -11,15 +11,7 @@ impl ContactPair {
     /// then the halo exchange.
     pub fn uzawa_update(&mut self, u_local: &[f64], factor: f64) -> Result<UzawaStats> {
         if let Some(m) = &mut self.mortar {
-            let rate = self
-                .rate
-                .as_ref()
-                .map(|r| crate::contact::mortar::friction::Rate {
-                    dt: r.dt,
-                    dv_du: r.dv_du,
-                    offset: &r.offset,
-                    master_velocity: r.rigid_velocity,
-                });
+            let rate = self.rate.as_ref().map(super::output::mortar_rate);
             return Ok(m.uzawa_update(u_local, rate.as_ref(), factor));
         }
         let before = self.multipliers.nodal_forces()?;
@@ -53,6 +45,14 @@ impl ContactPair {
             stats.max_change = stats.max_change.max(norm(&sub(a, b)));
         }
         Ok(stats)
+    }
+
+    /// A mortar pair's nodes at `u_local` as its Uzawa update would find
+    /// them (pressed, sliding, deepest mean penetration relative to h),
+    /// nothing changed; None for a links pair.
+    pub fn mortar_census(&self, u_local: &[f64], factor: f64) -> Option<UzawaStats> {
+        let m = self.mortar.as_ref()?;
+        Some(m.census(u_local, self.mortar_rate().as_ref(), factor))
     }
 
     /// Multiplies the normal penalty by `factor`, and the tangential one
