@@ -287,6 +287,12 @@ fn contact_scenes_same_on_1_3_4_8_ranks() {
             Some("contact.formulation=mortar"),
             "node_lambda",
         ),
+        (
+            "block-on-plane",
+            "floor",
+            Some("contact.formulation=mortar"),
+            "node_lambda",
+        ),
     ] {
         let label = format!("{scene}{}", if extra.is_some() { "-mortar" } else { "" });
         let dir = scratch(&format!("contact-ranks-1348-{label}"));
