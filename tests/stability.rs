@@ -167,3 +167,42 @@ fn distorted_meshes_keep_the_patch_test() {
         assert_force("distorted", n, 0.0);
     }
 }
+
+/// The default formulation, the mortar, through the same stresses: half an
+/// element of initial overlap, matching meshes (every slave node on a
+/// master node), ν = 0.49 and 30 % distorted meshes; each run's force
+/// within the Uzawa tolerance of exact.
+#[test]
+fn the_mortar_under_the_same_stresses() {
+    const MORTAR: [&str; 2] = ["--set", "contact.formulation=mortar"];
+    let cases: [(&str, &[&str], f64); 5] = [
+        ("overlap", &["--set", "mesh.gap=-0.125"], 0.125),
+        ("matching", &["--set", "mesh.upper_divisions=[4,4,2]"], 0.0),
+        (
+            "incompressible",
+            &[
+                "--set",
+                "body.0.poisson=0.49",
+                "--set",
+                "body.1.poisson=0.49",
+            ],
+            0.0,
+        ),
+        (
+            "distorted-1",
+            &["--set", "distort.fraction=0.3", "--set", "distort.seed=1"],
+            0.0,
+        ),
+        (
+            "distorted-7",
+            &["--set", "distort.fraction=0.3", "--set", "distort.seed=7"],
+            0.0,
+        ),
+    ];
+    for (name, extra, overlap) in cases {
+        let args = [extra, &MORTAR[..]].concat();
+        let (n, newton, uzawa) = patch(&format!("mortar-{name}"), &args);
+        println!("mortar, {name}: normal force {n:.9}, Newton {newton}, Uzawa {uzawa}");
+        assert_force(&format!("mortar, {name}"), n, overlap);
+    }
+}
