@@ -17,6 +17,31 @@ pub fn links_unless_set<'a>(extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
+/// block-slide with `formulation`, two Newton iterations and no cutback,
+/// one process without mpirun (so its output is the program's alone),
+/// writing `out`: the first sliding step fails. Asserts that
+/// the run failed without a panic; returns the one error's text.
+pub fn failing_block_slide(out: &Path, formulation: &str) -> String {
+    let set = format!("contact.formulation={formulation}");
+    let o = run(&[
+        "run",
+        "block-slide",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "solver.max_newton=2",
+        "--set",
+        "solver.max_cutbacks=0",
+        "--set",
+        &set,
+    ]);
+    let t = text(&o);
+    assert!(!o.status.success(), "the run should fail:\n{t}");
+    assert!(!t.contains("panicked"), "{t}");
+    t
+}
+
 pub fn binary() -> &'static str {
     env!("CARGO_BIN_EXE_contactlink")
 }

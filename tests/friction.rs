@@ -239,26 +239,7 @@ fn frictional_scenes_same_on_1_and_2_ranks() {
 fn slip_heavy_step_that_cannot_converge_reports_its_link_states() {
     let dir = scratch("friction-failure");
     let out = dir.join("fail.h5");
-    // Two Newton iterations and no cutback: the first sliding step fails.
-    let o = mpirun(
-        1,
-        &[
-            "run",
-            "block-slide",
-            "-q",
-            "-o",
-            out.to_str().unwrap(),
-            "--set",
-            "solver.max_newton=2",
-            "--set",
-            "solver.max_cutbacks=0",
-            LINKS[0],
-            LINKS[1],
-        ],
-    );
-    let t = text(&o);
-    assert!(!o.status.success(), "the run should fail:\n{t}");
-    assert!(!t.contains("panicked"), "{t}");
+    let t = failing_block_slide(&out, "links");
     for expect in [
         "did not converge",
         "links of pair 'floor'",

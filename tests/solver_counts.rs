@@ -80,6 +80,15 @@ fn counts(args: &[&str]) -> Counts {
     c
 }
 
+/// `c` took `steps` steps without cutback and its Newton, Uzawa and linear
+/// iterations lie within `bands`.
+fn pin(scene: &str, c: &Counts, steps: usize, bands: [(usize, usize); 3]) {
+    assert_eq!((c.steps, c.cutbacks), (steps, 0), "{scene}: {c:?}");
+    within("Newton iterations", scene, c.newton, bands[0]);
+    within("Uzawa iterations", scene, c.uzawa, bands[1]);
+    within("linear iterations", scene, c.ksp, bands[2]);
+}
+
 fn within(what: &str, scene: &str, value: usize, band: (usize, usize)) {
     assert!(
         (band.0..=band.1).contains(&value),
@@ -173,10 +182,7 @@ fn hertz_cylinder_coarse() {
         ]
         .concat(),
     );
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (11, 15));
-    within("Uzawa iterations", scene, c.uzawa, (6, 8));
-    within("linear iterations", scene, c.ksp, (25, 45));
+    pin(scene, &c, 1, [(11, 15), (6, 8), (25, 45)]);
     within("preconditioner builds", scene, c.builds, (5, 8));
 }
 
@@ -194,10 +200,7 @@ fn hertz_cylinder_medium() {
         ]
         .concat(),
     );
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (6, 9));
-    within("Uzawa iterations", scene, c.uzawa, (3, 6));
-    within("linear iterations", scene, c.ksp, (14, 30));
+    pin(scene, &c, 1, [(6, 9), (3, 6), (14, 30)]);
     within("preconditioner builds", scene, c.builds, (4, 8));
 }
 
@@ -231,10 +234,7 @@ fn coarse_krylov_cylinder(formulation: &str, bands: [(usize, usize); 4]) {
         "--set",
         &set,
     ]);
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", &scene, c.newton, bands[0]);
-    within("Uzawa iterations", &scene, c.uzawa, bands[1]);
-    within("linear iterations", &scene, c.ksp, bands[2]);
+    pin(&scene, &c, 1, [bands[0], bands[1], bands[2]]);
     within("preconditioner builds", &scene, c.builds, bands[3]);
 }
 
@@ -288,10 +288,7 @@ fn block_slide_with_friction() {
     // every Newton solve tight; loose ones cost 74 / 63).
     let scene = "block-slide";
     let c = counts(&["block-slide", LINKS[0], LINKS[1]]);
-    assert_eq!((c.steps, c.cutbacks), (20, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (55, 66));
-    within("Uzawa iterations", scene, c.uzawa, (38, 48));
-    within("linear iterations", scene, c.ksp, (45, 80));
+    pin(scene, &c, 20, [(55, 66), (38, 48), (45, 80)]);
     assert!(
         c.reuses > 0,
         "{scene}: the preconditioner was never kept: {c:?}"
@@ -304,10 +301,7 @@ fn patch_test() {
     // whole step (before: 9, 4, 29).
     let scene = "patch-test";
     let c = counts(&[&["patch-test"][..], &NO_SCHUR, &LINKS].concat());
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (5, 8));
-    within("Uzawa iterations", scene, c.uzawa, (3, 6));
-    within("linear iterations", scene, c.ksp, (20, 45));
+    pin(scene, &c, 1, [(5, 8), (3, 6), (20, 45)]);
     within("preconditioner builds", scene, c.builds, (1, 2));
 }
 
@@ -318,10 +312,7 @@ fn block_on_a_rigid_plane() {
     // Newton, 10 Uzawa, 28 GMRES over 2 steps (before: 16, 8, 26).
     let scene = "block-on-plane";
     let c = counts(&["block-on-plane", LINKS[0], LINKS[1]]);
-    assert_eq!((c.steps, c.cutbacks), (2, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (10, 14));
-    within("Uzawa iterations", scene, c.uzawa, (8, 12));
-    within("linear iterations", scene, c.ksp, (20, 40));
+    pin(scene, &c, 2, [(10, 14), (8, 12), (20, 40)]);
     assert_eq!(c.builds, 0, "{scene}: the watch ran on a hyperelastic body");
 }
 
@@ -333,7 +324,15 @@ fn tight_switches_restore_the_old_counts() {
     // 25 with the first Uzawa iteration's main-part tangent, the default;
     // 20 with the Uzawa rate rule's penalty raise, which these switches do
     // not turn off).
-    let scene = "hertz-cylinder h = 0.4, levers off";
+    let (scene, c) = levers_off("links", (18, 22));
+    assert_eq!(c.builds, 0, "{scene}: the watch ran while switched off");
+}
+
+/// hertz-cylinder h = 0.4 with `formulation`, both levers off (every Newton
+/// solve tight, no active-set lag): its Newton iterations within `newton`.
+fn levers_off(formulation: &str, newton: (usize, usize)) -> (String, Counts) {
+    let scene = format!("hertz-cylinder h = 0.4, {formulation}, levers off");
+    let set = format!("contact.formulation={formulation}");
     let c = counts(&[
         "hertz-cylinder",
         "--set",
@@ -342,11 +341,30 @@ fn tight_switches_restore_the_old_counts() {
         "solver.uzawa_forcing=0",
         "--set",
         "solver.lag_active_set=false",
-        LINKS[0],
-        LINKS[1],
+        "--set",
+        &set,
     ]);
-    within("Newton iterations", scene, c.newton, (18, 22));
-    assert_eq!(c.builds, 0, "{scene}: the watch ran while switched off");
+    within("Newton iterations", &scene, c.newton, newton);
+    (scene, c)
+}
+
+/// hertz-cylinder h = 0.2 with `formulation` and the full consistent
+/// tangent in the first Uzawa iteration: its Newton iterations within
+/// `newton`.
+fn consistent_first_tangent(formulation: &str, newton: (usize, usize)) -> Counts {
+    let scene = format!("hertz-cylinder h = 0.2, {formulation}, consistent first tangent");
+    let set = format!("contact.formulation={formulation}");
+    let c = counts(&[
+        "hertz-cylinder",
+        "--set",
+        "mesh.fine_size=0.2",
+        "--set",
+        "solver.first_contact_main_tangent=false",
+        "--set",
+        &set,
+    ]);
+    within("Newton iterations", &scene, c.newton, newton);
+    c
 }
 
 #[test]
@@ -354,18 +372,12 @@ fn consistent_first_contact_tangent_restores_the_old_counts() {
     // The first Uzawa iteration with the full consistent tangent, as before
     // the main-part one became the default: 9 Newton iterations where the
     // default takes 7 (hertz-cylinder h = 0.2).
-    let scene = "hertz-cylinder h = 0.2, consistent first tangent";
-    let c = counts(&[
-        "hertz-cylinder",
-        "--set",
-        "mesh.fine_size=0.2",
-        "--set",
-        "solver.first_contact_main_tangent=false",
-        LINKS[0],
-        LINKS[1],
-    ]);
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (8, 11));
+    let c = consistent_first_tangent("links", (8, 11));
+    assert_eq!(
+        (c.steps, c.cutbacks),
+        (1, 0),
+        "consistent first tangent: {c:?}"
+    );
 }
 
 #[test]
@@ -382,30 +394,18 @@ fn mortar_main_scenes() {
     ]
     .concat();
     let c = counts(&args);
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (6, 9));
-    within("Uzawa iterations", scene, c.uzawa, (3, 5));
-    within("linear iterations", scene, c.ksp, (12, 28));
+    pin(scene, &c, 1, [(6, 9), (3, 5), (12, 28)]);
     within("preconditioner builds", scene, c.builds, (3, 7));
     let scene = "patch-test, mortar";
     let c = counts(&[&["patch-test"][..], &NO_SCHUR].concat());
-    assert_eq!((c.steps, c.cutbacks), (1, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (4, 7));
-    within("Uzawa iterations", scene, c.uzawa, (4, 6));
-    within("linear iterations", scene, c.ksp, (4, 10));
+    pin(scene, &c, 1, [(4, 7), (4, 6), (4, 10)]);
     within("preconditioner builds", scene, c.builds, (1, 2));
     let scene = "block-slide, mortar";
     let c = counts(&["block-slide"]);
-    assert_eq!((c.steps, c.cutbacks), (20, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (54, 65));
-    within("Uzawa iterations", scene, c.uzawa, (40, 49));
-    within("linear iterations", scene, c.ksp, (50, 75));
+    pin(scene, &c, 20, [(54, 65), (40, 49), (50, 75)]);
     let scene = "block-on-plane, mortar";
     let c = counts(&["block-on-plane"]);
-    assert_eq!((c.steps, c.cutbacks), (2, 0), "{scene}: {c:?}");
-    within("Newton iterations", scene, c.newton, (10, 14));
-    within("Uzawa iterations", scene, c.uzawa, (8, 12));
-    within("linear iterations", scene, c.ksp, (20, 40));
+    pin(scene, &c, 2, [(10, 14), (8, 12), (20, 40)]);
 }
 
 #[test]
@@ -413,24 +413,6 @@ fn mortar_levers_off_and_consistent_first_tangent() {
     // Both levers off, mortar, h = 0.4: 16 Newton where the default takes
     // 7; the full consistent tangent in the first Uzawa iteration, h = 0.2:
     // 11 where the default takes 6.
-    let scene = "hertz-cylinder h = 0.4, mortar, levers off";
-    let c = counts(&[
-        "hertz-cylinder",
-        "--set",
-        "mesh.fine_size=0.4",
-        "--set",
-        "solver.uzawa_forcing=0",
-        "--set",
-        "solver.lag_active_set=false",
-    ]);
-    within("Newton iterations", scene, c.newton, (14, 18));
-    let scene = "hertz-cylinder h = 0.2, mortar, consistent first tangent";
-    let c = counts(&[
-        "hertz-cylinder",
-        "--set",
-        "mesh.fine_size=0.2",
-        "--set",
-        "solver.first_contact_main_tangent=false",
-    ]);
-    within("Newton iterations", scene, c.newton, (10, 13));
+    levers_off("mortar", (14, 18));
+    consistent_first_tangent("mortar", (10, 13));
 }
