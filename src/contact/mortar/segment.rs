@@ -31,6 +31,11 @@ pub struct MortarRules {
     pub quad_facet: Rule,
     pub tri_facet: Rule,
     pub triangle: Rule,
+    /// On the triangles of a tri3-on-tri3 segment, where both facets map
+    /// affinely: every integrand there (`Φ_j g`, `Φ_j N¹_k`, `Φ_j N²_l`
+    /// times a constant area ratio) is a polynomial of degree 2, exact
+    /// with three points at any positions, so its derivatives are too.
+    pub affine_triangle: Rule,
 }
 
 fn pairs(rule: &QuadRule) -> Rule {
@@ -77,6 +82,7 @@ impl Default for MortarRules {
             quad_facet: pairs(&QuadRule::quad_3x3()),
             tri_facet: pairs(&QuadRule::tri_6()),
             triangle: dunavant_12(),
+            affine_triangle: pairs(&QuadRule::tri_3()),
         }
     }
 }
@@ -86,6 +92,15 @@ impl MortarRules {
         match facet {
             FacetType::Quad4 => &self.quad_facet,
             FacetType::Tri3 => &self.tri_facet,
+        }
+    }
+
+    /// The rule on a segment's triangles: a quad4 facet's inverse map makes
+    /// the integrands rational, so they get the degree-6 rule.
+    pub fn segment(&self, slave: FacetType, master: FacetType) -> &Rule {
+        match (slave, master) {
+            (FacetType::Tri3, FacetType::Tri3) => &self.affine_triangle,
+            _ => &self.triangle,
         }
     }
 }
@@ -339,7 +354,8 @@ pub fn segment_terms<T: Scalar>(
     };
     let normal = ov.plane.normal;
     let projected_jacobian = PlaneJacobian::of(slave_type, &ov.slave_nodes);
-    let mapped = ov.for_each_point(slave_type, master_type, &rules.triangle, |q| {
+    let rule = rules.segment(slave_type, master_type);
+    let mapped = ov.for_each_point(slave_type, master_type, rule, |q| {
         let projected = projected_jacobian.at(&q.zeta);
         let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
         // The projected facet is counter-clockwise or clockwise depending on

@@ -489,6 +489,44 @@ fn segment_triangle_rule_is_exact_to_degree_six() {
     }
 }
 
+/// Tri3 on tri3 integrates with three points per triangle: the same
+/// segment integrals and derivatives as the degree-6 rule, on a tilted and
+/// warped pair (every integrand is a polynomial of degree 2 there).
+#[test]
+fn tri3_segments_with_three_points_match_the_degree_six_rule() {
+    let mut case = random_case(31, Tri3, Tri3);
+    let mut rng = Lcg::new(32);
+    for p in &mut case.positions {
+        p[2] += 0.05 * rng.next() + 0.1 * p[0] - 0.07 * p[1];
+    }
+    let fine = MortarRules {
+        affine_triangle: MortarRules::default().triangle,
+        ..MortarRules::default()
+    };
+    assert_eq!(MortarRules::default().affine_triangle.len(), 3);
+    let interface = case.interface(&case.positions);
+    let flat = |segs: Vec<Segment<Dual<24>>>| -> Vec<f64> {
+        let mut out = Vec::new();
+        for seg in segs {
+            let t = seg.terms;
+            let rows = t.d.iter().chain(&t.m).flatten();
+            for v in t.weighted_gap.iter().chain(rows).chain([&t.area]) {
+                out.push(v.re);
+                out.extend_from_slice(&v.eps);
+            }
+        }
+        out
+    };
+    let three = flat(segments(&interface, &MortarRules::default()));
+    let twelve = flat(segments(&interface, &fine));
+    assert_eq!(three.len(), twelve.len());
+    assert!(three.len() > 1000, "{} values", three.len());
+    let scale = twelve.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (i, (a, b)) in three.iter().zip(&twelve).enumerate() {
+        assert!((a - b).abs() <= 1e-13 * scale, "value {i}: {a} vs {b}");
+    }
+}
+
 /// On a flat slave, moving a master node along the slave's normal moves
 /// neither the overlaps nor `D`, `M`, `ν`: there the consistent tangent is
 /// its main part, `(ε_j/A_j) f_j ⊗ f_j`. The main part is symmetric.
