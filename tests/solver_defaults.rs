@@ -35,6 +35,7 @@ fn a_plain_linear_iterative_run_frees_the_galerkin_intermediates() {
     ]);
     assert!(t.contains("-pc_type gamg"), "{t}");
     assert!(t.contains("-mat_product_clear true"), "{t}");
+    assert!(t.contains("-pc_gamg_agg_nsmooths 0"), "{t}");
 }
 
 #[test]
@@ -49,6 +50,8 @@ fn a_linear_iterative_contact_run_frees_the_galerkin_intermediates() {
     let t = option_table(&cylinder);
     assert!(t.contains("-pc_type gamg"), "{t}");
     assert!(t.contains("-mat_product_clear true"), "{t}");
+    // Unsmoothed aggregation on the contact path too.
+    assert!(t.contains("-pc_gamg_agg_nsmooths 0"), "{t}");
     // Without the preconditioner reuse every Newton iteration rebuilds it.
     let mut rebuilt = cylinder.to_vec();
     rebuilt.extend(["--set", "solver.lag_preconditioner=false"]);
