@@ -46,8 +46,20 @@ pub fn binary() -> &'static str {
     env!("CARGO_BIN_EXE_contactlink")
 }
 
-/// A fresh scratch directory for one test.
+/// A fresh scratch directory for one test. A name is handed out once per
+/// test binary: its tests run at once, and two asking for one name would
+/// clear each other's files mid-run (a flaky failure, not a test of the
+/// program).
 pub fn scratch(name: &str) -> PathBuf {
+    static HANDED_OUT: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    {
+        let mut names = HANDED_OUT.lock().unwrap_or_else(|e| e.into_inner());
+        assert!(
+            !names.iter().any(|n| n == name),
+            "scratch directory {name} asked for twice in this test binary"
+        );
+        names.push(name.to_string());
+    }
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("create scratch dir");

@@ -74,6 +74,7 @@ fn largest_difference(a: &Path, b: &Path, steps: &[usize], pair: &str) -> f64 {
 /// dataset zeroed, which must move the next step by more than 1e-7: the
 /// continued run does read it back.
 fn continued_run_matches(
+    label: &str,
     scene: &str,
     extra: &[&str],
     keep: usize,
@@ -84,7 +85,10 @@ fn continued_run_matches(
     let tag = Path::new(scene)
         .file_stem()
         .map_or(scene.to_string(), |s| s.to_string_lossy().into_owned());
-    let dir = scratch(&format!("restart-mortar-{tag}-{ranks}"));
+    // One directory per calling test (`label`): the tests run at once, and
+    // two of them continuing `block-slide` on 1 rank shared a directory,
+    // each clearing it under the other.
+    let dir = scratch(&format!("restart-mortar-{label}-{tag}-{ranks}"));
     let full = dir.join("full.h5");
     let mut args = vec!["run", scene, "-q", "-o", full.to_str().unwrap()];
     args.extend_from_slice(extra);
@@ -147,7 +151,7 @@ fn frictional_mortar_on_a_rigid_plane_continues_exactly() {
         (1, layout::PAIR_NODE_LAMBDA_T),
         (2, layout::PAIR_NODE_SLIP_ORIGIN),
     ] {
-        continued_run_matches("block-slide", &extra, 11, ranks, "floor", history);
+        continued_run_matches("rigid", "block-slide", &extra, 11, ranks, "floor", history);
     }
 }
 
@@ -172,7 +176,7 @@ fn frictional_mortar_between_blocks_continues_exactly() {
         (2, layout::PAIR_NODE_LAMBDA_T),
         (3, layout::PAIR_NODE_SLIP_ORIGIN),
     ] {
-        continued_run_matches(scene, &extra, 6, ranks, "interface", history);
+        continued_run_matches("blocks", scene, &extra, 6, ranks, "interface", history);
     }
 }
 
@@ -186,5 +190,13 @@ fn a_raised_mortar_penalty_carries_over() {
         "--set",
         "contact.max_uzawa=2",
     ];
-    continued_run_matches("block-slide", &extra, 11, 1, "floor", layout::PAIR_PENALTY);
+    continued_run_matches(
+        "raised",
+        "block-slide",
+        &extra,
+        11,
+        1,
+        "floor",
+        layout::PAIR_PENALTY,
+    );
 }
