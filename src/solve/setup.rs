@@ -133,11 +133,12 @@ pub(super) fn set_solver_defaults(
     // Unsmoothed aggregation: 8-22 % more Krylov iterations than smoothed
     // (81 / 70 CG on the 167k-DOF plain sphere, 134 / 110 GMRES on
     // hertz-sphere), but a sparser prolongator makes each cheaper and the
-    // set-up's Galerkin product smaller, so the runs took the same time or
-    // less at every size measured, 1 and 2 ranks (hertz-sphere 97k / 167k
-    // / 318k DOFs: 6.30 / 11.46 / 43.6 s against 6.75 / 11.20 / 46.9 s,
-    // plain 3.09 / 6.50 / 24.4 s against 3.61 / 6.90 / 25.5 s) with
-    // 8-18 % less peak memory (hertz-sphere's largest of 4 ranks 265 MiB
+    // set-up's Galerkin product smaller, so the runs took at most 2 % more
+    // time, mostly less, at every size measured, 1 and 2 ranks
+    // (hertz-sphere 97k / 167k / 318k DOFs on 2 ranks: 6.30 / 11.46 / 43.6
+    // s against 6.75 / 11.20 / 46.9 s, plain 3.09 / 6.50 / 24.4 s against
+    // 3.61 / 6.90 / 25.5 s; docs/performance.md) with 8-18 % less peak
+    // memory (hertz-sphere's largest of 4 ranks 265 MiB
     // against 309, 1 rank 806 against 843).
     petsc::options::set_default("-pc_gamg_agg_nsmooths", "0")?;
     // A mortar pair's Newton converges in one or two iterations per Uzawa
