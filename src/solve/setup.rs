@@ -138,8 +138,8 @@ pub(super) fn set_solver_defaults(
     // (hertz-sphere 97k / 167k / 318k DOFs on 2 ranks: 6.30 / 11.46 / 43.6
     // s against 6.75 / 11.20 / 46.9 s, plain 3.09 / 6.50 / 24.4 s against
     // 3.61 / 6.90 / 25.5 s; docs/performance.md) with 8-18 % less peak
-    // memory (hertz-sphere's largest of 4 ranks 265 MiB
-    // against 309, 1 rank 806 against 843).
+    // memory (hertz-sphere's largest of 4 ranks 265 MiB against 309, 1 rank
+    // 806 against 843).
     petsc::options::set_default("-pc_gamg_agg_nsmooths", "0")?;
     // A mortar pair's Newton converges in one or two iterations per Uzawa
     // iteration when its linear solves are accurate, and crawls when they
