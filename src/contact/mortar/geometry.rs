@@ -645,6 +645,12 @@ pub fn overlap<T: Scalar>(
 }
 
 impl<T: Scalar> Overlap<T> {
+    /// Whether both projected facets map affinely onto the plane (to
+    /// [`AFFINE_TOL`]): triangles and parallelograms.
+    pub fn maps_affinely(&self) -> bool {
+        self.bilinear[0].max(self.bilinear[1]) <= AFFINE_TOL
+    }
+
     /// Quadrature points on the overlap's triangles with the triangle rule
     /// `rule` (reference triangle, weights summing to ½), mapped back to both
     /// facets; `f` is called once per point. Returns false if a point could
@@ -656,7 +662,7 @@ impl<T: Scalar> Overlap<T> {
         rule: &[([f64; 2], f64)],
         mut f: impl FnMut(&SegmentPoint<T>),
     ) -> bool {
-        let affine = self.bilinear[0].max(self.bilinear[1]) <= AFFINE_TOL;
+        let affine = self.maps_affinely();
         let maps = (
             PlanarMap::new(slave_type, &self.slave_nodes, self.bilinear[0]),
             PlanarMap::new(master_type, &self.master_nodes, self.bilinear[1]),

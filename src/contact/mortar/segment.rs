@@ -16,7 +16,7 @@
 //!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
 //!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
 //!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
-use super::geometry::{overlap, shape_gradients};
+use super::geometry::{overlap, shape_gradients, AFFINE_TOL};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::shape::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
@@ -36,6 +36,13 @@ pub struct MortarRules {
     /// times a constant area ratio) is a polynomial of degree 2, exact
     /// with three points at any positions, so its derivatives are too.
     pub affine_triangle: Rule,
+    /// On the triangles of a segment whose facets are all parallelograms
+    /// or triangles (both projected facets and the slave's reference
+    /// facet): the parametric maps are affine in the plane, the integrands
+    /// polynomials of degree 4 and their first derivatives in the nodes
+    /// (a perturbation bends a map, and `∂ζ/∂x` is quadratic) of degree 5,
+    /// so a degree-5 rule gives the degree-6 rule's values and tangent.
+    pub parallelogram_triangle: Rule,
 }
 
 fn pairs(rule: &QuadRule) -> Rule {
@@ -69,6 +76,22 @@ fn dunavant_12() -> Rule {
     rule
 }
 
+/// Radon's 7-point rule on the reference triangle, exact to degree 5
+/// (positive weights, points inside); weights sum to ½.
+fn radon_7() -> Rule {
+    let r = 15f64.sqrt();
+    let mut rule = vec![([1.0 / 3.0, 1.0 / 3.0], 9.0 / 80.0)];
+    for (a, w) in [(6.0 - r) / 21.0, (6.0 + r) / 21.0]
+        .into_iter()
+        .zip([(155.0 - r) / 2400.0, (155.0 + r) / 2400.0])
+    {
+        for p in [[a, a], [a, 1.0 - 2.0 * a], [1.0 - 2.0 * a, a]] {
+            rule.push((p, w));
+        }
+    }
+    rule
+}
+
 impl Default for MortarRules {
     /// 3×3 Gauss on quads (exact for `N_j N_k J`, biquadratic × bilinear),
     /// the degree-4 six-point rule on tri facets. On segment triangles the
@@ -83,6 +106,7 @@ impl Default for MortarRules {
             tri_facet: pairs(&QuadRule::tri_6()),
             triangle: dunavant_12(),
             affine_triangle: pairs(&QuadRule::tri_3()),
+            parallelogram_triangle: radon_7(),
         }
     }
 }
@@ -95,11 +119,13 @@ impl MortarRules {
         }
     }
 
-    /// The rule on a segment's triangles: a quad4 facet's inverse map makes
-    /// the integrands rational, so they get the degree-6 rule.
-    pub fn segment(&self, slave: FacetType, master: FacetType) -> &Rule {
+    /// The rule on a segment's triangles: where a quad4 facet is not a
+    /// parallelogram (`parallelograms` false) its inverse map makes the
+    /// integrands rational, so they get the degree-6 rule.
+    pub fn segment(&self, slave: FacetType, master: FacetType, parallelograms: bool) -> &Rule {
         match (slave, master) {
             (FacetType::Tri3, FacetType::Tri3) => &self.affine_triangle,
+            _ if parallelograms => &self.parallelogram_triangle,
             _ => &self.triangle,
         }
     }
@@ -287,6 +313,22 @@ fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T
     T::linearised(j.re, j.eps, zeta)
 }
 
+/// Whether a facet (reference positions) is a triangle or a parallelogram
+/// to [`AFFINE_TOL`]: then its area element `J₀` is constant.
+fn is_parallelogram(facet: FacetType, x: &[[f64; 3]]) -> bool {
+    match facet {
+        FacetType::Tri3 => true,
+        FacetType::Quad4 => {
+            let bilinear = (0..3).map(|i| x[0][i] - x[1][i] + x[2][i] - x[3][i]);
+            let size = (0..3)
+                .map(|i| x[0][i] - x[2][i])
+                .map(|d| d * d)
+                .sum::<f64>();
+            bilinear.map(|b| b * b).sum::<f64>() <= AFFINE_TOL * AFFINE_TOL * size
+        }
+    }
+}
+
 /// `det ∂P/∂ζ` of the slave facet projected into the auxiliary plane at an
 /// f64 point.
 fn plane_jacobian<T: Scalar>(facet: FacetType, nodes: &[[T; 2]], zeta: [f64; 2]) -> T {
@@ -354,7 +396,8 @@ pub fn segment_terms<T: Scalar>(
     };
     let normal = ov.plane.normal;
     let projected_jacobian = PlaneJacobian::of(slave_type, &ov.slave_nodes);
-    let rule = rules.segment(slave_type, master_type);
+    let parallelograms = ov.maps_affinely() && is_parallelogram(slave_type, x_ref);
+    let rule = rules.segment(slave_type, master_type, parallelograms);
     let mapped = ov.for_each_point(slave_type, master_type, rule, |q| {
         let projected = projected_jacobian.at(&q.zeta);
         let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
