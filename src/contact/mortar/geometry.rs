@@ -9,6 +9,7 @@
 //! inside, which edges cross) are made on the f64 values: the derivative is
 //! then that of the current clipping pattern, which is the derivative almost
 //! everywhere.
+use super::bilinear::Bilinear;
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::{FacetType, MAX_FACET_NODES};
 
@@ -344,7 +345,7 @@ pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACE
 pub struct PlanarMap<'a, T> {
     facet: FacetType,
     nodes: &'a [Vec2<T>],
-    nodes_f: [Vec2<f64>; MAX_FACET_NODES],
+    map: Bilinear,
     affine: Option<AffineMap>,
 }
 
@@ -359,13 +360,13 @@ impl<'a, T: Scalar> PlanarMap<'a, T> {
     /// The map of the projected nodes `nodes` whose relative bilinear term
     /// is `bilinear`; `None` if it is affine and singular.
     pub fn new(facet: FacetType, nodes: &'a [Vec2<T>], bilinear: f64) -> Option<Self> {
-        let nodes_f = values2(nodes);
+        let map = Bilinear::of(facet, nodes);
         let affine = if bilinear <= EXACTLY_AFFINE_TOL {
             let centre = crate::contact::projection::reference_centre(facet);
             Some(AffineMap {
                 centre,
-                image: interpolate(facet, &nodes_f, &centre),
-                inverse: inverse_jacobian(facet, &nodes_f, centre)?,
+                image: map.at(centre),
+                inverse: map.inverse_jacobian(centre)?,
             })
         } else {
             None
@@ -373,7 +374,7 @@ impl<'a, T: Scalar> PlanarMap<'a, T> {
         Some(PlanarMap {
             facet,
             nodes,
-            nodes_f,
+            map,
             affine,
         })
     }
@@ -393,8 +394,9 @@ impl<'a, T: Scalar> PlanarMap<'a, T> {
                 (zeta, a.inverse)
             }
             None => {
-                let zeta = newton(self.facet, &self.nodes_f, target)?;
-                (zeta, inverse_jacobian(self.facet, &self.nodes_f, zeta)?)
+                let centre = crate::contact::projection::reference_centre(self.facet);
+                let zeta = self.map.newton(target, centre)?;
+                (zeta, self.map.inverse_jacobian(zeta)?)
             }
         };
         Some(implicit_step(self.facet, &inverse, self.nodes, p, zeta))
@@ -405,29 +407,6 @@ impl<'a, T: Scalar> PlanarMap<'a, T> {
 /// the projected nodes `nodes` (Newton however the facet maps).
 pub fn inverse_map<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
     PlanarMap::new(facet, nodes, f64::INFINITY)?.invert(p)
-}
-
-/// Newton in f64 from the facet centre for the point mapped onto `target`.
-fn newton(facet: FacetType, nodes_f: &[Vec2<f64>], target: Vec2<f64>) -> Option<Vec2<f64>> {
-    let mut zeta = crate::contact::projection::reference_centre(facet);
-    for _ in 0..30 {
-        let step = newton_step(facet, nodes_f, &target, zeta)?;
-        zeta = [zeta[0] + step[0], zeta[1] + step[1]];
-        if step[0].abs().max(step[1].abs()) < 1e-14 {
-            return Some(zeta);
-        }
-        if !(zeta[0].abs() < 10.0 && zeta[1].abs() < 10.0) {
-            return None;
-        }
-    }
-    // Accept a residual at rounding level (bilinear Newton stalls there).
-    let scale = nodes_f[..facet.nodes()]
-        .iter()
-        .map(|v| v[0].abs().max(v[1].abs()))
-        .fold(0.0, f64::max)
-        .max(f64::MIN_POSITIVE);
-    let x = interpolate(facet, nodes_f, &zeta);
-    ((x[0] - target[0]).hypot(x[1] - target[1]) <= 1e-12 * scale).then_some(zeta)
 }
 
 /// One more Newton step from the solution `ζ₀` (f64), in `T` with the shape
@@ -456,65 +435,6 @@ fn implicit_step<T: Scalar>(
         z.add_scaled(&r[1], inverse[k][1]);
         z + zeta[k]
     })
-}
-
-/// The f64 values of projected nodes.
-fn values2<T: Scalar>(nodes: &[Vec2<T>]) -> [Vec2<f64>; MAX_FACET_NODES] {
-    let mut out = [[0.0; 2]; MAX_FACET_NODES];
-    for (o, v) in out.iter_mut().zip(nodes) {
-        *o = [v[0].re(), v[1].re()];
-    }
-    out
-}
-
-fn interpolate(facet: FacetType, nodes: &[Vec2<f64>], zeta: &Vec2<f64>) -> Vec2<f64> {
-    let n = shape_values(facet, zeta);
-    let mut x = [0.0; 2];
-    for (na, v) in n.iter().zip(nodes).take(facet.nodes()) {
-        x = [x[0] + na * v[0], x[1] + na * v[1]];
-    }
-    x
-}
-
-/// `(∂x/∂ζ)⁻¹` of the planar map at `ζ`; `None` if singular.
-fn inverse_jacobian(
-    facet: FacetType,
-    nodes: &[Vec2<f64>],
-    zeta: Vec2<f64>,
-) -> Option<[[f64; 2]; 2]> {
-    let dn = shape_gradients(facet, &zeta);
-    let mut j = [[0.0; 2]; 2];
-    for (d, v) in dn.iter().zip(nodes).take(facet.nodes()) {
-        for row in 0..2 {
-            j[row][0] += v[row] * d[0];
-            j[row][1] += v[row] * d[1];
-        }
-    }
-    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-    let size = (j[0][0].abs() + j[1][1].abs() + j[0][1].abs() + j[1][0].abs()).powi(2);
-    if !(det.abs() > 1e-14 * size && size > 0.0) {
-        return None;
-    }
-    let inv = 1.0 / det;
-    Some([
-        [j[1][1] * inv, -j[0][1] * inv],
-        [-j[1][0] * inv, j[0][0] * inv],
-    ])
-}
-
-/// One Newton step `J⁻¹ (p − x(ζ))` of the planar map; `None` if singular.
-fn newton_step(
-    facet: FacetType,
-    nodes: &[Vec2<f64>],
-    p: &Vec2<f64>,
-    zeta: Vec2<f64>,
-) -> Option<Vec2<f64>> {
-    let r = sub2(p, &interpolate(facet, nodes, &zeta));
-    let inv = inverse_jacobian(facet, nodes, zeta)?;
-    Some([
-        inv[0][0] * r[0] + inv[0][1] * r[1],
-        inv[1][0] * r[0] + inv[1][1] * r[1],
-    ])
 }
 
 /// `∂N_a/∂ζ` at a point in `T`.

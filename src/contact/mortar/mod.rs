@@ -3,7 +3,8 @@
 //! overlaps.
 //!
 //! - `geometry`: auxiliary plane, projection, polygon clipping,
-//!   triangulation, quadrature points mapped back to both facets;
+//!   triangulation, quadrature points mapped back to both facets
+//!   (`bilinear`: a facet's planar map and its inversion in f64);
 //! - `segment`: dual basis of a slave facet and the integrals of one segment
 //!   (weighted gap, mortar matrices `D` and `M`);
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
@@ -25,6 +26,7 @@
 //!   and its motion, `rigid_pair` their run-time side;
 //! - `pair_output`: the pair's nodal fields, force and point values;
 //!   `pair_restart`: taking them over from a result file.
+mod bilinear;
 mod facet_search;
 pub mod friction;
 pub mod geometry;
