@@ -5,6 +5,7 @@ pub mod condensed;
 pub mod condensed_state;
 pub mod dense;
 pub mod heap;
+mod linear_floor;
 pub mod log;
 pub mod low_rank;
 pub mod matrix;

@@ -1,5 +1,6 @@
 //! Newton's method through PETSc SNES, with residual and Jacobian computed by
 //! Rust code behind the [`NonlinearProblem`] trait.
+use super::linear_floor::{floor_test, LinearFloor};
 use super::low_rank::LowRankPreconditioner;
 use super::reason::{KspReason, SnesReason};
 use super::schur::SchurPreconditioner;
@@ -35,6 +36,19 @@ pub trait NonlinearProblem {
     /// lag setting alone. Must give the same answer on every rank.
     fn rebuild_preconditioner(&mut self, _last_linear_iterations: usize) -> Option<bool> {
         None
+    }
+
+    /// Called before each backtracking line search (not before the other
+    /// kinds) with the iterate `x` and the Newton step `y` (the full step
+    /// goes to `x − y`): a fraction in (0, 1) to shorten the step to, or
+    /// None to keep it. Collective; must give the same answer on every
+    /// rank.
+    fn step_fraction(
+        &mut self,
+        _x: &Vector,
+        _y: &Vector,
+    ) -> std::result::Result<Option<f64>, CallbackError> {
+        Ok(None)
     }
 }
 
@@ -80,30 +94,19 @@ pub struct Snes {
     /// slope is taken with (`super::slope`); boxed and dropped after the
     /// SNES, as above.
     slope: Option<Box<LastSolve>>,
+    /// The line search is PETSc's backtracking one (read after the options
+    /// are applied): the problem's `step_fraction` is asked before it.
+    backtracking: bool,
 }
 
-/// A KSP convergence test and the destructor of its context.
-type ConvergenceTest = Option<
-    unsafe extern "C" fn(
-        sys::KSP,
-        sys::PetscInt,
-        f64,
-        *mut sys::KSPConvergedReason,
-        *mut c_void,
-    ) -> sys::PetscErrorCode,
->;
-type ConvergenceDestroy = Option<unsafe extern "C" fn(*mut c_void) -> sys::PetscErrorCode>;
-
-/// The state of the convergence test `set_linear_floor` installs: the
-/// KSP's own test it wraps and the solve's first residual norm.
-struct LinearFloor {
-    snes: sys::SNES,
-    fraction: f64,
-    inner: ConvergenceTest,
-    inner_ctx: *mut c_void,
-    inner_destroy: ConvergenceDestroy,
-    rnorm0: f64,
-}
+/// A line search's pre-check (`SNESLineSearchSetPreCheck`).
+type PreCheck = unsafe extern "C" fn(
+    sys::SNESLineSearch,
+    sys::Vec,
+    sys::Vec,
+    *mut sys::PetscBool,
+    *mut c_void,
+) -> sys::PetscErrorCode;
 
 impl Snes {
     /// A Newton solver that reads its settings from the options database under
@@ -118,6 +121,7 @@ impl Snes {
             low_rank: None,
             floor: None,
             slope: None,
+            backtracking: false,
         };
         Ok(snes)
     }
@@ -305,13 +309,21 @@ impl Snes {
 
     /// Applies the options database (after the program's defaults are set).
     pub fn set_from_options(&mut self) -> Result<()> {
-        // SAFETY: valid snes.
+        let mut kind: sys::SNESLineSearchType = std::ptr::null();
+        // SAFETY: valid snes; the line search is borrowed from it and its
+        // type name, a static string of PETSc's, is only read here.
         unsafe {
             petsc_call!(SNESSetFromOptions(self.raw))?;
             let mut ksp: sys::KSP = std::ptr::null_mut();
             petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
-            petsc_call!(KSPSetFromOptions(ksp))
+            petsc_call!(KSPSetFromOptions(ksp))?;
+            let mut search: sys::SNESLineSearch = std::ptr::null_mut();
+            petsc_call!(SNESGetLineSearch(self.raw, &mut search))?;
+            petsc_call!(SNESLineSearchGetType(search, &mut kind))?;
+            self.backtracking =
+                !kind.is_null() && std::ffi::CStr::from_ptr(kind).to_bytes() == b"bt";
         }
+        Ok(())
     }
 
     /// Solves R(x) = 0 starting from `x`, overwriting it. `r` and `j` are the
@@ -358,6 +370,14 @@ impl Snes {
                 Some(jacobian_trampoline),
                 ctx_ptr
             ))?;
+            let mut search: sys::SNESLineSearch = std::ptr::null_mut();
+            petsc_call!(SNESGetLineSearch(self.raw, &mut search))?;
+            let precheck = if self.backtracking {
+                Some(precheck_trampoline as PreCheck)
+            } else {
+                None
+            };
+            petsc_call!(SNESLineSearchSetPreCheck(search, precheck, ctx_ptr))?;
             petsc_call!(SNESSetConvergenceHistory(
                 self.raw,
                 hist.as_mut_ptr(),
@@ -455,68 +475,6 @@ impl Drop for Snes {
     }
 }
 
-/// The convergence test of `Snes::set_linear_floor`: the KSP's own test,
-/// then convergence once the residual is below the floor.
-unsafe extern "C" fn floor_test(
-    ksp: sys::KSP,
-    n: sys::PetscInt,
-    rnorm: f64,
-    reason: *mut sys::KSPConvergedReason,
-    ctx: *mut c_void,
-) -> sys::PetscErrorCode {
-    // SAFETY: ctx is the boxed `LinearFloor` of a live Snes (set in
-    // `set_linear_floor`); PETSc passes a valid reason pointer.
-    let f = unsafe { &mut *(ctx as *mut LinearFloor) };
-    if let Some(inner) = f.inner {
-        // SAFETY: the KSP's own test with its own context.
-        let code = unsafe { inner(ksp, n, rnorm, reason, f.inner_ctx) };
-        if code != 0 {
-            return code;
-        }
-    }
-    if n == 0 {
-        f.rnorm0 = rnorm;
-        return 0;
-    }
-    if f.fraction <= 0.0 {
-        return 0;
-    }
-    // SAFETY: reason is valid for the call.
-    if unsafe { *reason } != 0 {
-        return 0;
-    }
-    let (mut atol, mut rtol, mut stol) = (0.0, 0.0, 0.0);
-    let (mut max_it, mut max_f): (sys::PetscInt, sys::PetscInt) = (0, 0);
-    let mut fnorm = 0.0;
-    let mut hist: *mut f64 = std::ptr::null_mut();
-    let mut hist_its: *mut sys::PetscInt = std::ptr::null_mut();
-    let mut nhist: sys::PetscInt = 0;
-    // SAFETY: valid snes (it owns this KSP); out-pointers are locals.
-    let got = unsafe {
-        sys::SNESGetTolerances(
-            f.snes,
-            &mut atol,
-            &mut rtol,
-            &mut stol,
-            &mut max_it,
-            &mut max_f,
-        ) == 0
-            && sys::SNESGetFunctionNorm(f.snes, &mut fnorm) == 0
-            && sys::SNESGetConvergenceHistory(f.snes, &mut hist, &mut hist_its, &mut nhist) == 0
-    };
-    if !got || hist.is_null() || nhist < 1 || fnorm.is_nan() || fnorm <= 0.0 {
-        return 0;
-    }
-    // SAFETY: the history holds nhist >= 1 entries; the first is |R0|.
-    let first = unsafe { *hist };
-    let target = atol.max(rtol * first);
-    if rnorm <= f.fraction * (target / fnorm) * f.rnorm0 {
-        // SAFETY: reason is valid for the call.
-        unsafe { *reason = sys::KSPConvergedReason_KSP_CONVERGED_ATOL };
-    }
-    0
-}
-
 /// Which callback is running: a domain error is flagged on its own kind.
 #[derive(Clone, Copy)]
 enum Kind {
@@ -580,6 +538,38 @@ unsafe extern "C" fn residual_trampoline(
     // SAFETY: PETSc passes valid vectors owned by the SNES for the call's duration.
     let (xv, mut rv) = unsafe { (Vector::borrowed(x), Vector::borrowed(r)) };
     run_callback(ctx, snes, Kind::Residual, |p| p.residual(&xv, &mut rv))
+}
+
+unsafe extern "C" fn precheck_trampoline(
+    search: sys::SNESLineSearch,
+    x: sys::Vec,
+    y: sys::Vec,
+    changed: *mut sys::PetscBool,
+    ctx: *mut c_void,
+) -> sys::PetscErrorCode {
+    let mut snes: sys::SNES = std::ptr::null_mut();
+    // SAFETY: PETSc passes the line search of the SNES being solved.
+    if unsafe { sys::SNESLineSearchGetSNES(search, &mut snes) } != 0 {
+        return sys::PETSC_ERR_USER;
+    }
+    // SAFETY: PETSc passes valid vectors for the call's duration.
+    let (xv, mut yv) = unsafe { (Vector::borrowed(x), Vector::borrowed(y)) };
+    let mut fraction = None;
+    let code = run_callback(ctx, snes, Kind::Residual, |p| {
+        fraction = p.step_fraction(&xv, &yv)?;
+        Ok(())
+    });
+    if code != 0 {
+        return code;
+    }
+    if let Some(f) = fraction.filter(|f| *f > 0.0 && *f < 1.0) {
+        if yv.scale(f).is_err() {
+            return sys::PETSC_ERR_USER;
+        }
+        // SAFETY: PETSc passes a valid flag pointer.
+        unsafe { *changed = sys::PetscBool_PETSC_TRUE };
+    }
+    0
 }
 
 unsafe extern "C" fn jacobian_trampoline(

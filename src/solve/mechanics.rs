@@ -2,6 +2,7 @@
 //! that SNES solves at one load factor with the contact multipliers λ fixed,
 //! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
+use super::closing;
 use super::dynamics::Inertia;
 use super::lagging::PreconditionerLag;
 use super::master_tail::{extended, MasterTail};
@@ -623,6 +624,21 @@ fn first_nonfinite(values: &[f64], what: &str) -> Result<()> {
     }
 }
 
+impl Mechanics<'_> {
+    /// [`closing::fraction`] of the Newton step `x → x − y` on this rank.
+    /// Collective (ghost updates of both states).
+    fn closing_step(&mut self, x: &Vector, y: &Vector) -> Result<Option<f64>> {
+        let u0 = self.with_state(x, |u, _| Ok(u.to_vec()))?;
+        let mut x1 = x.duplicate()?;
+        x1.copy_from(x)?;
+        x1.axpy(-1.0, y)?;
+        let factor = self.factor;
+        self.with_state(&x1, |u1, pairs| {
+            Ok(closing::fraction(pairs, &u0, u1, factor))
+        })
+    }
+}
+
 impl NonlinearProblem for Mechanics<'_> {
     fn residual(&mut self, x: &Vector, r: &mut Vector) -> std::result::Result<(), CallbackError> {
         let local = self.residual_impl(x, r);
@@ -636,6 +652,28 @@ impl NonlinearProblem for Mechanics<'_> {
             crate::footprint::checkpoint("first Jacobian");
         }
         self.agree(local)
+    }
+
+    /// See [`closing`].
+    fn step_fraction(
+        &mut self,
+        x: &Vector,
+        y: &Vector,
+    ) -> std::result::Result<Option<f64>, CallbackError> {
+        // The same on every rank: the pairs are the scene's, the condensed
+        // state is switched collectively.
+        let condensed = self.condensed.as_ref().is_some_and(|c| c.is_active());
+        if condensed || !self.contact.iter().any(|p| p.mortar.is_some()) {
+            return Ok(None);
+        }
+        let local = self.closing_step(x, y);
+        let fraction = match &local {
+            Ok(Some(f)) => *f,
+            _ => -1.0,
+        };
+        self.agree(local.map(|_| ()))?;
+        let [agreed] = crate::parallel::agree::max(&self.world, [fraction]);
+        Ok((agreed >= 0.0).then_some(closing::past(agreed)))
     }
 
     fn rebuild_preconditioner(&mut self, last_linear_iterations: usize) -> Option<bool> {

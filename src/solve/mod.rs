@@ -10,6 +10,7 @@
 //! SNES, and only this module calls the solver.
 mod anderson;
 pub mod boundary;
+mod closing;
 mod driver;
 pub mod dynamics;
 mod failure;

@@ -510,6 +510,39 @@ impl MortarPair {
         self.census_of(&states, &frictions)
     }
 
+    /// Over the owned nodes whose weighted gap is complete here that are
+    /// open at `u0` and closed at `u1`: the largest fraction of the way
+    /// from `u0` to `u1` at which one of them closes (its trial pressure
+    /// `λ_j − ε_j g̃_j / A_j` interpolated linearly); None if none closes.
+    pub fn closing_fraction(
+        &self,
+        u0: &[f64],
+        u1: &[f64],
+        rate: Option<&Rate>,
+        factor: f64,
+    ) -> Option<f64> {
+        let (s0, _) = self.trial(&self.positions(u0), u0, rate, factor);
+        let (s1, _) = self.trial(&self.positions(u1), u1, rate, factor);
+        let nodal = &self.nodal;
+        let trial = |s: &NodeState, j: usize| {
+            nodal.lambda[j] - nodal.penalty[j] * s.weighted_gap / nodal.area[j]
+        };
+        let mut out: Option<f64> = None;
+        for (j, (a, b)) in s0.iter().zip(&s1).enumerate() {
+            if !(self.complete[j] && self.owned[j]) || a.closed || !b.closed {
+                continue;
+            }
+            let (t0, t1) = (trial(a, j), trial(b, j));
+            let f = if t0 < 0.0 && t1 > t0 {
+                (t0 / (t0 - t1)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            out = Some(out.map_or(f, |o| o.max(f)));
+        }
+        out
+    }
+
     /// Node states and friction outcomes at the positions `x`.
     fn trial(
         &self,
