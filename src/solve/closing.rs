@@ -10,11 +10,14 @@
 //! taken). Before a backtracking line search (`Snes`'s pre-check) the step
 //! now ends a little past where the last node that closes along it
 //! closes, its trial pressure interpolated linearly, so the next direction
-//! has its stiffness: `impact` 164 -> 143 Newton iterations, frictional
-//! hertz-sphere h = 0.5 on 2 ranks 13 -> 11 (250 -> 191 GMRES); ironing
-//! 588 -> 605, the same forces; the other scenes unchanged (the l2 line
-//! search, where this made hertz-sphere h = 0.35 take one more Uzawa
-//! iteration, and the Schur path do not ask).
+//! has its stiffness: `impact` 164 -> 143 Newton iterations; ironing 588
+//! -> 605, the same forces; frictional hertz-sphere h = 0.5 on 2 ranks
+//! (GMRES + GAMG) 13 -> 11 Newton, 250 -> 191 GMRES. Not on the l2 line
+//! search (linear frictionless bodies; there it made hertz-sphere h = 0.35
+//! take one more Uzawa iteration), nor with linear bodies on the direct
+//! path (`Mechanics::closing_steps`), where friction takes the contact
+//! Schur path, whose condensed Newton has no step end positions and must
+//! match the whole-vector Newton.
 use crate::contact::pair_state::ContactPair;
 
 /// How far past the last closing node a shortened step goes, as a

@@ -47,6 +47,9 @@ pub struct Mechanics<'a> {
     /// tangent: K is in the preconditioner's factor, and nothing else
     /// reads the operator (the linear solve is the preconditioner alone).
     pub always_rebuild: bool,
+    /// Shorten backtracking steps to the last closing mortar node
+    /// (`closing`): with hyperelastic bodies, or on the Krylov path.
+    pub closing_steps: bool,
     /// Newton on the condensed contact system (the Schur paths'; see
     /// `petsc::condensed` and `petsc::low_rank`): while its step is active
     /// the SNES vector is the condensed one and so is the residual.
@@ -98,6 +101,7 @@ impl<'a> Mechanics<'a> {
             times: PhaseTimes::default(),
             lag: None,
             always_rebuild: false,
+            closing_steps: false,
             condensed: None,
             stages: Stages::register()?,
             world: SimpleCommunicator::world(),
@@ -663,7 +667,7 @@ impl NonlinearProblem for Mechanics<'_> {
         // The same on every rank: the pairs are the scene's, the condensed
         // state is switched collectively.
         let condensed = self.condensed.as_ref().is_some_and(|c| c.is_active());
-        if condensed || !self.contact.iter().any(|p| p.mortar.is_some()) {
+        if condensed || !self.closing_steps || !self.contact.iter().any(|p| p.mortar.is_some()) {
             return Ok(None);
         }
         let local = self.closing_step(x, y);

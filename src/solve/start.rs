@@ -66,6 +66,13 @@ pub(super) fn mechanics<'a>(
         model.body_force.clone(),
         keep,
     )?;
+    // Above the direct limit the preconditioner is GMRES + AMG.
+    let iterative = DIM * dofs.num_global_nodes() > model.solver.direct_max_dofs;
+    // Linear bodies on the direct path take the contact Schur path, whose
+    // Newton runs on the condensed system (no step end positions at hand):
+    // shortened steps would part it from the whole-vector Newton it must
+    // match (frictional hertz-cylinder: 25 against 24 iterations).
+    mech.closing_steps = !tangent.linear_bulk || iterative;
     // Only with linear bodies is the tangent fixed while the active set
     // is (a hyperelastic tangent changes every iteration anyway).
     if !mech.contact.is_empty()
@@ -73,8 +80,6 @@ pub(super) fn mechanics<'a>(
         && model.solver.reuse.preconditioner
         && model.solver.reuse.active_set
     {
-        // Above the direct limit the preconditioner is GMRES + AMG.
-        let iterative = DIM * dofs.num_global_nodes() > model.solver.direct_max_dofs;
         mech.lag = Some(if iterative {
             PreconditionerLag::iterative()
         } else {
