@@ -2,11 +2,11 @@
 //! that SNES solves at one load factor with the contact multipliers λ fixed,
 //! with Dirichlet rows replaced by u − ū.
 use super::boundary::Dirichlet;
-use super::closing;
 use super::dynamics::Inertia;
 use super::lagging::PreconditionerLag;
 use super::master_tail::{extended, MasterTail};
 use super::phases::{Phase, PhaseTimes, Stages};
+use super::state_change;
 use super::stiffness::{self, KeepStiffness, LiftWork, LinearStiffness};
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
@@ -47,9 +47,10 @@ pub struct Mechanics<'a> {
     /// tangent: K is in the preconditioner's factor, and nothing else
     /// reads the operator (the linear solve is the preconditioner alone).
     pub always_rebuild: bool,
-    /// Shorten backtracking steps to the last closing mortar node
-    /// (`closing`): with hyperelastic bodies, or on the Krylov path.
-    pub closing_steps: bool,
+    /// End backtracking steps where the last mortar node changes between
+    /// open and closed (`state_change`): with hyperelastic bodies, or on
+    /// the Krylov path.
+    pub state_change_steps: bool,
     /// Newton on the condensed contact system (the Schur paths'; see
     /// `petsc::condensed` and `petsc::low_rank`): while its step is active
     /// the SNES vector is the condensed one and so is the residual.
@@ -101,7 +102,7 @@ impl<'a> Mechanics<'a> {
             times: PhaseTimes::default(),
             lag: None,
             always_rebuild: false,
-            closing_steps: false,
+            state_change_steps: false,
             condensed: None,
             stages: Stages::register()?,
             world: SimpleCommunicator::world(),
@@ -629,16 +630,17 @@ fn first_nonfinite(values: &[f64], what: &str) -> Result<()> {
 }
 
 impl Mechanics<'_> {
-    /// [`closing::fraction`] of the Newton step `x → x − y` on this rank.
+    /// [`state_change::fraction`] of the Newton step `x → x − y` on this
+    /// rank.
     /// Collective (ghost updates of both states).
-    fn closing_step(&mut self, x: &Vector, y: &Vector) -> Result<Option<f64>> {
+    fn state_change_step(&mut self, x: &Vector, y: &Vector) -> Result<Option<f64>> {
         let u0 = self.with_state(x, |u, _| Ok(u.to_vec()))?;
         let mut x1 = x.duplicate()?;
         x1.copy_from(x)?;
         x1.axpy(-1.0, y)?;
         let factor = self.factor;
         self.with_state(&x1, |u1, pairs| {
-            Ok(closing::fraction(pairs, &u0, u1, factor))
+            Ok(state_change::fraction(pairs, &u0, u1, factor))
         })
     }
 }
@@ -658,7 +660,7 @@ impl NonlinearProblem for Mechanics<'_> {
         self.agree(local)
     }
 
-    /// See [`closing`].
+    /// See [`state_change`].
     fn step_fraction(
         &mut self,
         x: &Vector,
@@ -667,17 +669,18 @@ impl NonlinearProblem for Mechanics<'_> {
         // The same on every rank: the pairs are the scene's, the condensed
         // state is switched collectively.
         let condensed = self.condensed.as_ref().is_some_and(|c| c.is_active());
-        if condensed || !self.closing_steps || !self.contact.iter().any(|p| p.mortar.is_some()) {
+        if condensed || !self.state_change_steps || !self.contact.iter().any(|p| p.mortar.is_some())
+        {
             return Ok(None);
         }
-        let local = self.closing_step(x, y);
+        let local = self.state_change_step(x, y);
         let fraction = match &local {
             Ok(Some(f)) => *f,
             _ => -1.0,
         };
         self.agree(local.map(|_| ()))?;
         let [agreed] = crate::parallel::agree::max(&self.world, [fraction]);
-        Ok((agreed >= 0.0).then_some(closing::past(agreed)))
+        Ok((agreed >= 0.0).then_some(state_change::past(agreed)))
     }
 
     fn rebuild_preconditioner(&mut self, last_linear_iterations: usize) -> Option<bool> {

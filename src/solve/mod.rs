@@ -10,7 +10,6 @@
 //! SNES, and only this module calls the solver.
 mod anderson;
 pub mod boundary;
-mod closing;
 mod driver;
 pub mod dynamics;
 mod failure;
@@ -29,6 +28,7 @@ mod restart_state;
 mod schur;
 mod setup;
 mod start;
+mod state_change;
 pub mod stiffness;
 pub mod tolerance;
 mod uzawa;

@@ -72,7 +72,7 @@ pub(super) fn mechanics<'a>(
     // Newton runs on the condensed system (no step end positions at hand):
     // shortened steps would part it from the whole-vector Newton it must
     // match (frictional hertz-cylinder: 25 against 24 iterations).
-    mech.closing_steps = !tangent.linear_bulk || iterative;
+    mech.state_change_steps = !tangent.linear_bulk || iterative;
     // Only with linear bodies is the tangent fixed while the active set
     // is (a hyperelastic tangent changes every iteration anyway).
     if !mech.contact.is_empty()

@@ -511,10 +511,11 @@ impl MortarPair {
     }
 
     /// Over the owned nodes whose weighted gap is complete here that are
-    /// open at `u0` and closed at `u1`: the largest fraction of the way
-    /// from `u0` to `u1` at which one of them closes (its trial pressure
-    /// `λ_j − ε_j g̃_j / A_j` interpolated linearly); None if none closes.
-    pub fn closing_fraction(
+    /// open at `u0` and closed at `u1`, or closed and open: the largest
+    /// fraction of the way from `u0` to `u1` at which one of them changes
+    /// state (its trial pressure `λ_j − ε_j g̃_j / A_j` interpolated
+    /// linearly); None if none changes.
+    pub fn state_change_fraction(
         &self,
         u0: &[f64],
         u1: &[f64],
@@ -529,11 +530,13 @@ impl MortarPair {
         };
         let mut out: Option<f64> = None;
         for (j, (a, b)) in s0.iter().zip(&s1).enumerate() {
-            if !(self.complete[j] && self.owned[j]) || a.closed || !b.closed {
+            if !(self.complete[j] && self.owned[j]) || a.closed == b.closed {
                 continue;
             }
+            // A node uncovered at one end changes state without its trial
+            // pressure crossing zero: at the start of the step.
             let (t0, t1) = (trial(a, j), trial(b, j));
-            let f = if t0 < 0.0 && t1 > t0 {
+            let f = if (t0 < 0.0) != (t1 < 0.0) {
                 (t0 / (t0 - t1)).clamp(0.0, 1.0)
             } else {
                 0.0

@@ -55,12 +55,13 @@ impl ContactPair {
         Some(m.census(u_local, self.mortar_rate().as_ref(), factor))
     }
 
-    /// A mortar pair's nodes that close on the way from `u0` to `u1`: the
-    /// fraction of the way at which the last of them closes (the mortar
-    /// pair's `closing_fraction`); None for a links pair or none closing.
-    pub fn closing_fraction(&self, u0: &[f64], u1: &[f64], factor: f64) -> Option<f64> {
+    /// A mortar pair's nodes that change between open and closed on the
+    /// way from `u0` to `u1`: the fraction of the way at which the last of
+    /// them changes (the mortar pair's `state_change_fraction`); None for a
+    /// links pair or none changing.
+    pub fn state_change_fraction(&self, u0: &[f64], u1: &[f64], factor: f64) -> Option<f64> {
         let m = self.mortar.as_ref()?;
-        m.closing_fraction(u0, u1, self.mortar_rate().as_ref(), factor)
+        m.state_change_fraction(u0, u1, self.mortar_rate().as_ref(), factor)
     }
 
     /// Multiplies the normal penalty by `factor`, and the tangential one
