@@ -540,6 +540,9 @@ unsafe extern "C" fn residual_trampoline(
     run_callback(ctx, snes, Kind::Residual, |p| p.residual(&xv, &mut rv))
 }
 
+/// The backtracking line search's pre-check: the problem's step fraction
+/// scales the step in place. A domain error there stops the solve as a
+/// residual's does (the step is then cut back).
 unsafe extern "C" fn precheck_trampoline(
     search: sys::SNESLineSearch,
     x: sys::Vec,
