@@ -631,8 +631,7 @@ fn first_nonfinite(values: &[f64], what: &str) -> Result<()> {
 
 impl Mechanics<'_> {
     /// [`state_change::fraction`] of the Newton step `x → x − y` on this
-    /// rank.
-    /// Collective (ghost updates of both states).
+    /// rank. Collective (ghost updates of both states).
     fn state_change_step(&mut self, x: &Vector, y: &Vector) -> Result<Option<f64>> {
         let u0 = self.with_state(x, |u, _| Ok(u.to_vec()))?;
         let mut x1 = x.duplicate()?;

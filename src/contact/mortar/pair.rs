@@ -511,10 +511,10 @@ impl MortarPair {
     }
 
     /// Over the owned nodes whose weighted gap is complete here that are
-    /// open at `u0` and closed at `u1`, or closed and open: the largest
-    /// fraction of the way from `u0` to `u1` at which one of them changes
-    /// state (its trial pressure `λ_j − ε_j g̃_j / A_j` interpolated
-    /// linearly); None if none changes.
+    /// open at `u0` and closed at `u1`, or closed and open, their trial
+    /// pressure `λ_j − ε_j g̃_j / A_j` crossing zero: the largest fraction
+    /// of the way from `u0` to `u1` at which one of them changes state
+    /// (the trial pressure interpolated linearly); None if none changes.
     pub fn state_change_fraction(
         &self,
         u0: &[f64],
@@ -533,14 +533,14 @@ impl MortarPair {
             if !(self.complete[j] && self.owned[j]) || a.closed == b.closed {
                 continue;
             }
-            // A node uncovered at one end changes state without its trial
-            // pressure crossing zero: at the start of the step.
+            // A node that leaves or enters the master's cover changes state
+            // without its trial pressure crossing zero: no kink to step to
+            // (a fraction of 0 there would shorten every step to 5 %).
             let (t0, t1) = (trial(a, j), trial(b, j));
-            let f = if (t0 < 0.0) != (t1 < 0.0) {
-                (t0 / (t0 - t1)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+            if (t0 < 0.0) == (t1 < 0.0) {
+                continue;
+            }
+            let f = (t0 / (t0 - t1)).clamp(0.0, 1.0);
             out = Some(out.map_or(f, |o| o.max(f)));
         }
         out
