@@ -59,6 +59,13 @@ impl Bilinear {
         }
     }
 
+    /// The bilinear term's size relative to the largest node coordinate,
+    /// `|x₀ − x₁ + x₂ − x₃| / scale` (zero for a triangle or a
+    /// parallelogram: the map is then affine).
+    pub(super) fn relative_bilinear_term(&self) -> f64 {
+        4.0 * self.b[0].hypot(self.b[1]) / self.scale
+    }
+
     pub(super) fn at(&self, z: Vec2) -> Vec2 {
         let bz = z[0] * z[1];
         [0, 1].map(|k| self.c[k] + self.a1[k] * z[0] + self.a2[k] * z[1] + self.b[k] * bz)

@@ -303,24 +303,6 @@ pub const AFFINE_TOL: f64 = 1e-9;
 /// that term times the step squared).
 pub const EXACTLY_AFFINE_TOL: f64 = 1e-13;
 
-/// The relative size of a projected facet's bilinear term (zero for a
-/// triangle and a parallelogram: the parametric map onto the plane is
-/// then affine).
-fn bilinear_term<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>]) -> f64 {
-    match facet {
-        FacetType::Tri3 => 0.0,
-        FacetType::Quad4 => {
-            let c = |i: usize, k: usize| nodes[i][k].re();
-            let b = [0, 1].map(|k| c(0, k) - c(1, k) + c(2, k) - c(3, k));
-            let size = nodes[..4]
-                .iter()
-                .flat_map(|v| [v[0].re().abs(), v[1].re().abs()])
-                .fold(0.0, f64::max);
-            b[0].hypot(b[1]) / size
-        }
-    }
-}
-
 /// Facet shape functions at a parametric point in `T` (bilinear quad,
 /// linear triangle), so a dual-valued point carries its derivative.
 pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
@@ -357,11 +339,11 @@ struct AffineMap {
 }
 
 impl<'a, T: Scalar> PlanarMap<'a, T> {
-    /// The map of the projected nodes `nodes` whose relative bilinear term
-    /// is `bilinear`; `None` if it is affine and singular.
-    pub fn new(facet: FacetType, nodes: &'a [Vec2<T>], bilinear: f64) -> Option<Self> {
-        let map = Bilinear::of(facet, nodes);
-        let affine = if bilinear <= EXACTLY_AFFINE_TOL {
+    /// The map of the projected nodes `nodes` (their f64 form `map`), taken
+    /// as affine where its relative bilinear term is at most `affine_tol`;
+    /// `None` if it is affine and singular.
+    fn new(facet: FacetType, nodes: &'a [Vec2<T>], map: Bilinear, affine_tol: f64) -> Option<Self> {
+        let affine = if map.relative_bilinear_term() <= affine_tol {
             let centre = crate::contact::projection::reference_centre(facet);
             Some(AffineMap {
                 centre,
@@ -406,7 +388,7 @@ impl<'a, T: Scalar> PlanarMap<'a, T> {
 /// Parametric coordinates of the facet point whose projection is `p`, given
 /// the projected nodes `nodes` (Newton however the facet maps).
 pub fn inverse_map<T: Scalar>(facet: FacetType, nodes: &[Vec2<T>], p: &Vec2<T>) -> Option<Vec2<T>> {
-    PlanarMap::new(facet, nodes, f64::INFINITY)?.invert(p)
+    PlanarMap::new(facet, nodes, Bilinear::of(facet, nodes), -1.0)?.invert(p)
 }
 
 /// One more Newton step from the solution `ζ₀` (f64), in `T` with the shape
@@ -469,9 +451,8 @@ pub struct Overlap<T> {
     pub master_nodes: [Vec2<T>; MAX_FACET_NODES],
     /// The clipped polygon, counter-clockwise about the plane normal.
     pub polygon: Polygon<T>,
-    /// Relative bilinear terms of the projected slave and master facets
-    /// (zero: the facet maps affinely onto the plane).
-    pub bilinear: [f64; 2],
+    /// The projected slave and master facets' maps in f64.
+    maps: [Bilinear; 2],
 }
 
 /// A quadrature point of an overlap: its weight (area in the plane) and its
@@ -551,16 +532,16 @@ pub fn overlap<T: Scalar>(
     if polygon.len < 3 || polygon.signed_area().re() <= area_tol {
         return None;
     }
-    let bilinear = [
-        bilinear_term(slave_type, &slave_nodes),
-        bilinear_term(master_type, &master_nodes),
+    let maps = [
+        Bilinear::of(slave_type, slave_2d),
+        Bilinear::of(master_type, master_2d),
     ];
     Some(Overlap {
         plane,
         slave_nodes,
         master_nodes,
         polygon,
-        bilinear,
+        maps,
     })
 }
 
@@ -568,7 +549,9 @@ impl<T: Scalar> Overlap<T> {
     /// Whether both projected facets map affinely onto the plane (to
     /// [`AFFINE_TOL`]): triangles and parallelograms.
     pub fn maps_affinely(&self) -> bool {
-        self.bilinear[0].max(self.bilinear[1]) <= AFFINE_TOL
+        self.maps
+            .iter()
+            .all(|m| m.relative_bilinear_term() <= AFFINE_TOL)
     }
 
     /// Quadrature points on the overlap's triangles with the triangle rule
@@ -584,8 +567,18 @@ impl<T: Scalar> Overlap<T> {
     ) -> bool {
         let affine = self.maps_affinely();
         let maps = (
-            PlanarMap::new(slave_type, &self.slave_nodes, self.bilinear[0]),
-            PlanarMap::new(master_type, &self.master_nodes, self.bilinear[1]),
+            PlanarMap::new(
+                slave_type,
+                &self.slave_nodes,
+                self.maps[0],
+                EXACTLY_AFFINE_TOL,
+            ),
+            PlanarMap::new(
+                master_type,
+                &self.master_nodes,
+                self.maps[1],
+                EXACTLY_AFFINE_TOL,
+            ),
         );
         let (Some(slave_map), Some(master_map)) = maps else {
             return false;
