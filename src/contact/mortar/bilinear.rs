@@ -66,6 +66,21 @@ impl Bilinear {
         4.0 * self.b[0].hypot(self.b[1]) / self.scale
     }
 
+    /// How far the map is from affine, free of the facet's position and
+    /// size: `|b| / √|a₁ × a₂|`, the bilinear term against the square root
+    /// of the mean Jacobian (zero for a triangle or a parallelogram).
+    pub(super) fn distortion(&self) -> f64 {
+        let b = self.b[0].hypot(self.b[1]);
+        let area = (self.a1[0] * self.a2[1] - self.a1[1] * self.a2[0]).abs();
+        if b == 0.0 {
+            0.0
+        } else if area > 0.0 {
+            b / area.sqrt()
+        } else {
+            f64::INFINITY
+        }
+    }
+
     pub(super) fn at(&self, z: Vec2) -> Vec2 {
         let bz = z[0] * z[1];
         [0, 1].map(|k| self.c[k] + self.a1[k] * z[0] + self.a2[k] * z[1] + self.b[k] * bz)

@@ -51,4 +51,6 @@ mod friction_tests;
 #[cfg(test)]
 mod rigid_tests;
 #[cfg(test)]
+mod rule_tests;
+#[cfg(test)]
 mod tests;

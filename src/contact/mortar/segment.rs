@@ -16,7 +16,7 @@
 //!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
 //!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
 //!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
-use super::geometry::{overlap, shape_gradients, AFFINE_TOL};
+use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::shape::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
@@ -42,6 +42,7 @@ pub struct MortarRules {
     /// polynomials of degree 4 and their first derivatives in the nodes
     /// (a perturbation bends a map, and `∂ζ/∂x` is quadratic) of degree 5,
     /// so a degree-5 rule gives the degree-6 rule's values and tangent.
+    /// Also where they are nearly so ([`NEAR_AFFINE`]).
     pub parallelogram_triangle: Rule,
 }
 
@@ -120,8 +121,9 @@ impl MortarRules {
     }
 
     /// The rule on a segment's triangles: where a quad4 facet is not a
-    /// parallelogram (`parallelograms` false) its inverse map makes the
-    /// integrands rational, so they get the degree-6 rule.
+    /// parallelogram, not even nearly ([`NEAR_AFFINE`]; `parallelograms`
+    /// false), its inverse map makes the integrands rational, so they get
+    /// the degree-6 rule.
     pub fn segment(&self, slave: FacetType, master: FacetType, parallelograms: bool) -> &Rule {
         match (slave, master) {
             (FacetType::Tri3, FacetType::Tri3) => &self.affine_triangle,
@@ -313,18 +315,29 @@ fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T
     T::linearised(j.re, j.eps, zeta)
 }
 
-/// Whether a facet (reference positions) is a triangle or a parallelogram
-/// to [`AFFINE_TOL`]: then its area element `J₀` is constant.
-fn is_parallelogram(facet: FacetType, x: &[[f64; 3]]) -> bool {
+/// The distortion ([`NEAR_AFFINE`]) of a facet in 3D (reference
+/// positions): `|b| / √|a₁ × a₂|` of `X(ζ) = c + a₁ ζ₁ + a₂ ζ₂ + b ζ₁ ζ₂`;
+/// zero for a triangle or a parallelogram, whose area element `J₀` is then
+/// constant.
+pub(super) fn reference_distortion(facet: FacetType, x: &[[f64; 3]]) -> f64 {
     match facet {
-        FacetType::Tri3 => true,
+        FacetType::Tri3 => 0.0,
         FacetType::Quad4 => {
-            let bilinear = (0..3).map(|i| x[0][i] - x[1][i] + x[2][i] - x[3][i]);
-            let size = (0..3)
-                .map(|i| x[0][i] - x[2][i])
-                .map(|d| d * d)
-                .sum::<f64>();
-            bilinear.map(|b| b * b).sum::<f64>() <= AFFINE_TOL * AFFINE_TOL * size
+            let combine = |w: [f64; 4]| -> [f64; 3] {
+                [0, 1, 2].map(|i| 0.25 * (0..4).map(|a| w[a] * x[a][i]).sum::<f64>())
+            };
+            let a1 = combine([-1.0, 1.0, 1.0, -1.0]);
+            let a2 = combine([-1.0, -1.0, 1.0, 1.0]);
+            let b = combine([1.0, -1.0, 1.0, -1.0]);
+            let b = dual::norm(&b);
+            let area = dual::norm(&dual::cross(&a1, &a2));
+            if b == 0.0 {
+                0.0
+            } else if area > 0.0 {
+                b / area.sqrt()
+            } else {
+                f64::INFINITY
+            }
         }
     }
 }
@@ -396,7 +409,8 @@ pub fn segment_terms<T: Scalar>(
     };
     let normal = ov.plane.normal;
     let projected_jacobian = PlaneJacobian::of(slave_type, &ov.slave_nodes);
-    let parallelograms = ov.maps_affinely() && is_parallelogram(slave_type, x_ref);
+    let parallelograms =
+        ov.maps_nearly_affinely() && reference_distortion(slave_type, x_ref) <= NEAR_AFFINE;
     let rule = rules.segment(slave_type, master_type, parallelograms);
     let mapped = ov.for_each_point(slave_type, master_type, rule, |q| {
         let projected = projected_jacobian.at(&q.zeta);
