@@ -20,9 +20,9 @@ pub struct SolverSettings {
     /// each load step (the step's own force scale), so small loads and large
     /// ones converge alike, and Uzawa's follow-up solves stay as tight.
     pub atol: Option<f64>,
-    /// Models with at most this many DOFs default to a parallel direct solver
-    /// (MUMPS LU), robust for stiff contact penalties; larger ones to
-    /// Krylov + algebraic multigrid.
+    /// Models with at most this many DOFs default to a direct solver
+    /// (MUMPS; PETSc's own for the smallest on one rank), robust for stiff
+    /// contact penalties; larger ones to Krylov + algebraic multigrid.
     pub direct_max_dofs: usize,
     pub max_cutbacks: usize,
     /// PETSc options (defaults that the command line and PETSC_OPTIONS override).
