@@ -622,6 +622,7 @@ impl LoadSteps<'_> {
             )
         })?;
         drop(pair_fields);
+        crate::footprint::checkpoint("step output");
         output_mark.book(
             Phase::Output,
             &mut self.times,
@@ -674,6 +675,10 @@ impl LoadSteps<'_> {
             ..
         } = self;
         let dofs = mech.dofs;
+        // The solver (its preconditioner above all) is freed before the
+        // gather's scatter is built, so the two never add up in the peak.
+        let schur = schur::summary(&snes);
+        drop(snes);
         let displacement = NaturalOrder::nodal(dofs)?.gather_root(&x)?;
         Ok(RunReport {
             steps: reports,
@@ -684,7 +689,7 @@ impl LoadSteps<'_> {
             pattern_builds,
             preconditioner_builds: mech.lag.as_ref().map_or(0, |l| l.rebuilds),
             preconditioner_reuses: mech.lag.as_ref().map_or(0, |l| l.reuses),
-            schur: schur::summary(&snes),
+            schur,
             phases: times.plus(&mech.times).max_over_ranks(&world),
             halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
             halo_multipliers: parallel::sum_usize(
