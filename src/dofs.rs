@@ -95,7 +95,8 @@ impl DofMap {
     /// Builds the numbering from the global mesh and the cell partition, on
     /// one process (tests, benchmarks, code-built models); the parallel set-up
     /// uses [`DofMap::from_piece`] with the piece rank 0 sent. A node belongs
-    /// to the lowest rank among the cells that contain it, and PETSc numbers
+    /// to one of the ranks among the cells that contain it (the one with
+    /// fewer owned nodes, `distribution::numbering`), and PETSc numbers
     /// the nodes rank by rank, each rank's in natural order, so the numbering
     /// is the same whatever the process that computes it.
     ///

@@ -5,9 +5,9 @@
 //! (DOF map, output order, contact multipliers) holds an array of the global
 //! node or cell count.
 //!
-//! The numbering rules live in [`numbering`]: a node belongs to the lowest
-//! rank among the cells containing it, and PETSc numbers the nodes rank by
-//! rank, each rank's in natural order. Pieces travel as flat `u64` words
+//! The numbering rules live in [`numbering`]: a node belongs to one of the
+//! ranks among the cells containing it (the one owning fewer nodes), and
+//! PETSc numbers the nodes rank by rank, each rank's in natural order. Pieces travel as flat `u64` words
 //! ([`wire`]), one point-to-point message per rank, built and sent one at a
 //! time so rank 0 never holds more than one foreign piece.
 mod local;

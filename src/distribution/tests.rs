@@ -119,3 +119,47 @@ fn a_local_mesh_is_a_fraction_of_the_whole() {
         assert!(p.mesh.block.nodes.len() <= n / 4 + 1);
     }
 }
+
+/// Boundary nodes go to whichever of their ranks owns fewer: every node's
+/// owner holds a cell with it, and the owned counts of a METIS partition
+/// of a 16³ box on 4 ranks spread far less than with the lowest rank
+/// always (which piles every boundary node on the lower ranks).
+#[test]
+fn boundary_nodes_spread_the_owned_counts() {
+    let mesh = graded_box(&BoxSpec {
+        divisions: [16; 3],
+        ..BoxSpec::default()
+    })
+    .unwrap();
+    let ranks = 4;
+    let part = crate::partition::partition_cells(&mesh, ranks, &[]).unwrap();
+    let numbering = Numbering::new(&mesh, &part, ranks);
+    let pieces: Vec<_> = (0..ranks)
+        .map(|r| numbering.piece(&mesh, &part, r, &Wanted::default()))
+        .collect();
+    let spread = |counts: &[usize]| counts.iter().max().unwrap() - counts.iter().min().unwrap();
+    let owned: Vec<usize> = pieces.iter().map(|p| p.n_owned).collect();
+    let mut lowest = vec![usize::MAX; mesh.num_nodes()];
+    for (c, &p) in part.iter().enumerate() {
+        for &v in mesh.cell(c) {
+            lowest[v] = lowest[v].min(p as usize);
+        }
+    }
+    let mut lowest_owned = vec![0; ranks];
+    lowest.iter().for_each(|&r| lowest_owned[r] += 1);
+    assert!(
+        spread(&owned) * 4 < spread(&lowest_owned),
+        "{owned:?} against {lowest_owned:?}"
+    );
+    assert!(spread(&owned) * 50 < mesh.num_nodes() / ranks, "{owned:?}");
+    for p in &pieces {
+        let local: std::collections::BTreeSet<usize> = p
+            .local_cells
+            .iter()
+            .flat_map(|&c| mesh.cell(c).iter().copied())
+            .collect();
+        assert!(p.local_natural[..p.n_owned]
+            .iter()
+            .all(|v| local.contains(v)));
+    }
+}

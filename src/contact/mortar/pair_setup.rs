@@ -101,8 +101,8 @@ impl MortarPair {
             .collect();
         let x_ref: Vec<[f64; 3]> = nodes.iter().map(|v| v.2).collect();
         // A rank evaluates the nodes of its own facets and the slave nodes
-        // it owns: the owner of a node (the lowest rank among the cells
-        // holding it) may hold none of its slave facets (a tet touching the
+        // it owns: the owner of a node (a rank among the cells holding
+        // it) may hold none of its slave facets (a tet touching the
         // surface at that node only), yet it is the one that writes the
         // node's fields.
         let mut mine: Vec<bool> = local
