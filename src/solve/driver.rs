@@ -14,7 +14,7 @@ use super::natural::NaturalOrder;
 use super::newmark::Coefficients;
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
 use super::predictor::Predictor;
-use super::reactions::{reaction_totals, zero_unconstrained};
+use super::reactions::support_reactions;
 use super::report::{
     contact_reports, nodal_pressure, print_step, PairFields, RunReport, StepReport, StepSink,
 };
@@ -637,15 +637,10 @@ impl LoadSteps<'_> {
     /// reaction field (constrained rows only) in `self.reaction`.
     fn reactions(&mut self) -> Result<Vec<(String, [f64; 3])>> {
         // In dynamics the support also carries the inertia of its rows.
-        parallel::agree(
-            &self.world,
-            self.mech.raw_residual(&self.x, &mut self.reaction),
-        )?;
-        let dirichlet = self.mech.dirichlet;
+        let raw = self.mech.raw_residual(&self.x, &mut self.reaction);
+        parallel::agree(&self.world, raw)?;
         let start = self.mech.dofs.owned_dof_start();
-        let totals = reaction_totals(&self.world, dirichlet, &self.reaction, start)?;
-        zero_unconstrained(&mut self.reaction, dirichlet)?;
-        Ok(totals)
+        support_reactions(&self.world, self.mech.dirichlet, &mut self.reaction, start)
     }
 
     /// Collective: every pair's values at its points and its force.
@@ -675,8 +670,7 @@ impl LoadSteps<'_> {
             ..
         } = self;
         let dofs = mech.dofs;
-        // The solver (its preconditioner above all) is freed before the
-        // gather's scatter is built, so the two never add up in the peak.
+        // Freed before the gather's scatter is built: the two never add up.
         let schur = schur::summary(&snes);
         drop(snes);
         let displacement = NaturalOrder::nodal(dofs)?.gather_root(&x)?;

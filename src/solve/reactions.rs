@@ -9,7 +9,7 @@ use mpi::traits::*;
 
 /// Collective: the total reaction of each Dirichlet set, summed over ranks,
 /// from the raw residual `raw` (owned rows, starting at global DOF `start`).
-pub(super) fn reaction_totals(
+fn reaction_totals(
     world: &impl Communicator,
     dirichlet: &Dirichlet,
     raw: &Vector,
@@ -33,9 +33,22 @@ pub(super) fn reaction_totals(
         .collect())
 }
 
+/// Collective: [`reaction_totals`] of the raw residual `reaction`, which is
+/// then cut to its constrained rows ([`zero_unconstrained`]).
+pub(super) fn support_reactions(
+    world: &impl Communicator,
+    dirichlet: &Dirichlet,
+    reaction: &mut Vector,
+    start: usize,
+) -> Result<Vec<(String, [f64; 3])>> {
+    let totals = reaction_totals(world, dirichlet, reaction, start)?;
+    zero_unconstrained(reaction, dirichlet)?;
+    Ok(totals)
+}
+
 /// Keeps the constrained rows of `reaction` only (the rest is the
 /// equilibrium residual, zero up to the tolerance).
-pub(super) fn zero_unconstrained(reaction: &mut Vector, dirichlet: &Dirichlet) -> Result<()> {
+fn zero_unconstrained(reaction: &mut Vector, dirichlet: &Dirichlet) -> Result<()> {
     reaction.with_array_mut(|a| {
         let mut keep = vec![false; a.len()];
         for d in &dirichlet.dofs {
