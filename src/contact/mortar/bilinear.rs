@@ -70,15 +70,8 @@ impl Bilinear {
     /// size: `|b| / √|a₁ × a₂|`, the bilinear term against the square root
     /// of the mean Jacobian (zero for a triangle or a parallelogram).
     pub(super) fn distortion(&self) -> f64 {
-        let b = self.b[0].hypot(self.b[1]);
         let area = (self.a1[0] * self.a2[1] - self.a1[1] * self.a2[0]).abs();
-        if b == 0.0 {
-            0.0
-        } else if area > 0.0 {
-            b / area.sqrt()
-        } else {
-            f64::INFINITY
-        }
+        distortion(self.b[0].hypot(self.b[1]), area)
     }
 
     pub(super) fn at(&self, z: Vec2) -> Vec2 {
@@ -122,6 +115,19 @@ impl Bilinear {
         // Accept a residual at rounding level (bilinear Newton stalls there).
         let x = self.at(zeta);
         ((x[0] - target[0]).hypot(x[1] - target[1]) <= 1e-12 * self.scale).then_some(zeta)
+    }
+}
+
+/// `|b| / √A` for a map's bilinear term `|b|` and mean Jacobian `A`: zero
+/// when `b` is zero (a triangle, a parallelogram), infinite for a
+/// degenerate facet (no area) with a bilinear term.
+pub(super) fn distortion(b: f64, area: f64) -> f64 {
+    if b == 0.0 {
+        0.0
+    } else if area > 0.0 {
+        b / area.sqrt()
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -329,15 +329,7 @@ pub(super) fn reference_distortion(facet: FacetType, x: &[[f64; 3]]) -> f64 {
             let a1 = combine([-1.0, 1.0, 1.0, -1.0]);
             let a2 = combine([-1.0, -1.0, 1.0, 1.0]);
             let b = combine([1.0, -1.0, 1.0, -1.0]);
-            let b = dual::norm(&b);
-            let area = dual::norm(&dual::cross(&a1, &a2));
-            if b == 0.0 {
-                0.0
-            } else if area > 0.0 {
-                b / area.sqrt()
-            } else {
-                f64::INFINITY
-            }
+            super::bilinear::distortion(dual::norm(&b), dual::norm(&dual::cross(&a1, &a2)))
         }
     }
 }
