@@ -92,29 +92,36 @@ pub fn segment_slips<T: Seed>(
     segments: &[Segment<T>],
     inc: &Increment,
 ) -> Vec<SegmentSlip<T>> {
-    let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
     segments
         .iter()
-        .map(|seg| {
-            let s_nodes = &interface.slave_facets[seg.slave as usize][..ns];
-            let m_nodes = &interface.master_facets[seg.master as usize][..nm];
-            let d1 = increments::<T>(s_nodes, 0, inc);
-            let d2 = increments::<T>(m_nodes, super::system::MASTER_OFFSET, inc);
-            let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
-            for (a, s) in slip.iter_mut().enumerate().take(ns) {
-                for (dak, x) in seg.terms.d[a].iter().zip(&d1).take(ns) {
-                    *s = dual::add(s, &dual::scale(x, *dak));
-                }
-                for (mal, x) in seg.terms.m[a].iter().zip(&d2).take(nm) {
-                    *s = dual::sub(s, &dual::scale(x, *mal));
-                }
-            }
-            SegmentSlip {
-                normal: dual::scale(&seg.terms.normal, seg.terms.area),
-                slip,
-            }
-        })
+        .map(|seg| segment_slip(interface, seg, inc))
         .collect()
+}
+
+/// One segment's slip terms.
+pub fn segment_slip<T: Seed>(
+    interface: &Interface,
+    seg: &Segment<T>,
+    inc: &Increment,
+) -> SegmentSlip<T> {
+    let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
+    let s_nodes = &interface.slave_facets[seg.slave as usize][..ns];
+    let m_nodes = &interface.master_facets[seg.master as usize][..nm];
+    let d1 = increments::<T>(s_nodes, 0, inc);
+    let d2 = increments::<T>(m_nodes, super::system::MASTER_OFFSET, inc);
+    let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+    for (a, s) in slip.iter_mut().enumerate().take(ns) {
+        for (dak, x) in seg.terms.d[a].iter().zip(&d1).take(ns) {
+            *s = dual::add(s, &dual::scale(x, *dak));
+        }
+        for (mal, x) in seg.terms.m[a].iter().zip(&d2).take(nm) {
+            *s = dual::sub(s, &dual::scale(x, *mal));
+        }
+    }
+    SegmentSlip {
+        normal: dual::scale(&seg.terms.normal, seg.terms.area),
+        slip,
+    }
 }
 
 /// What the friction law needs of one node besides its aggregates.
@@ -273,16 +280,45 @@ pub fn tangent(
     frictions: &[NodeFriction],
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
-    let ns = interface.slave_type.nodes();
-    let nn = nodal.nodes.len();
-    // Per active node: ∂tT_i/∂x over all its segments, and the assembled
-    // coefficients D_jk / −M_jl by node id.
-    let mut grad: Vec<[Vec<(NodeDof, f64)>; 3]> = vec![Default::default(); nn];
-    let mut coef: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
-    // Σ_j tT_j ∂c/∂x of one segment, summed over its nodes before it is
-    // emitted (rows 3 b + i: node slot b, component i of tT).
-    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
+    let mut t = FrictionTangent::new(nodal);
     for (seg, s) in segments.iter().zip(slips) {
+        t.add(interface, nodal, seg, s, frictions, &mut emit);
+    }
+    t.finish(emit);
+}
+
+/// The tangential tangent, one segment at a time (as the normal one,
+/// `system::NormalTangent`).
+pub struct FrictionTangent {
+    /// Per active node: ∂tT_i/∂x over all its segments, and the assembled
+    /// coefficients D_jk / −M_jl by node id.
+    grad: Vec<[Vec<(NodeDof, f64)>; 3]>,
+    coef: Vec<Vec<(NodeDof, f64)>>,
+    /// Σ_j tT_j ∂c/∂x of one segment, summed over its nodes before it is
+    /// emitted (rows 3 b + i: node slot b, component i of tT).
+    local: [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+}
+
+impl FrictionTangent {
+    pub fn new(nodal: &NodalData) -> Self {
+        let nn = nodal.nodes.len();
+        FrictionTangent {
+            grad: vec![Default::default(); nn],
+            coef: vec![Vec::new(); nn],
+            local: [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS],
+        }
+    }
+
+    pub fn add(
+        &mut self,
+        interface: &Interface,
+        nodal: &NodalData,
+        seg: &Segment<D>,
+        s: &SegmentSlip<D>,
+        frictions: &[NodeFriction],
+        emit: impl FnMut(NodeDof, NodeDof, f64),
+    ) {
+        let ns = interface.slave_type.nodes();
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
         let mut any = false;
@@ -312,7 +348,7 @@ pub fn tangent(
                 .enumerate()
                 .filter(|e| *e.1 != u32::MAX)
             {
-                for (g, row) in grad[j].iter_mut().zip(&f.derivative) {
+                for (g, row) in self.grad[j].iter_mut().zip(&f.derivative) {
                     let d: f64 = row.iter().zip(&aggregates).map(|(r, x)| r * x.eps[v]).sum();
                     if d != 0.0 {
                         g.push(((id, v % 3), d));
@@ -324,21 +360,24 @@ pub fn tangent(
             }
             for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
                 let c = coefficient(seg, a, b);
-                coef[j].push(((id, 0), c.re));
+                self.coef[j].push(((id, 0), c.re));
                 for (i, t) in f.traction.iter().enumerate().filter(|e| *e.1 != 0.0) {
                     any = true;
-                    for (l, d) in local[3 * b + i].iter_mut().zip(&c.eps) {
+                    for (l, d) in self.local[3 * b + i].iter_mut().zip(&c.eps) {
                         *l += t * d;
                     }
                 }
             }
         }
         if any {
-            emit_local(&ids, &mut local, &mut emit);
+            emit_local(&ids, &mut self.local, emit);
         }
     }
-    // c ⊗ ∂tT_j/∂x.
-    emit_outer(coef, grad, emit);
+
+    /// c ⊗ ∂tT_j/∂x.
+    pub fn finish(self, emit: impl FnMut(NodeDof, NodeDof, f64)) {
+        emit_outer(self.coef, self.grad, emit);
+    }
 }
 
 /// Emits, per active node j, the outer product of its assembled

@@ -9,7 +9,7 @@
 //! that holds node `j` computes the same `g̃_j` and the same update of
 //! `λ_j` bit for bit; the owner of the node is the one that counts it in
 //! the Uzawa statistics and writes it out.
-use super::friction::{self, Increment, NodeFriction, Rate, SegmentSlip};
+use super::friction::{self, Increment, NodeFriction, Rate};
 use super::holding::Holding;
 use super::rigid_master::RigidMaster;
 use super::rows::{signature, Rows};
@@ -53,11 +53,10 @@ pub struct MortarSnapshot {
 }
 
 /// One evaluation of the pair: segments, node states and (with friction)
-/// the segments' slip terms and the nodes' friction.
+/// the nodes' friction.
 pub(super) struct Evaluation<T> {
     pub segments: Vec<Segment<T>>,
     pub states: Vec<NodeState>,
-    pub slips: Vec<SegmentSlip<T>>,
     pub frictions: Vec<NodeFriction>,
 }
 
@@ -284,46 +283,8 @@ impl MortarPair {
         self.with_friction(&interface, segments, states, x, u_local, rate)
     }
 
-    /// The evaluation the tangent needs: the node states from the segments
-    /// in f64, then the derivatives only on the candidates of slave facets
-    /// with a closed node (the tangent of an open node is zero, and a
-    /// closed node's facets are all among them, so its terms are complete).
-    /// On a curved slave most overlaps lie away from the contact: on
-    /// hertz-sphere the dual numbers went through every one of them.
-    fn evaluate_tangent(
-        &self,
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        rate: Option<&Rate>,
-    ) -> Evaluation<Dual<{ system::SEGMENT_DOFS }>> {
-        let interface = self.interface(x);
-        let values = self.nodal.cache.segments(&interface, &self.rules);
-        let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &values);
-        let states = system::node_states(&self.nodal, &gap, &covered);
-        let nf = self.facet_type.nodes();
-        let closed = |f: u32| {
-            self.slave_facets[f as usize][..nf]
-                .iter()
-                .any(|&n| self.nodal.slot_of(n).is_some_and(|j| states[j].closed))
-        };
-        // The overlaps the f64 pass found: the dual pass makes the same
-        // clipping decisions (on the values), so the rest would be clipped
-        // in dual numbers only to be dropped.
-        let live: Vec<(u32, u32)> = values
-            .iter()
-            .filter(|s| closed(s.slave))
-            .map(|s| (s.slave, s.master))
-            .collect();
-        let interface = Interface {
-            candidates: &live,
-            ..interface
-        };
-        let segments = system::segments(&interface, &self.rules);
-        self.with_friction(&interface, segments, states, x, u_local, rate)
-    }
-
-    /// Completes an evaluation with the segments' slip terms and the nodes'
-    /// friction (nothing for a frictionless pair).
+    /// Completes an evaluation with the nodes' friction (nothing for a
+    /// frictionless pair).
     fn with_friction<T: system::Seed>(
         &self,
         interface: &Interface,
@@ -333,7 +294,7 @@ impl MortarPair {
         u_local: &[f64],
         rate: Option<&Rate>,
     ) -> Evaluation<T> {
-        let (slips, frictions) = match &self.friction {
+        let frictions = match &self.friction {
             Some(f) => {
                 let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
                 let inc = Increment {
@@ -341,22 +302,20 @@ impl MortarPair {
                     slope,
                 };
                 let slips = friction::segment_slips(interface, &segments, &inc);
-                let frictions = friction::node_frictions(
+                friction::node_frictions(
                     interface,
                     &self.nodal,
                     &f.nodal,
                     &states,
                     &segments,
                     &slips,
-                );
-                (slips, frictions)
+                )
             }
-            None => (Vec::new(), Vec::new()),
+            None => Vec::new(),
         };
         Evaluation {
             segments,
             states,
-            slips,
             frictions,
         }
     }
@@ -404,21 +363,10 @@ impl MortarPair {
         if main_part && self.friction.is_none() {
             return self.add_main_part(dofs, &x, u_local, k);
         }
-        let e = self.evaluate_tangent(&x, u_local, rate);
+        let e = self.evaluate::<f64>(&x, u_local, rate);
         let interface = self.interface(&x);
         let mut rows = Rows::new(self.node_local.len());
-        let mut add = |r, c, v| rows.add(r, c, v);
-        system::tangent(&interface, &self.nodal, &e.segments, &e.states, &mut add);
-        if self.friction.is_some() {
-            friction::tangent(
-                &interface,
-                &self.nodal,
-                &e.segments,
-                &e.slips,
-                &e.frictions,
-                &mut add,
-            );
-        }
+        self.stream_tangent(&interface, &e, &x, u_local, rate, &mut rows);
         rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
         Ok(signature(
             &e.segments,
@@ -428,6 +376,66 @@ impl MortarPair {
             self.facet_type.nodes(),
             &self.nodal,
         ))
+    }
+
+    /// The tangent at the node states (and friction) of the f64
+    /// evaluation `e`: the derivatives are taken only on the overlaps of
+    /// slave facets with a closed node (the tangent of an open node is
+    /// zero, and a closed node's facets are all among them, so its terms
+    /// are complete; on a curved slave most overlaps lie away from the
+    /// contact), and the f64 pass found them: the dual pass makes the same
+    /// clipping decisions on the values. Each `Dual` segment goes into the
+    /// normal and tangential tangents as it is integrated.
+    fn stream_tangent(
+        &self,
+        interface: &Interface,
+        e: &Evaluation<f64>,
+        x: &[[f64; 3]],
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        rows: &mut Rows,
+    ) {
+        let nf = self.facet_type.nodes();
+        let closed = |f: u32| {
+            self.slave_facets[f as usize][..nf]
+                .iter()
+                .any(|&n| self.nodal.slot_of(n).is_some_and(|j| e.states[j].closed))
+        };
+        let live: Vec<(u32, u32)> = e
+            .segments
+            .iter()
+            .filter(|s| closed(s.slave))
+            .map(|s| (s.slave, s.master))
+            .collect();
+        let live = Interface {
+            candidates: &live,
+            ..*interface
+        };
+        let increments = self
+            .friction
+            .as_ref()
+            .map(|f| f.increments(&self.node_local, x, u_local, rate));
+        let mut normal = system::NormalTangent::new(&self.nodal);
+        let mut tangential = self
+            .friction
+            .as_ref()
+            .map(|_| friction::FrictionTangent::new(&self.nodal));
+        system::for_each_segment::<Dual<{ system::SEGMENT_DOFS }>>(&live, &self.rules, |seg| {
+            let mut add = |r, c, v| rows.add(r, c, v);
+            normal.add(interface, &self.nodal, &seg, &e.states, &mut add);
+            if let (Some(t), Some((value, slope))) = (&mut tangential, &increments) {
+                let inc = Increment {
+                    value,
+                    slope: *slope,
+                };
+                let slip = friction::segment_slip(interface, &seg, &inc);
+                t.add(interface, &self.nodal, &seg, &slip, &e.frictions, &mut add);
+            }
+        });
+        normal.finish(&self.nodal, |r, c, v| rows.add(r, c, v));
+        if let Some(t) = tangential {
+            t.finish(|r, c, v| rows.add(r, c, v));
+        }
     }
 
     fn add_main_part(

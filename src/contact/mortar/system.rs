@@ -202,8 +202,21 @@ fn seeded<T: Seed>(
 
 /// Every overlapping candidate's integrals.
 pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
+    let mut out = Vec::with_capacity(interface.candidates.len());
+    for_each_segment(interface, rules, |seg| out.push(seg));
+    out
+}
+
+/// Calls `visit` with every overlapping candidate's integrals, in candidate
+/// order. The tangent streams its `Dual` segments through here: 8 KB each,
+/// a vector of them was grown, copied and paged in at every Newton
+/// iteration (a fifth of a frictional mortar run).
+pub fn for_each_segment<T: Seed>(
+    interface: &Interface,
+    rules: &MortarRules,
+    mut visit: impl FnMut(Segment<T>),
+) {
     let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
-    let mut out = Vec::new();
     let mut cached: Option<(u32, [[f64; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
     for &(s, m) in interface.candidates {
         let snodes = &interface.slave_facets[s as usize][..ns];
@@ -236,14 +249,13 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
             rules,
         );
         if let Some(terms) = terms {
-            out.push(Segment {
+            visit(Segment {
                 slave: s,
                 master: m,
                 terms,
             });
         }
     }
-    out
 }
 
 /// Nodal weighted gaps `g̃_j` (by slot) and whether the segments cover the
@@ -443,16 +455,46 @@ pub fn tangent(
     states: &[NodeState],
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
-    let ns = interface.slave_type.nodes();
-    let nn = nodal.nodes.len();
-    // Per closed node: ∂g̃_j/∂x over all its segments, and the assembled
-    // force coefficients c_j (rows).
-    let mut grad: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
-    let mut rows: Vec<Vec<(NodeDof, f64)>> = vec![Vec::new(); nn];
-    // Σ_j p_j ∂c_j/∂x of one segment, summed over its nodes before it is
-    // emitted (a quarter of the entries a node-by-node emission made).
-    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
+    let mut t = NormalTangent::new(nodal);
     for seg in segments {
+        t.add(interface, nodal, seg, states, &mut emit);
+    }
+    t.finish(nodal, emit);
+}
+
+/// The normal tangent, one segment at a time: the per-segment part is
+/// emitted as it comes, the per-node part once every segment has been
+/// added (it must then hold every segment of every node of an assembled
+/// facet).
+pub struct NormalTangent {
+    /// Per closed node: ∂g̃_j/∂x over all its segments, and the assembled
+    /// force coefficients c_j (rows).
+    grad: Vec<Vec<(NodeDof, f64)>>,
+    rows: Vec<Vec<(NodeDof, f64)>>,
+    /// Σ_j p_j ∂c_j/∂x of one segment, summed over its nodes before it is
+    /// emitted (a quarter of the entries a node-by-node emission made).
+    local: [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+}
+
+impl NormalTangent {
+    pub fn new(nodal: &NodalData) -> Self {
+        let nn = nodal.nodes.len();
+        NormalTangent {
+            grad: vec![Vec::new(); nn],
+            rows: vec![Vec::new(); nn],
+            local: [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS],
+        }
+    }
+
+    pub fn add(
+        &mut self,
+        interface: &Interface,
+        nodal: &NodalData,
+        seg: &Segment<D>,
+        states: &[NodeState],
+        emit: impl FnMut(NodeDof, NodeDof, f64),
+    ) {
+        let ns = interface.slave_type.nodes();
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
         let mut any = false;
@@ -472,26 +514,29 @@ pub fn tangent(
                 if id == u32::MAX {
                     continue;
                 }
-                grad[j].push(((id, v % 3), seg.terms.weighted_gap[a].eps[v]));
+                self.grad[j].push(((id, v % 3), seg.terms.weighted_gap[a].eps[v]));
                 if !assembled {
                     continue;
                 }
                 let c = force_coefficient(&seg.terms, a, v);
-                rows[j].push(((id, v % 3), c.re));
+                self.rows[j].push(((id, v % 3), c.re));
                 if p != 0.0 {
                     any = true;
-                    for (l, d) in local[v].iter_mut().zip(&c.eps) {
+                    for (l, d) in self.local[v].iter_mut().zip(&c.eps) {
                         *l += p * d;
                     }
                 }
             }
         }
         if any {
-            emit_local(&ids, &mut local, &mut emit);
+            emit_local(&ids, &mut self.local, emit);
         }
     }
-    // c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
-    emit_scaled_outer(nodal, -1.0, rows, grad, emit);
+
+    /// c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
+    pub fn finish(self, nodal: &NodalData, emit: impl FnMut(NodeDof, NodeDof, f64)) {
+        emit_scaled_outer(nodal, -1.0, self.rows, self.grad, emit);
+    }
 }
 
 /// Emits a segment's dense block `local[v][w]` (segment variables, node ids
