@@ -23,8 +23,8 @@
 //! segments' `Dual<24>` gives `∂tT_j/∂x`: the slip branch, the coupling to
 //! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
 use super::system::{
-    emit_local, for_each_slave_node, segment_nodes, Interface, Merger, NodalData, NodeDof,
-    NodeState, Seed, Segment, SEGMENT_DOFS,
+    emit_local, for_each_slave_node, segment_nodes, Block, Interface, Merger, NodalData, NodeDof,
+    NodeState, NormalTangent, Seed, Segment, SEGMENT_DOFS,
 };
 use crate::contact::dual::{self, Dual, Scalar, Vec3};
 use crate::fem::MAX_FACET_NODES;
@@ -270,54 +270,110 @@ pub fn residual<T: Scalar>(
     });
 }
 
-/// Adds the exact tangent of the tangential residual. `segments` and
-/// `slips` must hold every segment of every node of an assembled facet.
+/// Adds the exact tangent of the normal and the tangential residual (what
+/// a frictional pair assembles). `segments` and `slips` must hold every
+/// segment of every node of an assembled facet.
+#[allow(clippy::too_many_arguments)]
 pub fn tangent(
     interface: &Interface,
     nodal: &NodalData,
     segments: &[Segment<D>],
     slips: &[SegmentSlip<D>],
+    states: &[NodeState],
     frictions: &[NodeFriction],
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
-    let mut t = FrictionTangent::new(nodal);
+    let mut t = FrictionalTangent::new(interface, nodal, states, frictions);
     for (seg, s) in segments.iter().zip(slips) {
-        t.add(interface, nodal, seg, s, frictions, &mut emit);
+        t.add(seg, s, &mut emit);
     }
     t.finish(emit);
 }
 
-/// The tangential tangent, one segment at a time (as the normal one,
-/// `system::NormalTangent`).
-pub struct FrictionTangent {
-    /// Per active node: ∂tT_i/∂x over all its segments, and the assembled
-    /// coefficients D_jk / −M_jl by node id.
-    grad: Vec<[Vec<(NodeDof, f64)>; 3]>,
-    coef: Vec<Vec<(NodeDof, f64)>>,
-    /// Σ_j tT_j ∂c/∂x of one segment, summed over its nodes before it is
-    /// emitted (rows 3 b + i: node slot b, component i of tT).
-    local: [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+/// The normal and tangential tangents of a frictional pair, one segment at
+/// a time: a segment's own terms are emitted as one block, the per-node
+/// outer products once every segment has been added.
+pub struct FrictionalTangent<'a> {
+    interface: &'a Interface<'a>,
+    nodal: &'a NodalData,
+    states: &'a [NodeState],
+    frictions: &'a [NodeFriction],
+    normal: NormalTangent,
+    tangential: FrictionTangent,
+    local: Block,
 }
 
-impl FrictionTangent {
-    pub fn new(nodal: &NodalData) -> Self {
-        let nn = nodal.nodes.len();
-        FrictionTangent {
-            grad: vec![Default::default(); nn],
-            coef: vec![Vec::new(); nn],
+impl<'a> FrictionalTangent<'a> {
+    pub fn new(
+        interface: &'a Interface<'a>,
+        nodal: &'a NodalData,
+        states: &'a [NodeState],
+        frictions: &'a [NodeFriction],
+    ) -> Self {
+        FrictionalTangent {
+            interface,
+            nodal,
+            states,
+            frictions,
+            normal: NormalTangent::new(nodal),
+            tangential: FrictionTangent::new(nodal),
             local: [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS],
         }
     }
 
     pub fn add(
         &mut self,
+        seg: &Segment<D>,
+        slip: &SegmentSlip<D>,
+        emit: impl FnMut(NodeDof, NodeDof, f64),
+    ) {
+        let (interface, nodal) = (self.interface, self.nodal);
+        let normal = self
+            .normal
+            .add(interface, nodal, seg, self.states, &mut self.local);
+        let tangential =
+            self.tangential
+                .add(interface, nodal, seg, slip, self.frictions, &mut self.local);
+        if normal || tangential {
+            let ids = segment_nodes(interface, seg.slave, seg.master);
+            emit_local(&ids, &mut self.local, emit);
+        }
+    }
+
+    pub fn finish(self, emit: impl FnMut(NodeDof, NodeDof, f64)) {
+        self.tangential.finish_with(self.normal, self.nodal, emit);
+    }
+}
+
+/// The tangential tangent, one segment at a time (as the normal one,
+/// [`NormalTangent`], whose segment blocks it adds to).
+struct FrictionTangent {
+    /// Per active node: ∂tT_i/∂x over all its segments, and the assembled
+    /// coefficients D_jk / −M_jl by node id.
+    grad: Vec<[Vec<(NodeDof, f64)>; 3]>,
+    coef: Vec<Vec<(NodeDof, f64)>>,
+}
+
+impl FrictionTangent {
+    fn new(nodal: &NodalData) -> Self {
+        let nn = nodal.nodes.len();
+        FrictionTangent {
+            grad: vec![Default::default(); nn],
+            coef: vec![Vec::new(); nn],
+        }
+    }
+
+    /// Adds `seg`'s terms: Σ_j tT_j ∂c/∂x into `local` (rows 3 b + i: node
+    /// slot b, component i of tT); true if it added any.
+    fn add(
+        &mut self,
         interface: &Interface,
         nodal: &NodalData,
         seg: &Segment<D>,
         s: &SegmentSlip<D>,
         frictions: &[NodeFriction],
-        emit: impl FnMut(NodeDof, NodeDof, f64),
-    ) {
+        local: &mut Block,
+    ) -> bool {
         let ns = interface.slave_type.nodes();
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
@@ -363,21 +419,118 @@ impl FrictionTangent {
                 self.coef[j].push(((id, 0), c.re));
                 for (i, t) in f.traction.iter().enumerate().filter(|e| *e.1 != 0.0) {
                     any = true;
-                    for (l, d) in self.local[3 * b + i].iter_mut().zip(&c.eps) {
+                    for (l, d) in local[3 * b + i].iter_mut().zip(&c.eps) {
                         *l += t * d;
                     }
                 }
             }
         }
-        if any {
-            emit_local(&ids, &mut self.local, emit);
-        }
+        any
     }
 
-    /// c ⊗ ∂tT_j/∂x.
-    pub fn finish(self, emit: impl FnMut(NodeDof, NodeDof, f64)) {
-        emit_outer(self.coef, self.grad, emit);
+    /// This tangent's and `normal`'s per-node parts in one pass: row
+    /// `(k, i)` of node `j` gets `c^N_{(k,i)} s_j ∂g̃_j + c^T_k ∂tT_{j,i}`
+    /// (`s_j = −ε_j/A_j`), one entry per coupling where the two outer
+    /// products emitted two (half of a frictional tangent's entries).
+    fn finish_with(
+        mut self,
+        mut normal: NormalTangent,
+        nodal: &NodalData,
+        mut emit: impl FnMut(NodeDof, NodeDof, f64),
+    ) {
+        let mut merger = Merger::new();
+        let mut columns = Columns::default();
+        for j in 0..self.coef.len() {
+            if self.coef[j].is_empty() && normal.rows[j].is_empty() {
+                continue;
+            }
+            let scale = -nodal.penalty[j] / nodal.area[j];
+            let grad_n = merger.merged(&std::mem::take(&mut normal.grad[j]));
+            let grad_t = std::mem::take(&mut self.grad[j]).map(|g| merger.merged(&g));
+            columns.gather(&grad_n, &grad_t);
+            let rows_n = merger.merged(&std::mem::take(&mut normal.rows[j]));
+            let rows_t = merger.merged(&std::mem::take(&mut self.coef[j]));
+            for (row, c_n, c_t) in fused_rows(&rows_n, &rows_t) {
+                let i = row.1;
+                for (u, col) in columns.keys.iter().enumerate() {
+                    let v = c_n * scale * columns.normal[u] + c_t * columns.tangential[i][u];
+                    if v != 0.0 {
+                        emit(row, *col, v);
+                    }
+                }
+            }
+        }
     }
+}
+
+/// The union of a node's normal and tangential gradient columns, with each
+/// gradient's value there (zero where it has none).
+#[derive(Default)]
+struct Columns {
+    keys: Vec<NodeDof>,
+    normal: Vec<f64>,
+    tangential: [Vec<f64>; 3],
+}
+
+impl Columns {
+    /// `normal` and `tangential` are merged (sorted, unique keys).
+    fn gather(&mut self, normal: &[(NodeDof, f64)], tangential: &[Vec<(NodeDof, f64)>; 3]) {
+        self.keys.clear();
+        self.keys.extend(normal.iter().map(|e| e.0));
+        for t in tangential {
+            self.keys.extend(t.iter().map(|e| e.0));
+        }
+        self.keys.sort_unstable();
+        self.keys.dedup();
+        let n = self.keys.len();
+        let spread = |out: &mut Vec<f64>, from: &[(NodeDof, f64)], keys: &[NodeDof]| {
+            out.clear();
+            out.resize(n, 0.0);
+            let mut u = 0;
+            for (k, v) in from {
+                while keys[u] != *k {
+                    u += 1;
+                }
+                out[u] = *v;
+            }
+        };
+        spread(&mut self.normal, normal, &self.keys);
+        for (out, t) in self.tangential.iter_mut().zip(tangential) {
+            spread(out, t, &self.keys);
+        }
+    }
+}
+
+/// The rows of a node's two outer products: the normal coefficients by
+/// `(id, i)` and the tangential ones by `(id, 0)` (the same for every
+/// component), both merged; `(row, c^N, c^T)` for every `(id, i)` of either.
+fn fused_rows(
+    normal: &[(NodeDof, f64)],
+    tangential: &[(NodeDof, f64)],
+) -> Vec<(NodeDof, f64, f64)> {
+    let mut out = Vec::with_capacity(normal.len().max(3 * tangential.len()));
+    let (mut n, mut t) = (normal.iter().peekable(), tangential.iter().peekable());
+    loop {
+        let id = match (n.peek(), t.peek()) {
+            (None, None) => break,
+            (Some(a), None) => a.0 .0,
+            (None, Some(b)) => b.0 .0,
+            (Some(a), Some(b)) => a.0 .0.min(b.0 .0),
+        };
+        let c_t = match t.peek() {
+            Some(b) if b.0 .0 == id => t.next().map_or(0.0, |b| b.1),
+            _ => 0.0,
+        };
+        let mut c_n = [0.0; 3];
+        while let Some(a) = n.peek().filter(|a| a.0 .0 == id) {
+            c_n[a.0 .1] = a.1;
+            n.next();
+        }
+        for (i, c) in c_n.iter().enumerate() {
+            out.push(((id, i), *c, c_t));
+        }
+    }
+    out
 }
 
 /// Emits, per active node j, the outer product of its assembled

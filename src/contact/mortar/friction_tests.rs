@@ -109,8 +109,7 @@ impl Frictional {
         let mut add = |r: (u32, usize), c: (u32, usize), v: f64| {
             k[(3 * r.0 as usize + r.1) * n + 3 * c.0 as usize + c.1] += v
         };
-        system::tangent(&interface, nodal, &segs, &states, &mut add);
-        friction::tangent(&interface, nodal, &segs, &slips, &nf, &mut add);
+        friction::tangent(&interface, nodal, &segs, &slips, &states, &nf, &mut add);
         k
     }
 }

@@ -415,26 +415,40 @@ impl MortarPair {
             .friction
             .as_ref()
             .map(|f| f.increments(&self.node_local, x, u_local, rate));
-        let mut normal = system::NormalTangent::new(&self.nodal);
-        let mut tangential = self
-            .friction
-            .as_ref()
-            .map(|_| friction::FrictionTangent::new(&self.nodal));
-        system::for_each_segment::<Dual<{ system::SEGMENT_DOFS }>>(&live, &self.rules, |seg| {
-            let mut add = |r, c, v| rows.add(r, c, v);
-            normal.add(interface, &self.nodal, &seg, &e.states, &mut add);
-            if let (Some(t), Some((value, slope))) = (&mut tangential, &increments) {
+        type D = Dual<{ system::SEGMENT_DOFS }>;
+        let mut add = |r, c, v| rows.add(r, c, v);
+        match (&self.friction, &increments) {
+            (Some(_), Some((value, slope))) => {
                 let inc = Increment {
                     value,
                     slope: *slope,
                 };
-                let slip = friction::segment_slip(interface, &seg, &inc);
-                t.add(interface, &self.nodal, &seg, &slip, &e.frictions, &mut add);
+                let mut t = friction::FrictionalTangent::new(
+                    interface,
+                    &self.nodal,
+                    &e.states,
+                    &e.frictions,
+                );
+                system::for_each_segment::<D>(&live, &self.rules, |seg| {
+                    t.add(
+                        &seg,
+                        &friction::segment_slip(interface, &seg, &inc),
+                        &mut add,
+                    );
+                });
+                t.finish(add);
             }
-        });
-        normal.finish(&self.nodal, |r, c, v| rows.add(r, c, v));
-        if let Some(t) = tangential {
-            t.finish(|r, c, v| rows.add(r, c, v));
+            _ => {
+                let mut t = system::NormalTangent::new(&self.nodal);
+                let mut local = [[0.0; system::SEGMENT_DOFS]; system::SEGMENT_DOFS];
+                system::for_each_segment::<D>(&live, &self.rules, |seg| {
+                    if t.add(interface, &self.nodal, &seg, &e.states, &mut local) {
+                        let ids = system::segment_nodes(interface, seg.slave, seg.master);
+                        system::emit_local(&ids, &mut local, &mut add);
+                    }
+                });
+                t.finish(&self.nodal, add);
+            }
         }
     }
 

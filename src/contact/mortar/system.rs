@@ -456,24 +456,29 @@ pub fn tangent(
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
     let mut t = NormalTangent::new(nodal);
+    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
     for seg in segments {
-        t.add(interface, nodal, seg, states, &mut emit);
+        if t.add(interface, nodal, seg, states, &mut local) {
+            let ids = segment_nodes(interface, seg.slave, seg.master);
+            emit_local(&ids, &mut local, &mut emit);
+        }
     }
     t.finish(nodal, emit);
 }
 
-/// The normal tangent, one segment at a time: the per-segment part is
-/// emitted as it comes, the per-node part once every segment has been
+/// A segment's dense block over its variables (`local[v][w]`).
+pub(super) type Block = [[f64; SEGMENT_DOFS]; SEGMENT_DOFS];
+
+/// The normal tangent, one segment at a time: the per-segment part goes
+/// into a dense block the caller emits (the tangential part adds to the
+/// same block), the per-node part is emitted once every segment has been
 /// added (it must then hold every segment of every node of an assembled
 /// facet).
 pub struct NormalTangent {
     /// Per closed node: ∂g̃_j/∂x over all its segments, and the assembled
     /// force coefficients c_j (rows).
-    grad: Vec<Vec<(NodeDof, f64)>>,
-    rows: Vec<Vec<(NodeDof, f64)>>,
-    /// Σ_j p_j ∂c_j/∂x of one segment, summed over its nodes before it is
-    /// emitted (a quarter of the entries a node-by-node emission made).
-    local: [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+    pub(super) grad: Vec<Vec<(NodeDof, f64)>>,
+    pub(super) rows: Vec<Vec<(NodeDof, f64)>>,
 }
 
 impl NormalTangent {
@@ -482,18 +487,20 @@ impl NormalTangent {
         NormalTangent {
             grad: vec![Vec::new(); nn],
             rows: vec![Vec::new(); nn],
-            local: [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS],
         }
     }
 
+    /// Adds `seg`'s terms: Σ_j p_j ∂c_j/∂x into `local` (summed over the
+    /// segment's nodes before it is emitted: a quarter of the entries a
+    /// node-by-node emission made); true if it added any.
     pub fn add(
         &mut self,
         interface: &Interface,
         nodal: &NodalData,
         seg: &Segment<D>,
         states: &[NodeState],
-        emit: impl FnMut(NodeDof, NodeDof, f64),
-    ) {
+        local: &mut Block,
+    ) -> bool {
         let ns = interface.slave_type.nodes();
         let ids = segment_nodes(interface, seg.slave, seg.master);
         let assembled = interface.assembled[seg.slave as usize];
@@ -522,15 +529,13 @@ impl NormalTangent {
                 self.rows[j].push(((id, v % 3), c.re));
                 if p != 0.0 {
                     any = true;
-                    for (l, d) in self.local[v].iter_mut().zip(&c.eps) {
+                    for (l, d) in local[v].iter_mut().zip(&c.eps) {
                         *l += p * d;
                     }
                 }
             }
         }
-        if any {
-            emit_local(&ids, &mut self.local, emit);
-        }
+        any
     }
 
     /// c_j ⊗ ∂p_j/∂x with ∂p_j/∂x = −(ε_j/A_j) ∂g̃_j/∂x.
@@ -543,7 +548,7 @@ impl NormalTangent {
 /// `ids`) and clears it.
 pub(super) fn emit_local(
     ids: &[u32; 2 * MAX_FACET_NODES],
-    local: &mut [[f64; SEGMENT_DOFS]; SEGMENT_DOFS],
+    local: &mut Block,
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
     for (v, row) in local.iter_mut().enumerate() {
