@@ -329,7 +329,7 @@ pub type Vec3<T> = [T; 3];
 
 #[inline]
 pub fn constant3<T: Scalar>(v: [f64; 3]) -> Vec3<T> {
-    v.map(T::from_f64)
+    [T::from_f64(v[0]), T::from_f64(v[1]), T::from_f64(v[2])]
 }
 
 #[inline]

@@ -71,21 +71,6 @@ pub struct SegmentSlip<T> {
     pub slip: [Vec3<T>; MAX_FACET_NODES],
 }
 
-/// The increments of a facet's nodes in `T`, seeded at the segment's
-/// variable slots `offset + 3a + i` with derivative `slope`.
-fn increments<T: Seed>(
-    nodes: &[u32],
-    offset: usize,
-    inc: &Increment,
-) -> [Vec3<T>; MAX_FACET_NODES] {
-    let mut out = [[T::from_f64(0.0); 3]; MAX_FACET_NODES];
-    for (a, (o, &n)) in out.iter_mut().zip(nodes).enumerate() {
-        let v = inc.value[n as usize];
-        *o = [0, 1, 2].map(|i| T::seed_scaled(v[i], offset + 3 * a + i, inc.slope));
-    }
-    out
-}
-
 /// Every segment's slip terms (same order as `segments`).
 pub fn segment_slips<T: Seed>(
     interface: &Interface,
@@ -107,15 +92,24 @@ pub fn segment_slip<T: Seed>(
     let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
     let s_nodes = &interface.slave_facets[seg.slave as usize][..ns];
     let m_nodes = &interface.master_facets[seg.master as usize][..nm];
-    let d1 = increments::<T>(s_nodes, 0, inc);
-    let d2 = increments::<T>(m_nodes, super::system::MASTER_OFFSET, inc);
+    // Σ_k D_ak Δ_k: the increment Δ_k depends on node k's own variables
+    // only, as `value + slope (x − x_current)`, so each term is `D_ak`
+    // scaled by the value, plus `D_ak slope` on that one derivative (a
+    // product in `T` passed over every variable: a sixth of the tangent).
     let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+    let sides = [
+        (s_nodes, &seg.terms.d, 0, 1.0),
+        (m_nodes, &seg.terms.m, super::system::MASTER_OFFSET, -1.0),
+    ];
     for (a, s) in slip.iter_mut().enumerate().take(ns) {
-        for (dak, x) in seg.terms.d[a].iter().zip(&d1).take(ns) {
-            *s = dual::add(s, &dual::scale(x, *dak));
-        }
-        for (mal, x) in seg.terms.m[a].iter().zip(&d2).take(nm) {
-            *s = dual::sub(s, &dual::scale(x, *mal));
+        for (nodes, coefficients, offset, sign) in sides {
+            for (k, (&node, c)) in nodes.iter().zip(&coefficients[a]).enumerate() {
+                let value = inc.value[node as usize];
+                for (i, si) in s.iter_mut().enumerate() {
+                    si.add_scaled(c, sign * value[i]);
+                    si.add_derivative(offset + 3 * k + i, sign * c.re() * inc.slope);
+                }
+            }
         }
     }
     SegmentSlip {

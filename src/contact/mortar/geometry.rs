@@ -175,25 +175,39 @@ enum Side {
 /// point strictly inside and one strictly outside, so the division is by at
 /// least `2 tol` and the derivative stays bounded when edges coincide.
 pub fn clip<T: Scalar>(subject: &Polygon<T>, clip: &Polygon<T>, tol: f64) -> Polygon<T> {
-    let mut out = *subject;
+    // Two buffers clipped into in turn: a fresh polygon per edge was zeroed
+    // and copied (3 KB each in `Dual`, 4 % of a frictional mortar run).
+    let (mut first, mut second) = (*subject, Polygon::new());
+    let (mut from, mut to) = (&mut first, &mut second);
     let c = clip.points();
     for i in 0..c.len() {
-        if out.len == 0 {
+        if from.len == 0 {
             break;
         }
         let (a, b) = (c[i], c[(i + 1) % c.len()]);
-        out = clip_by_edge(&out, &a, &b, tol);
+        if clip_by_edge(from, &a, &b, tol, to) {
+            std::mem::swap(&mut from, &mut to);
+        }
     }
-    remove_duplicates(out, tol)
+    remove_duplicates(from, tol);
+    *from
 }
 
-fn clip_by_edge<T: Scalar>(poly: &Polygon<T>, a: &Vec2<T>, b: &Vec2<T>, tol: f64) -> Polygon<T> {
+/// The part of `poly` on the inner side of the line `a`–`b` into `out`;
+/// false (and `out` untouched) for a degenerate edge, which clips nothing.
+fn clip_by_edge<T: Scalar>(
+    poly: &Polygon<T>,
+    a: &Vec2<T>,
+    b: &Vec2<T>,
+    tol: f64,
+    out: &mut Polygon<T>,
+) -> bool {
     let edge = sub2(b, a);
     let length = edge[0].re().hypot(edge[1].re());
-    let mut out = Polygon::new();
     if length <= 0.0 {
-        return *poly;
+        return false;
     }
+    out.len = 0;
     // Signed distance from the edge's line, > 0 on the inner (left) side.
     let distance = |p: &Vec2<T>| cross2(&edge, &sub2(p, a)) * (1.0 / length);
     let side = |d: f64| {
@@ -207,8 +221,8 @@ fn clip_by_edge<T: Scalar>(poly: &Polygon<T>, a: &Vec2<T>, b: &Vec2<T>, tol: f64
     };
     let p = poly.points();
     for j in 0..p.len() {
-        let (p0, p1) = (p[(j + p.len() - 1) % p.len()], p[j]);
-        let (d0, d1) = (distance(&p0), distance(&p1));
+        let (p0, p1) = (&p[(j + p.len() - 1) % p.len()], &p[j]);
+        let (d0, d1) = (distance(p0), distance(p1));
         let (s0, s1) = (side(d0.re()), side(d1.re()));
         let crossing = (s0 == Side::In && s1 == Side::Out) || (s0 == Side::Out && s1 == Side::In);
         if crossing {
@@ -216,31 +230,29 @@ fn clip_by_edge<T: Scalar>(poly: &Polygon<T>, a: &Vec2<T>, b: &Vec2<T>, tol: f64
             out.push([p0[0] + (p1[0] - p0[0]) * t, p0[1] + (p1[1] - p0[1]) * t]);
         }
         if s1 != Side::Out {
-            out.push(p1);
+            out.push(*p1);
         }
     }
-    out
+    true
 }
 
-/// Drops vertices that coincide (within `tol`) with their predecessor.
-fn remove_duplicates<T: Scalar>(poly: Polygon<T>, tol: f64) -> Polygon<T> {
-    let mut out = Polygon::new();
-    for v in poly.points() {
-        let same = |w: &Vec2<T>| (v[0].re() - w[0].re()).hypot(v[1].re() - w[1].re()) <= tol;
-        if out.len > 0 && same(&out.vertices[out.len - 1]) {
+/// Drops vertices that coincide (within `tol`) with their predecessor, in
+/// place.
+fn remove_duplicates<T: Scalar>(poly: &mut Polygon<T>, tol: f64) {
+    let same =
+        |v: &Vec2<T>, w: &Vec2<T>| (v[0].re() - w[0].re()).hypot(v[1].re() - w[1].re()) <= tol;
+    let mut kept = 0;
+    for i in 0..poly.len {
+        if kept > 0 && same(&poly.vertices[i], &poly.vertices[kept - 1]) {
             continue;
         }
-        out.push(*v);
+        poly.vertices[kept] = poly.vertices[i];
+        kept += 1;
     }
-    while out.len > 1 {
-        let (first, last) = (out.vertices[0], out.vertices[out.len - 1]);
-        if (first[0].re() - last[0].re()).hypot(first[1].re() - last[1].re()) <= tol {
-            out.len -= 1;
-        } else {
-            break;
-        }
+    poly.len = kept;
+    while poly.len > 1 && same(&poly.vertices[0], &poly.vertices[poly.len - 1]) {
+        poly.len -= 1;
     }
-    out
 }
 
 /// A triangle of the overlap's triangulation.
@@ -423,11 +435,12 @@ fn implicit_step<T: Scalar>(
         r[0].add_scaled(&v[0], -na);
         r[1].add_scaled(&v[1], -na);
     }
-    [0, 1].map(|k| {
+    let component = |k: usize| {
         let mut z = r[0] * inverse[k][0];
         z.add_scaled(&r[1], inverse[k][1]);
         z + zeta[k]
-    })
+    };
+    [component(0), component(1)]
 }
 
 /// `∂N_a/∂ζ` at a point in `T`.

@@ -279,7 +279,9 @@ fn linearised_dual_basis<T: Scalar>(
 /// The facet point `Σ_a N_a(ζ) x_a` in `T`: the nodes' derivatives times
 /// the f64 shape values, plus the f64 tangents along the point's.
 fn point_on<T: Scalar>(s: &FacetShape, x: &[Vec3<T>], zeta: &[T; 2]) -> Vec3<T> {
-    [0, 1, 2].map(|i| {
+    // An array literal, not `[0, 1, 2].map`: its closure's results were
+    // copied through a guard (200 bytes each in `Dual<24>`).
+    let component = |i: usize| {
         let mut t = [0.0; 2];
         for (d, xa) in s.dn.iter().zip(x).take(s.nodes) {
             t = [t[0] + d[0] * xa[i].re(), t[1] + d[1] * xa[i].re()];
@@ -289,7 +291,8 @@ fn point_on<T: Scalar>(s: &FacetShape, x: &[Vec3<T>], zeta: &[T; 2]) -> Vec3<T> 
             p.add_scaled(&xa[i], *na);
         }
         p
-    })
+    };
+    [component(0), component(1), component(2)]
 }
 
 /// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.

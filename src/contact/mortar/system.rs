@@ -134,6 +134,8 @@ pub trait Seed: Scalar {
     /// Value `v` with derivative `slope` along variable `i` (an affine
     /// function of that variable, such as a slip increment).
     fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
+    /// Adds `v` to the derivative along variable `i` (f64: nothing).
+    fn add_derivative(&mut self, i: usize, v: f64);
     /// [`segments`] in this type; f64 through the pair's cache.
     fn segments(
         cache: &SegmentCache,
@@ -153,6 +155,8 @@ impl Seed for f64 {
     fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
         v
     }
+
+    fn add_derivative(&mut self, _: usize, _: f64) {}
 
     fn segments(
         cache: &SegmentCache,
@@ -177,6 +181,12 @@ impl<const N: usize> Seed for Dual<N> {
         }
         d
     }
+
+    fn add_derivative(&mut self, i: usize, v: f64) {
+        if let Some(e) = self.eps.get_mut(i) {
+            *e += v;
+        }
+    }
 }
 
 /// One segment's integrals, with the facets it came from.
@@ -195,7 +205,12 @@ fn seeded<T: Seed>(
     let mut out = [[T::from_f64(0.0); 3]; MAX_FACET_NODES];
     for (a, (o, &n)) in out.iter_mut().zip(nodes).enumerate() {
         let p = interface.positions[n as usize];
-        *o = [0, 1, 2].map(|i| T::seed(p[i], offset + 3 * a + i));
+        let base = offset + 3 * a;
+        *o = [
+            T::seed(p[0], base),
+            T::seed(p[1], base + 1),
+            T::seed(p[2], base + 2),
+        ];
     }
     out
 }
