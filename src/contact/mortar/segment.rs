@@ -276,23 +276,27 @@ fn linearised_dual_basis<T: Scalar>(
     phi
 }
 
-/// The facet point `Σ_a N_a(ζ) x_a` in `T`: the nodes' derivatives times
-/// the f64 shape values, plus the f64 tangents along the point's.
-fn point_on<T: Scalar>(s: &FacetShape, x: &[Vec3<T>], zeta: &[T; 2]) -> Vec3<T> {
-    // An array literal, not `[0, 1, 2].map`: its closure's results were
-    // copied through a guard (200 bytes each in `Dual<24>`).
-    let component = |i: usize| {
-        let mut t = [0.0; 2];
-        for (d, xa) in s.dn.iter().zip(x).take(s.nodes) {
-            t = [t[0] + d[0] * xa[i].re(), t[1] + d[1] * xa[i].re()];
-        }
-        let mut p = T::linearised(0.0, t, zeta);
-        for (na, xa) in s.n.iter().zip(x).take(s.nodes) {
-            p.add_scaled(&xa[i], *na);
-        }
-        p
-    };
-    [component(0), component(1), component(2)]
+/// `Σ_a N_a(ζ) h_a` in `T` for nodal values `h`: their derivatives times
+/// the f64 shape values, plus the f64 slope along the point's `ζ`.
+fn interpolate<T: Scalar>(s: &FacetShape, h: &[T], zeta: &[T; 2]) -> T {
+    let mut t = [0.0; 2];
+    for (d, ha) in s.dn.iter().zip(h).take(s.nodes) {
+        t = [t[0] + d[0] * ha.re(), t[1] + d[1] * ha.re()];
+    }
+    let mut v = T::linearised(0.0, t, zeta);
+    for (na, ha) in s.n.iter().zip(h).take(s.nodes) {
+        v.add_scaled(ha, *na);
+    }
+    v
+}
+
+/// The nodes' heights `ν · x_a` over the auxiliary plane.
+fn heights<T: Scalar>(normal: &Vec3<T>, x: &[Vec3<T>]) -> [T; MAX_FACET_NODES] {
+    let mut h = [T::from_f64(0.0); MAX_FACET_NODES];
+    for (ha, xa) in h.iter_mut().zip(x) {
+        *ha = dual::dot(normal, xa);
+    }
+    h
 }
 
 /// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` of the reference slave facet at a point in `T`.
@@ -407,6 +411,7 @@ pub fn segment_terms<T: Scalar>(
     let parallelograms =
         ov.maps_nearly_affinely() && reference_distortion(slave_type, x_ref) <= NEAR_AFFINE;
     let rule = rules.segment(slave_type, master_type, parallelograms);
+    let (slave_heights, master_heights) = (heights(&normal, xs), heights(&normal, xm));
     let mapped = ov.for_each_point(slave_type, master_type, rule, |q| {
         let projected = projected_jacobian.at(&q.zeta);
         let scale = reference_jacobian(slave_type, x_ref, &q.zeta) / projected;
@@ -418,10 +423,11 @@ pub fn segment_terms<T: Scalar>(
         let (s2, n2) = linearised_shape(master_type, &q.xi);
         // Φ_j = Σ_k A_jk N_k with the constant A in f64.
         let phi = linearised_dual_basis(a, &s1, &q.zeta);
-        let gap = dual::dot(
-            &normal,
-            &dual::sub(&point_on(&s2, xm, &q.xi), &point_on(&s1, xs, &q.zeta)),
-        );
+        // ν · (x²(ξ) − x¹(ζ)) as the difference of the points' heights
+        // over the plane, each interpolated from its nodes' (ν is the
+        // segment's): a third of the dual operations of the 3D points.
+        let gap =
+            interpolate(&s2, &master_heights, &q.xi) - interpolate(&s1, &slave_heights, &q.zeta);
         terms.area = terms.area + weight;
         for (j, phi_j) in phi.iter().enumerate().take(ns) {
             let pw = *phi_j * weight;
