@@ -427,7 +427,9 @@ fn mortar_main_scenes() {
 fn mortar_levers_off_and_consistent_first_tangent() {
     // Both levers off, mortar, h = 0.4: 16 Newton where the default takes
     // 7; the full consistent tangent in the first Uzawa iteration, h = 0.2:
-    // 11 where the default takes 6.
+    // 9 where the default takes 6 (11 before the segment gap became the
+    // difference of interpolated nodal heights: the nodes touching at zero
+    // gap round to the other side of zero, a tie either way).
     levers_off("mortar", (14, 18));
-    consistent_first_tangent("mortar", (10, 13));
+    consistent_first_tangent("mortar", (8, 13));
 }

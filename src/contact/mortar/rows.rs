@@ -14,9 +14,20 @@ use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use crate::fem::MAX_FACET_NODES;
 
-/// Entries by pair DOF `3 id + c`.
+/// A pair of at most this many DOFs (on a rank) sums its tangent in a
+/// dense matrix over them (4.5 MB at most): a small pair's tangent is
+/// nearly dense, and summing each entry where it lands is cheaper than
+/// bucketing and merging it (on the 183-DOF frictional block slide every
+/// coupling is emitted five times over).
+const DENSE_MAX_DOFS: usize = 768;
+
+/// Entries by pair DOF `3 id + c`: bucketed by row (large pairs) or summed
+/// in a dense matrix (small ones, [`DENSE_MAX_DOFS`]).
 pub(super) struct Rows {
     rows: Vec<Vec<(u32, f64)>>,
+    /// Row-major `n × n` sums, and which rows have any (dense mode).
+    dense: Vec<f64>,
+    dense_rows: Vec<bool>,
 }
 
 thread_local! {
@@ -24,6 +35,9 @@ thread_local! {
     /// growth was 3 % of a frictional mortar run's instructions.
     static SPARE: std::cell::RefCell<Vec<Vec<(u32, f64)>>> =
         const { std::cell::RefCell::new(Vec::new()) };
+    /// The last dense matrix, zeroed, kept for the next one (a fresh one
+    /// per tangent was paged in every time).
+    static SPARE_DENSE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl Drop for Rows {
@@ -31,6 +45,9 @@ impl Drop for Rows {
         let mut rows = std::mem::take(&mut self.rows);
         rows.iter_mut().for_each(Vec::clear);
         SPARE.with(|s| *s.borrow_mut() = rows);
+        let mut dense = std::mem::take(&mut self.dense);
+        dense.iter_mut().for_each(|v| *v = 0.0);
+        SPARE_DENSE.with(|s| *s.borrow_mut() = dense);
     }
 }
 
@@ -41,13 +58,34 @@ fn pair_dof(d: NodeDof) -> usize {
 impl Rows {
     /// For node ids `0..nodes`.
     pub(super) fn new(nodes: usize) -> Self {
+        let n = DIM * nodes;
+        if n <= DENSE_MAX_DOFS {
+            let mut dense = SPARE_DENSE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+            dense.resize(n * n, 0.0);
+            return Rows {
+                rows: Vec::new(),
+                dense,
+                dense_rows: vec![false; n],
+            };
+        }
         let mut rows = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        rows.resize_with(DIM * nodes, Vec::new);
-        Rows { rows }
+        rows.resize_with(n, Vec::new);
+        Rows {
+            rows,
+            dense: Vec::new(),
+            dense_rows: Vec::new(),
+        }
     }
 
     pub(super) fn add(&mut self, row: NodeDof, col: NodeDof, value: f64) {
-        self.rows[pair_dof(row)].push((pair_dof(col) as u32, value));
+        let (r, c) = (pair_dof(row), pair_dof(col));
+        if self.dense_rows.is_empty() {
+            self.rows[r].push((c as u32, value));
+        } else {
+            let n = self.dense_rows.len();
+            self.dense[r * n + c] += value;
+            self.dense_rows[r] = true;
+        }
     }
 
     /// Adds every row into `k`; `dof_of(id, c)` is the global DOF of a node
@@ -57,12 +95,15 @@ impl Rows {
         dof_of: impl Fn(u32, usize) -> GlobalDof,
         k: &mut dyn MatrixSink,
     ) -> Result<()> {
+        if !self.dense_rows.is_empty() {
+            return self.add_dense_to(dof_of, k);
+        }
         let n = self.rows.len();
         let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
         let mut sum = vec![0.0; n];
         let mut seen = vec![false; n];
         let mut touched: Vec<u32> = Vec::new();
-        let (mut cols, mut vals): (Vec<GlobalDof>, Vec<f64>) = (Vec::new(), Vec::new());
+        let mut row_entries = RowEntries::default();
         for (row, entries) in self.rows.iter().enumerate().filter(|r| !r.1.is_empty()) {
             touched.clear();
             for &(c, v) in entries {
@@ -74,23 +115,62 @@ impl Rows {
                 sum[c_us] += v;
             }
             sort_columns(&mut touched, &seen);
-            cols.clear();
-            vals.clear();
+            row_entries.clear();
             for &c in &touched {
                 let c_us = c as usize;
-                let (g, v) = (global(c_us), sum[c_us]);
+                row_entries.push(global(c_us), sum[c_us]);
                 sum[c_us] = 0.0;
                 seen[c_us] = false;
-                if cols.last() == Some(&g) {
-                    *vals.last_mut().unwrap_or(&mut 0.0) += v;
-                } else {
-                    cols.push(g);
-                    vals.push(v);
-                }
             }
-            k.add_block(&[global(row)], &cols, &vals)?;
+            k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
         }
         Ok(())
+    }
+
+    /// [`Rows::add_to`] of the dense sums: a row's nonzero entries in
+    /// column order.
+    fn add_dense_to(
+        &self,
+        dof_of: impl Fn(u32, usize) -> GlobalDof,
+        k: &mut dyn MatrixSink,
+    ) -> Result<()> {
+        let n = self.dense_rows.len();
+        let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
+        let mut row_entries = RowEntries::default();
+        for row in (0..n).filter(|&r| self.dense_rows[r]) {
+            row_entries.clear();
+            for (c, &v) in self.dense[row * n..(row + 1) * n].iter().enumerate() {
+                if v != 0.0 {
+                    row_entries.push(global(c), v);
+                }
+            }
+            k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
+        }
+        Ok(())
+    }
+}
+
+/// One row's global columns and values, in pair-DOF order; consecutive
+/// columns that share a global DOF are summed.
+#[derive(Default)]
+struct RowEntries {
+    cols: Vec<GlobalDof>,
+    vals: Vec<f64>,
+}
+
+impl RowEntries {
+    fn clear(&mut self) {
+        self.cols.clear();
+        self.vals.clear();
+    }
+
+    fn push(&mut self, g: GlobalDof, v: f64) {
+        if self.cols.last() == Some(&g) {
+            *self.vals.last_mut().unwrap_or(&mut 0.0) += v;
+        } else {
+            self.cols.push(g);
+            self.vals.push(v);
+        }
     }
 }
 
