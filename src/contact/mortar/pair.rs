@@ -52,10 +52,11 @@ pub struct MortarSnapshot {
     lambda_t: Option<Vec<[f64; 3]>>,
 }
 
-/// One evaluation of the pair: segments, node states and (with friction)
-/// the nodes' friction.
-pub(super) struct Evaluation<T> {
-    pub segments: Vec<Segment<T>>,
+/// One evaluation of the pair (values only; the tangent takes its
+/// derivatives segment by segment): segments, node states and (with
+/// friction) the nodes' friction.
+pub(super) struct Evaluation {
+    pub segments: Vec<Segment<f64>>,
     pub states: Vec<NodeState>,
     pub frictions: Vec<NodeFriction>,
 }
@@ -270,14 +271,14 @@ impl MortarPair {
         Ok(())
     }
 
-    pub(super) fn evaluate<T: system::Seed>(
+    pub(super) fn evaluate(
         &self,
         x: &[[f64; 3]],
         u_local: &[f64],
         rate: Option<&Rate>,
-    ) -> Evaluation<T> {
+    ) -> Evaluation {
         let interface = self.interface(x);
-        let segments = T::segments(&self.nodal.cache, &interface, &self.rules);
+        let segments = self.nodal.cache.segments(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
         self.with_friction(&interface, segments, states, x, u_local, rate)
@@ -285,15 +286,15 @@ impl MortarPair {
 
     /// Completes an evaluation with the nodes' friction (nothing for a
     /// frictionless pair).
-    fn with_friction<T: system::Seed>(
+    fn with_friction(
         &self,
         interface: &Interface,
-        segments: Vec<Segment<T>>,
+        segments: Vec<Segment<f64>>,
         states: Vec<NodeState>,
         x: &[[f64; 3]],
         u_local: &[f64],
         rate: Option<&Rate>,
-    ) -> Evaluation<T> {
+    ) -> Evaluation {
         let frictions = match &self.friction {
             Some(f) => {
                 let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
@@ -331,7 +332,7 @@ impl MortarPair {
             return self.rigid_residual(u_local, rate, factor, r_local);
         }
         let x = self.positions(u_local);
-        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let e = self.evaluate(&x, u_local, rate);
         let interface = self.interface(&x);
         let mut add = |n: u32, c: usize, v: f64| {
             r_local[self.local_dof(n, c)] += v;
@@ -363,7 +364,7 @@ impl MortarPair {
         if main_part && self.friction.is_none() {
             return self.add_main_part(dofs, &x, u_local, k);
         }
-        let e = self.evaluate::<f64>(&x, u_local, rate);
+        let e = self.evaluate(&x, u_local, rate);
         let interface = self.interface(&x);
         let mut rows = Rows::new(self.node_local.len());
         self.stream_tangent(&interface, &e, &x, u_local, rate, &mut rows);
@@ -389,7 +390,7 @@ impl MortarPair {
     fn stream_tangent(
         &self,
         interface: &Interface,
-        e: &Evaluation<f64>,
+        e: &Evaluation,
         x: &[[f64; 3]],
         u_local: &[f64],
         rate: Option<&Rate>,
@@ -459,7 +460,7 @@ impl MortarPair {
         u_local: &[f64],
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
-        let e = self.evaluate::<f64>(x, u_local, None);
+        let e = self.evaluate(x, u_local, None);
         let interface = self.interface(x);
         let mut rows = Rows::new(self.node_local.len());
         let add = |r, c, v| rows.add(r, c, v);
@@ -579,7 +580,7 @@ impl MortarPair {
         match &self.rigid {
             Some(_) => self.rigid_outcome(x, u_local, rate, factor),
             None => {
-                let e = self.evaluate::<f64>(x, u_local, rate);
+                let e = self.evaluate(x, u_local, rate);
                 (e.states, e.frictions)
             }
         }

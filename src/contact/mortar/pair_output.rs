@@ -43,7 +43,7 @@ impl MortarPair {
             None => {
                 let Evaluation {
                     segments, states, ..
-                } = self.evaluate::<f64>(&x, u_local, rate);
+                } = self.evaluate(&x, u_local, rate);
                 let nf = self.facet_type.nodes();
                 let mut rows = Vec::new();
                 for seg in segments.iter().filter(|s| self.assembled[s.slave as usize]) {

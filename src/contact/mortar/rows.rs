@@ -21,13 +21,21 @@ use crate::fem::MAX_FACET_NODES;
 /// coupling is emitted five times over).
 const DENSE_MAX_DOFS: usize = 768;
 
-/// Entries by pair DOF `3 id + c`: bucketed by row (large pairs) or summed
-/// in a dense matrix (small ones, [`DENSE_MAX_DOFS`]).
+/// Entries by pair DOF `3 id + c`.
 pub(super) struct Rows {
-    rows: Vec<Vec<(u32, f64)>>,
-    /// Row-major `n × n` sums, and which rows have any (dense mode).
-    dense: Vec<f64>,
-    dense_rows: Vec<bool>,
+    entries: Entries,
+}
+
+enum Entries {
+    /// Per row, `(column, value)` in emission order (large pairs).
+    Bucketed(Vec<Vec<(u32, f64)>>),
+    /// Row-major `n × n` sums and which rows have any (small pairs,
+    /// [`DENSE_MAX_DOFS`]).
+    Dense {
+        n: usize,
+        sums: Vec<f64>,
+        rows: Vec<bool>,
+    },
 }
 
 thread_local! {
@@ -35,19 +43,25 @@ thread_local! {
     /// growth was 3 % of a frictional mortar run's instructions.
     static SPARE: std::cell::RefCell<Vec<Vec<(u32, f64)>>> =
         const { std::cell::RefCell::new(Vec::new()) };
-    /// The last dense matrix, zeroed, kept for the next one (a fresh one
+    /// The last dense sums, zeroed, kept for the next one (a fresh matrix
     /// per tangent was paged in every time).
     static SPARE_DENSE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl Drop for Rows {
     fn drop(&mut self) {
-        let mut rows = std::mem::take(&mut self.rows);
-        rows.iter_mut().for_each(Vec::clear);
-        SPARE.with(|s| *s.borrow_mut() = rows);
-        let mut dense = std::mem::take(&mut self.dense);
-        dense.iter_mut().for_each(|v| *v = 0.0);
-        SPARE_DENSE.with(|s| *s.borrow_mut() = dense);
+        match &mut self.entries {
+            Entries::Bucketed(rows) => {
+                let mut rows = std::mem::take(rows);
+                rows.iter_mut().for_each(Vec::clear);
+                SPARE.with(|s| *s.borrow_mut() = rows);
+            }
+            Entries::Dense { sums, .. } => {
+                let mut sums = std::mem::take(sums);
+                sums.iter_mut().for_each(|v| *v = 0.0);
+                SPARE_DENSE.with(|s| *s.borrow_mut() = sums);
+            }
+        }
     }
 }
 
@@ -59,32 +73,30 @@ impl Rows {
     /// For node ids `0..nodes`.
     pub(super) fn new(nodes: usize) -> Self {
         let n = DIM * nodes;
-        if n <= DENSE_MAX_DOFS {
-            let mut dense = SPARE_DENSE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-            dense.resize(n * n, 0.0);
-            return Rows {
-                rows: Vec::new(),
-                dense,
-                dense_rows: vec![false; n],
-            };
-        }
-        let mut rows = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
-        rows.resize_with(n, Vec::new);
-        Rows {
-            rows,
-            dense: Vec::new(),
-            dense_rows: Vec::new(),
-        }
+        let entries = if n <= DENSE_MAX_DOFS {
+            let mut sums = SPARE_DENSE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+            sums.resize(n * n, 0.0);
+            Entries::Dense {
+                n,
+                sums,
+                rows: vec![false; n],
+            }
+        } else {
+            let mut rows = SPARE.with(|s| std::mem::take(&mut *s.borrow_mut()));
+            rows.resize_with(n, Vec::new);
+            Entries::Bucketed(rows)
+        };
+        Rows { entries }
     }
 
     pub(super) fn add(&mut self, row: NodeDof, col: NodeDof, value: f64) {
         let (r, c) = (pair_dof(row), pair_dof(col));
-        if self.dense_rows.is_empty() {
-            self.rows[r].push((c as u32, value));
-        } else {
-            let n = self.dense_rows.len();
-            self.dense[r * n + c] += value;
-            self.dense_rows[r] = true;
+        match &mut self.entries {
+            Entries::Bucketed(rows) => rows[r].push((c as u32, value)),
+            Entries::Dense { n, sums, rows } => {
+                sums[r * *n + c] += value;
+                rows[r] = true;
+            }
         }
     }
 
@@ -95,59 +107,69 @@ impl Rows {
         dof_of: impl Fn(u32, usize) -> GlobalDof,
         k: &mut dyn MatrixSink,
     ) -> Result<()> {
-        if !self.dense_rows.is_empty() {
-            return self.add_dense_to(dof_of, k);
+        match &self.entries {
+            Entries::Bucketed(rows) => add_bucketed(rows, dof_of, k),
+            Entries::Dense { n, sums, rows } => add_dense(*n, sums, rows, dof_of, k),
         }
-        let n = self.rows.len();
-        let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
-        let mut sum = vec![0.0; n];
-        let mut seen = vec![false; n];
-        let mut touched: Vec<u32> = Vec::new();
-        let mut row_entries = RowEntries::default();
-        for (row, entries) in self.rows.iter().enumerate().filter(|r| !r.1.is_empty()) {
-            touched.clear();
-            for &(c, v) in entries {
-                let c_us = c as usize;
-                if !seen[c_us] {
-                    seen[c_us] = true;
-                    touched.push(c);
-                }
-                sum[c_us] += v;
-            }
-            sort_columns(&mut touched, &seen);
-            row_entries.clear();
-            for &c in &touched {
-                let c_us = c as usize;
-                row_entries.push(global(c_us), sum[c_us]);
-                sum[c_us] = 0.0;
-                seen[c_us] = false;
-            }
-            k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
-        }
-        Ok(())
     }
+}
 
-    /// [`Rows::add_to`] of the dense sums: a row's nonzero entries in
-    /// column order.
-    fn add_dense_to(
-        &self,
-        dof_of: impl Fn(u32, usize) -> GlobalDof,
-        k: &mut dyn MatrixSink,
-    ) -> Result<()> {
-        let n = self.dense_rows.len();
-        let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
-        let mut row_entries = RowEntries::default();
-        for row in (0..n).filter(|&r| self.dense_rows[r]) {
-            row_entries.clear();
-            for (c, &v) in self.dense[row * n..(row + 1) * n].iter().enumerate() {
-                if v != 0.0 {
-                    row_entries.push(global(c), v);
-                }
+/// [`Rows::add_to`] of bucketed rows: each merged through a dense scatter.
+fn add_bucketed(
+    rows: &[Vec<(u32, f64)>],
+    dof_of: impl Fn(u32, usize) -> GlobalDof,
+    k: &mut dyn MatrixSink,
+) -> Result<()> {
+    let n = rows.len();
+    let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
+    let mut sum = vec![0.0; n];
+    let mut seen = vec![false; n];
+    let mut touched: Vec<u32> = Vec::new();
+    let mut row_entries = RowEntries::default();
+    for (row, entries) in rows.iter().enumerate().filter(|r| !r.1.is_empty()) {
+        touched.clear();
+        for &(c, v) in entries {
+            let c_us = c as usize;
+            if !seen[c_us] {
+                seen[c_us] = true;
+                touched.push(c);
             }
-            k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
+            sum[c_us] += v;
         }
-        Ok(())
+        sort_columns(&mut touched, &seen);
+        row_entries.clear();
+        for &c in &touched {
+            let c_us = c as usize;
+            row_entries.push(global(c_us), sum[c_us]);
+            sum[c_us] = 0.0;
+            seen[c_us] = false;
+        }
+        k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
     }
+    Ok(())
+}
+
+/// [`Rows::add_to`] of the dense sums: a row's nonzero entries in column
+/// order.
+fn add_dense(
+    n: usize,
+    sums: &[f64],
+    rows: &[bool],
+    dof_of: impl Fn(u32, usize) -> GlobalDof,
+    k: &mut dyn MatrixSink,
+) -> Result<()> {
+    let global = |p: usize| dof_of((p / DIM) as u32, p % DIM);
+    let mut row_entries = RowEntries::default();
+    for row in (0..n).filter(|&r| rows[r]) {
+        row_entries.clear();
+        for (c, &v) in sums[row * n..(row + 1) * n].iter().enumerate() {
+            if v != 0.0 {
+                row_entries.push(global(c), v);
+            }
+        }
+        k.add_block(&[global(row)], &row_entries.cols, &row_entries.vals)?;
+    }
+    Ok(())
 }
 
 /// One row's global columns and values, in pair-DOF order; consecutive

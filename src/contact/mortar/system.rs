@@ -136,15 +136,6 @@ pub trait Seed: Scalar {
     fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
     /// Adds `v` to the derivative along variable `i` (f64: nothing).
     fn add_derivative(&mut self, i: usize, v: f64);
-    /// [`segments`] in this type; f64 through the pair's cache.
-    fn segments(
-        cache: &SegmentCache,
-        interface: &Interface,
-        rules: &MortarRules,
-    ) -> Vec<Segment<Self>> {
-        let _ = cache;
-        segments(interface, rules)
-    }
 }
 
 impl Seed for f64 {
@@ -157,14 +148,6 @@ impl Seed for f64 {
     }
 
     fn add_derivative(&mut self, _: usize, _: f64) {}
-
-    fn segments(
-        cache: &SegmentCache,
-        interface: &Interface,
-        rules: &MortarRules,
-    ) -> Vec<Segment<f64>> {
-        cache.segments(interface, rules)
-    }
 }
 
 // One impl for every size: the segment variables (`D`) and a rigid
