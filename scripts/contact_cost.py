@@ -42,9 +42,10 @@ def cases(lines):
     for ranks in (1, 2):
         out.append(("sphere h=0.35", ranks, "Krylov",
                     [PLAIN_SPHERE, *SPHERE], ["hertz-sphere", *SPHERE, *LINKS]))
-    out.append(("sphere h=0.35 mortar", 2, "Krylov",
-                [PLAIN_SPHERE, *SPHERE],
-                ["hertz-sphere", *SPHERE, "--set", "contact.formulation=mortar"]))
+    for ranks in (1, 2):
+        out.append(("sphere h=0.35 mortar", ranks, "Krylov",
+                    [PLAIN_SPHERE, *SPHERE],
+                    ["hertz-sphere", *SPHERE, "--set", "contact.formulation=mortar"]))
     out.append(("sphere h=0.35", 2, "direct",
                 [PLAIN_SPHERE, *SPHERE_DIRECT], ["hertz-sphere", *SPHERE_DIRECT, *LINKS]))
     # The built-in sphere's own mesh (h = 0.25, 167,013 DOFs), links and mortar.
