@@ -440,15 +440,9 @@ impl MortarPair {
                 t.finish(add);
             }
             _ => {
-                let mut t = system::NormalTangent::new(&self.nodal);
-                let mut local = [[0.0; system::SEGMENT_DOFS]; system::SEGMENT_DOFS];
-                system::for_each_segment::<D>(&live, &self.rules, |seg| {
-                    if t.add(interface, &self.nodal, &seg, &e.states, &mut local) {
-                        let ids = system::segment_nodes(interface, seg.slave, seg.master);
-                        system::emit_local(&ids, &mut local, &mut add);
-                    }
-                });
-                t.finish(&self.nodal, add);
+                let mut t = system::FrictionlessTangent::new(interface, &self.nodal, &e.states);
+                system::for_each_segment::<D>(&live, &self.rules, |seg| t.add(&seg, &mut add));
+                t.finish(add);
             }
         }
     }

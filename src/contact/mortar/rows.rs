@@ -56,9 +56,12 @@ impl Drop for Rows {
                 rows.iter_mut().for_each(Vec::clear);
                 SPARE.with(|s| *s.borrow_mut() = rows);
             }
-            Entries::Dense { sums, .. } => {
+            Entries::Dense { n, sums, rows } => {
+                // Only the rows written to hold anything.
                 let mut sums = std::mem::take(sums);
-                sums.iter_mut().for_each(|v| *v = 0.0);
+                for r in (0..*n).filter(|&r| rows[r]) {
+                    sums[r * *n..(r + 1) * *n].fill(0.0);
+                }
                 SPARE_DENSE.with(|s| *s.borrow_mut() = sums);
             }
         }

@@ -453,15 +453,53 @@ pub fn tangent(
     states: &[NodeState],
     mut emit: impl FnMut(NodeDof, NodeDof, f64),
 ) {
-    let mut t = NormalTangent::new(nodal);
-    let mut local = [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS];
+    let mut t = FrictionlessTangent::new(interface, nodal, states);
     for seg in segments {
-        if t.add(interface, nodal, seg, states, &mut local) {
-            let ids = segment_nodes(interface, seg.slave, seg.master);
-            emit_local(&ids, &mut local, &mut emit);
+        t.add(seg, &mut emit);
+    }
+    t.finish(emit);
+}
+
+/// The tangent of a frictionless pair, one segment at a time: a segment's
+/// own terms are emitted as one block, the per-node outer products once
+/// every segment has been added (as `friction::FrictionalTangent`).
+pub struct FrictionlessTangent<'a> {
+    interface: &'a Interface<'a>,
+    nodal: &'a NodalData,
+    states: &'a [NodeState],
+    normal: NormalTangent,
+    local: Block,
+}
+
+impl<'a> FrictionlessTangent<'a> {
+    pub fn new(
+        interface: &'a Interface<'a>,
+        nodal: &'a NodalData,
+        states: &'a [NodeState],
+    ) -> Self {
+        FrictionlessTangent {
+            interface,
+            nodal,
+            states,
+            normal: NormalTangent::new(nodal),
+            local: [[0.0; SEGMENT_DOFS]; SEGMENT_DOFS],
         }
     }
-    t.finish(nodal, emit);
+
+    pub fn add(&mut self, seg: &Segment<D>, emit: impl FnMut(NodeDof, NodeDof, f64)) {
+        let (interface, nodal) = (self.interface, self.nodal);
+        if self
+            .normal
+            .add(interface, nodal, seg, self.states, &mut self.local)
+        {
+            let ids = segment_nodes(interface, seg.slave, seg.master);
+            emit_local(&ids, &mut self.local, emit);
+        }
+    }
+
+    pub fn finish(self, emit: impl FnMut(NodeDof, NodeDof, f64)) {
+        self.normal.finish(self.nodal, emit);
+    }
 }
 
 /// A segment's dense block over its variables (`local[v][w]`).
