@@ -247,6 +247,8 @@ pub trait Scalar:
     /// parametric coordinates costs in `Dual<N>` is then one pass over the
     /// gradient, however many operations `f` takes in f64.
     fn linearised(value: f64, grad: [f64; 2], at: &[Self; 2]) -> Self;
+    /// Zero with a zero gradient: a coefficient that adds nothing.
+    fn is_zero(&self) -> bool;
     /// `self += a b` in place (the accumulation of the segment integrals:
     /// no temporaries of the product).
     #[inline]
@@ -281,6 +283,10 @@ impl Scalar for f64 {
     fn linearised(value: f64, _: [f64; 2], _: &[f64; 2]) -> Self {
         value
     }
+    #[inline]
+    fn is_zero(&self) -> bool {
+        *self == 0.0
+    }
 }
 
 impl<const N: usize> Scalar for Dual<N> {
@@ -307,6 +313,10 @@ impl<const N: usize> Scalar for Dual<N> {
             out.eps[i] = grad[0] * at[0].eps[i] + grad[1] * at[1].eps[i];
         }
         out
+    }
+    #[inline]
+    fn is_zero(&self) -> bool {
+        self.re == 0.0 && self.eps.iter().all(|e| *e == 0.0)
     }
     #[inline]
     fn add_scaled(&mut self, a: &Self, s: f64) {

@@ -104,6 +104,10 @@ pub fn segment_slip<T: Seed>(
     for (a, s) in slip.iter_mut().enumerate().take(ns) {
         for (nodes, coefficients, offset, sign) in sides {
             for (k, (&node, c)) in nodes.iter().zip(&coefficients[a]).enumerate() {
+                if c.is_zero() {
+                    // A covered facet's D off its diagonal or first segment.
+                    continue;
+                }
                 let value = inc.value[node as usize];
                 for (i, si) in s.iter_mut().enumerate() {
                     si.add_scaled(c, sign * value[i]);
@@ -410,6 +414,10 @@ impl FrictionTangent {
             }
             for (b, &id) in ids.iter().enumerate().filter(|e| *e.1 != u32::MAX) {
                 let c = coefficient(seg, a, b);
+                if c.is_zero() {
+                    // A covered facet's zero D (see `NormalTangent::add`).
+                    continue;
+                }
                 self.coef[j].push(((id, 0), c.re));
                 for (i, t) in f.traction.iter().enumerate().filter(|e| *e.1 != 0.0) {
                     any = true;

@@ -6,7 +6,8 @@
 //!   triangulation, quadrature points mapped back to both facets
 //!   (`bilinear`: a facet's planar map and its inversion in f64);
 //! - `segment`: dual basis of a slave facet and the integrals of one segment
-//!   (weighted gap, mortar matrices `D` and `M`);
+//!   (weighted gap, mortar matrices `D` and `M`); `coverage`: the slave
+//!   facets the master covers whole, whose `D` is their exact diagonal;
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
 //! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
@@ -27,6 +28,7 @@
 //! - `pair_output`: the pair's nodal fields, force and point values;
 //!   `pair_restart`: taking them over from a result file.
 mod bilinear;
+pub mod coverage;
 mod facet_search;
 pub mod friction;
 pub mod geometry;

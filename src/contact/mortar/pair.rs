@@ -412,6 +412,7 @@ impl MortarPair {
             candidates: &live,
             ..*interface
         };
+        let covered = super::coverage::covered_facets(interface, &self.rules, &e.segments);
         let increments = self
             .friction
             .as_ref()
@@ -430,7 +431,7 @@ impl MortarPair {
                     &e.states,
                     &e.frictions,
                 );
-                system::for_each_segment::<D>(&live, &self.rules, |seg| {
+                system::for_each_segment::<D>(&live, &self.rules, &covered, |seg| {
                     t.add(
                         &seg,
                         &friction::segment_slip(interface, &seg, &inc),
@@ -441,7 +442,9 @@ impl MortarPair {
             }
             _ => {
                 let mut t = system::FrictionlessTangent::new(interface, &self.nodal, &e.states);
-                system::for_each_segment::<D>(&live, &self.rules, |seg| t.add(&seg, &mut add));
+                system::for_each_segment::<D>(&live, &self.rules, &covered, |seg| {
+                    t.add(&seg, &mut add)
+                });
                 t.finish(add);
             }
         }

@@ -4,8 +4,8 @@
 //! Dual (biorthogonal) shape functions `Φ_j = Σ_k A_jk N_k` satisfy
 //! `∫ Φ_j N_k dA = δ_jk ∫ N_k dA` over the slave facet, which gives
 //! `A = D M⁻¹` with `D = diag(∫ N_j dA)` and `M_jk = ∫ N_j N_k dA`, computed
-//! per facet from its CURRENT geometry (so `A` depends on the slave nodes and
-//! its derivative enters the tangent). Since `M·1 = diag(D)`, `Σ_j Φ_j = 1`:
+//! once per facet from its REFERENCE geometry (so `A` is constant, as the
+//! integrals are over the reference surface). Since `M·1 = diag(D)`, `Σ_j Φ_j = 1`:
 //! a uniform multiplier field is represented exactly.
 //!
 //! On a segment (the overlap of the slave facet with one master facet in the
@@ -16,6 +16,10 @@
 //!   with which `g̃_j = Σ_l M_jl ν·x²_l − Σ_k D_jk ν·x¹_k` and the contact
 //!   force of node `j`'s multiplier `p_j` is `+p_j D_jk ν` on slave node `k`
 //!   and `−p_j M_jl ν` on master node `l` (residual sign, see `system`).
+//!
+//! Over a slave facet its segments cover whole, `Σ D_jk = δ_jk ∫ N_j dA`
+//! (biorthogonality), a constant: such a facet takes that diagonal instead
+//! of the segments' sum (`system::covered_facets`).
 use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::shape::{facet_shape, FacetShape};
@@ -133,13 +137,47 @@ impl MortarRules {
     }
 }
 
-/// Dual-basis coefficients `A` (row `j` gives `Φ_j`) of a slave facet at its
-/// current positions `x`. `None` for a degenerate facet.
+/// Dual-basis coefficients `A` (row `j` gives `Φ_j`) of a slave facet at
+/// positions `x` (the pair passes the reference ones). `None` for a
+/// degenerate facet.
 pub fn dual_coefficients<T: Scalar>(
     facet: FacetType,
     x: &[Vec3<T>],
     rules: &MortarRules,
 ) -> Option<[[T; MAX_FACET_NODES]; MAX_FACET_NODES]> {
+    let n = facet.nodes();
+    let (d, m) = facet_moments(facet, x, rules);
+    let inv = invert(m, n)?;
+    let mut a = [[T::from_f64(0.0); MAX_FACET_NODES]; MAX_FACET_NODES];
+    for j in 0..n {
+        for k in 0..n {
+            a[j][k] = d[j] * inv[j][k];
+        }
+    }
+    Some(a)
+}
+
+/// `∫ N_j dA` of a facet at positions `x` with the rule the dual basis is
+/// built with: by biorthogonality `∫ Φ_j N_k dA = δ_jk` times this, the
+/// facet's `D` when segments cover it whole (see `system::covered_facets`).
+pub fn nodal_areas(
+    facet: FacetType,
+    x: &[[f64; 3]],
+    rules: &MortarRules,
+) -> [f64; MAX_FACET_NODES] {
+    facet_moments::<f64>(facet, x, rules).0
+}
+
+/// `(∫ N_j dA, ∫ N_j N_k dA)` over a facet at positions `x`.
+#[allow(clippy::type_complexity)]
+fn facet_moments<T: Scalar>(
+    facet: FacetType,
+    x: &[Vec3<T>],
+    rules: &MortarRules,
+) -> (
+    [T; MAX_FACET_NODES],
+    [[T; MAX_FACET_NODES]; MAX_FACET_NODES],
+) {
     let n = facet.nodes();
     let zero = T::from_f64(0.0);
     let mut m = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
@@ -162,14 +200,7 @@ pub fn dual_coefficients<T: Scalar>(
             }
         }
     }
-    let inv = invert(m, n)?;
-    let mut a = [[zero; MAX_FACET_NODES]; MAX_FACET_NODES];
-    for j in 0..n {
-        for k in 0..n {
-            a[j][k] = d[j] * inv[j][k];
-        }
-    }
-    Some(a)
+    (d, m)
 }
 
 /// Gauss–Jordan inverse of the leading `n × n` block with partial pivoting
@@ -387,6 +418,10 @@ impl<T: Scalar> PlaneJacobian<T> {
 /// nominal pressures (force per reference area, as the links'), the
 /// traction a body load applies is matched node by node, and `A` is that of
 /// the reference facet.
+///
+/// With `fixed_d` the segment's `D` is not integrated but set to that
+/// diagonal (a constant): see `system::covered_facets`.
+#[allow(clippy::too_many_arguments)]
 pub fn segment_terms<T: Scalar>(
     slave_type: FacetType,
     xs: &[Vec3<T>],
@@ -395,6 +430,7 @@ pub fn segment_terms<T: Scalar>(
     xm: &[Vec3<T>],
     a: &[[f64; MAX_FACET_NODES]; MAX_FACET_NODES],
     rules: &MortarRules,
+    fixed_d: Option<&[f64; MAX_FACET_NODES]>,
 ) -> Option<SegmentTerms<T>> {
     let ov = overlap(slave_type, xs, master_type, xm)?;
     let (ns, nm) = (slave_type.nodes(), master_type.nodes());
@@ -432,13 +468,20 @@ pub fn segment_terms<T: Scalar>(
         for (j, phi_j) in phi.iter().enumerate().take(ns) {
             let pw = *phi_j * weight;
             terms.weighted_gap[j].add_product(pw, gap);
-            for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
-                djk.add_product(pw, *nk);
+            if fixed_d.is_none() {
+                for (djk, nk) in terms.d[j].iter_mut().zip(&n1).take(ns) {
+                    djk.add_product(pw, *nk);
+                }
             }
             for (mjl, nl) in terms.m[j].iter_mut().zip(&n2).take(nm) {
                 mjl.add_product(pw, *nl);
             }
         }
     });
+    if let Some(diagonal) = fixed_d {
+        for (j, dj) in diagonal.iter().enumerate().take(ns) {
+            terms.d[j][j] = T::from_f64(*dj);
+        }
+    }
     mapped.then_some(terms)
 }

@@ -15,7 +15,8 @@
 //! on a closed node, `∂g̃_j/∂x` including the move of the auxiliary plane, of
 //! the clipped polygon and of the dual basis. It couples every DOF of every
 //! segment of node `j` with every other: see [`node_supports`].
-use super::segment::{dual_coefficients, segment_terms, MortarRules, SegmentTerms};
+use super::coverage::{covered_facets, set_covered_diagonals};
+use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
 use crate::contact::dual::{Dual, Scalar, Vec3};
 use crate::contact::multipliers::updated_multiplier;
 use crate::fem::{FacetType, MAX_FACET_NODES};
@@ -198,24 +199,32 @@ fn seeded<T: Seed>(
     out
 }
 
-/// Every overlapping candidate's integrals.
+/// Every overlapping candidate's integrals, with the `D` of covered facets
+/// set to their diagonal ([`coverage`](super::coverage)).
 pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
     let mut out = Vec::with_capacity(interface.candidates.len());
-    for_each_segment(interface, rules, |seg| out.push(seg));
+    for_each_segment(interface, rules, &[], |seg| out.push(seg));
+    let covered = covered_facets(interface, rules, &out);
+    set_covered_diagonals(interface, rules, &covered, &mut out);
     out
 }
 
 /// Calls `visit` with every overlapping candidate's integrals, in candidate
 /// order. The tangent streams its `Dual` segments through here: 8 KB each,
 /// a vector of them was grown, copied and paged in at every Newton
-/// iteration (a fifth of a frictional mortar run).
+/// iteration (a fifth of a frictional mortar run). `covered` (per slave
+/// facet, or empty) are the facets `covered_facets` found on these
+/// candidates' values: their `D` is set, not integrated.
 pub fn for_each_segment<T: Seed>(
     interface: &Interface,
     rules: &MortarRules,
+    covered: &[bool],
     mut visit: impl FnMut(Segment<T>),
 ) {
     let (ns, nm) = (interface.slave_type.nodes(), interface.master_type.nodes());
     let mut cached: Option<(u32, [[f64; MAX_FACET_NODES]; MAX_FACET_NODES])> = None;
+    let mut last_covered = None;
+    const NO_D: [f64; MAX_FACET_NODES] = [0.0; MAX_FACET_NODES];
     for &(s, m) in interface.candidates {
         let snodes = &interface.slave_facets[s as usize][..ns];
         let mnodes = &interface.master_facets[m as usize][..nm];
@@ -237,6 +246,14 @@ pub fn for_each_segment<T: Seed>(
                 None => continue,
             },
         };
+        // A covered facet's diagonal goes on its first segment.
+        let diagonal = match covered.get(s as usize) {
+            Some(true) if last_covered != Some(s) => {
+                Some(nodal_areas(interface.slave_type, &x_ref[..ns], rules))
+            }
+            Some(true) => Some(NO_D),
+            _ => None,
+        };
         let terms = segment_terms(
             interface.slave_type,
             &xs[..ns],
@@ -245,8 +262,12 @@ pub fn for_each_segment<T: Seed>(
             &xm[..nm],
             &a,
             rules,
+            diagonal.as_ref(),
         );
         if let Some(terms) = terms {
+            if diagonal.is_some() {
+                last_covered = Some(s);
+            }
             visit(Segment {
                 slave: s,
                 master: m,
@@ -552,13 +573,16 @@ impl NormalTangent {
                 continue;
             }
             let p = states[j].pressure;
+            // A covered facet's D is diagonal and on its first segment
+            // alone (`covered_facets`): its zeros add nothing.
+            let no_d = seg.terms.d[a].map(|d| d.is_zero());
             for v in 0..SEGMENT_DOFS {
                 let id = ids[v / 3];
                 if id == u32::MAX {
                     continue;
                 }
                 self.grad[j].push(((id, v % 3), seg.terms.weighted_gap[a].eps[v]));
-                if !assembled {
+                if !assembled || no_d.get(v / 3) == Some(&true) {
                     continue;
                 }
                 let c = force_coefficient(&seg.terms, a, v);
