@@ -396,16 +396,26 @@ impl FrictionTangent {
                 &s.slip[a][1],
                 &s.slip[a][2],
             ];
+            // ∂tT_i = Σ_r (∂tT_i/∂aggregate_r) ∂aggregate_r, over all
+            // segment variables at once (the sums in the order they were
+            // taken variable by variable).
+            let mut dt = [[0.0; SEGMENT_DOFS]; 3];
+            for (dti, row) in dt.iter_mut().zip(&f.derivative) {
+                for (r, x) in row.iter().zip(&aggregates) {
+                    for (d, e) in dti.iter_mut().zip(&x.eps) {
+                        *d += r * e;
+                    }
+                }
+            }
             for (v, &id) in ids
                 .iter()
                 .flat_map(|id| [id; 3])
                 .enumerate()
                 .filter(|e| *e.1 != u32::MAX)
             {
-                for (g, row) in self.grad[j].iter_mut().zip(&f.derivative) {
-                    let d: f64 = row.iter().zip(&aggregates).map(|(r, x)| r * x.eps[v]).sum();
-                    if d != 0.0 {
-                        g.push(((id, v % 3), d));
+                for (g, dti) in self.grad[j].iter_mut().zip(&dt) {
+                    if dti[v] != 0.0 {
+                        g.push(((id, v % 3), dti[v]));
                     }
                 }
             }
