@@ -392,6 +392,52 @@ pub fn norm<T: Scalar>(a: &Vec3<T>) -> T {
     dot(a, a).sqrt()
 }
 
+/// A scalar that can be seeded as the `i`-th independent variable (f64
+/// ignores the index: values only). The mortar kernels seed a segment's
+/// node coordinates with it.
+pub trait Seed: Scalar {
+    fn seed(v: f64, i: usize) -> Self;
+    /// Value `v` with derivative `slope` along variable `i` (an affine
+    /// function of that variable, such as a slip increment).
+    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
+    /// Adds `v` to the derivative along variable `i` (f64: nothing).
+    fn add_derivative(&mut self, i: usize, v: f64);
+}
+
+impl Seed for f64 {
+    fn seed(v: f64, _: usize) -> Self {
+        v
+    }
+
+    fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
+        v
+    }
+
+    fn add_derivative(&mut self, _: usize, _: f64) {}
+}
+
+// One impl for every size: the segment variables (`D`) and a rigid
+// master's slave-facet variables alike.
+impl<const N: usize> Seed for Dual<N> {
+    fn seed(v: f64, i: usize) -> Self {
+        Dual::variable(v, i)
+    }
+
+    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self {
+        let mut d = Dual::constant(v);
+        if let Some(e) = d.eps.get_mut(i) {
+            *e = slope;
+        }
+        d
+    }
+
+    fn add_derivative(&mut self, i: usize, v: f64) {
+        if let Some(e) = self.eps.get_mut(i) {
+            *e += v;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,8 +7,7 @@
 //! 36 dual-number products a segment point took). A facet the master
 //! covers in part (at the master's edge) keeps its segments' `D`, the part
 //! that matches `M` there.
-use super::segment::{nodal_areas, MortarRules};
-use super::system::{Interface, Segment};
+use super::segment::SegmentTerms;
 use crate::contact::dual::Scalar;
 use crate::fem::MAX_FACET_NODES;
 
@@ -17,63 +16,47 @@ use crate::fem::MAX_FACET_NODES;
 /// sliver a master edge would leave.
 pub const COVERED_TOL: f64 = 1e-6;
 
-/// Per slave facet: whether its segments cover it whole, i.e. their
-/// reference areas sum to the facet's to [`COVERED_TOL`]. `segments` in
-/// candidate order (a facet's segments consecutive).
-pub fn covered_facets<T: Scalar>(
-    interface: &Interface,
-    rules: &MortarRules,
-    segments: &[Segment<T>],
+/// Per slave facet (`facets` of them): whether its segments cover it
+/// whole, i.e. their reference areas sum to the facet's (`facet_area`) to
+/// [`COVERED_TOL`]. `segments` are (slave facet, reference area) in
+/// candidate order, a facet's segments consecutive.
+pub fn covered_facets(
+    facets: usize,
+    segments: impl Iterator<Item = (u32, f64)>,
+    facet_area: impl Fn(u32) -> f64,
 ) -> Vec<bool> {
-    let mut covered = vec![false; interface.slave_facets.len()];
-    let mut i = 0;
-    while i < segments.len() {
-        let f = segments[i].slave;
-        let mut area = 0.0;
-        while i < segments.len() && segments[i].slave == f {
-            area += segments[i].terms.area.re();
-            i += 1;
+    let mut covered = vec![false; facets];
+    let mut sums: Vec<(u32, f64)> = Vec::new();
+    for (f, area) in segments {
+        match sums.last_mut() {
+            Some((g, sum)) if *g == f => *sum += area,
+            _ => sums.push((f, area)),
         }
-        let whole: f64 = slave_nodal_areas(interface, f, rules).iter().sum();
+    }
+    for (f, area) in sums {
+        let whole = facet_area(f);
         covered[f as usize] = (area - whole).abs() <= COVERED_TOL * whole;
     }
     covered
 }
 
-/// `∫ N_j dA₀` of slave facet `f` (reference positions, the dual basis' rule).
-pub(super) fn slave_nodal_areas(
-    interface: &Interface,
-    f: u32,
-    rules: &MortarRules,
-) -> [f64; MAX_FACET_NODES] {
-    let ns = interface.slave_type.nodes();
-    let mut x_ref = [[0.0; 3]; MAX_FACET_NODES];
-    for (r, &n) in x_ref
-        .iter_mut()
-        .zip(&interface.slave_facets[f as usize][..ns])
-    {
-        *r = interface.reference[n as usize];
-    }
-    nodal_areas(interface.slave_type, &x_ref[..ns], rules)
-}
-
-/// Sets the `D` of the covered facets' segments: the facet's diagonal on
-/// its first segment, zero on the others (constants, so in dual numbers
-/// their derivatives vanish, as those of the sum do).
-pub fn set_covered_diagonals<T: Scalar>(
-    interface: &Interface,
-    rules: &MortarRules,
+/// Sets the `D` of the covered facets' segments (slave facet, terms; in
+/// candidate order): the facet's diagonal `nodal_areas` on its first
+/// segment, zero on the others (constants, so in dual numbers their
+/// derivatives vanish, as those of the sum do). `ns`: slave facet nodes.
+pub fn set_diagonals<'a, T: Scalar + 'a>(
     covered: &[bool],
-    segments: &mut [Segment<T>],
+    segments: impl Iterator<Item = (u32, &'a mut SegmentTerms<T>)>,
+    nodal_areas: impl Fn(u32) -> [f64; MAX_FACET_NODES],
+    ns: usize,
 ) {
     let zero = T::from_f64(0.0);
-    let ns = interface.slave_type.nodes();
     let mut last = None;
-    for seg in segments.iter_mut().filter(|s| covered[s.slave as usize]) {
-        let first = last != Some(seg.slave);
-        last = Some(seg.slave);
-        let areas = first.then(|| slave_nodal_areas(interface, seg.slave, rules));
-        for (j, row) in seg.terms.d.iter_mut().enumerate().take(ns) {
+    for (f, terms) in segments.filter(|s| covered[s.0 as usize]) {
+        let first = last != Some(f);
+        last = Some(f);
+        let areas = first.then(|| nodal_areas(f));
+        for (j, row) in terms.d.iter_mut().enumerate().take(ns) {
             for (k, djk) in row.iter_mut().enumerate().take(ns) {
                 *djk = match areas {
                     Some(a) if j == k => T::from_f64(a[j]),

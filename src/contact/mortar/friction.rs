@@ -24,9 +24,9 @@
 //! `p_j` and, in dynamics, the damping `Δt ∂v/∂x` all land in the tangent.
 use super::system::{
     emit_local, for_each_slave_node, segment_nodes, Block, Interface, Merger, NodalData, NodeDof,
-    NodeState, NormalTangent, Seed, Segment, SEGMENT_DOFS,
+    NodeState, NormalTangent, Segment, SEGMENT_DOFS,
 };
-use crate::contact::dual::{self, Dual, Scalar, Vec3};
+use crate::contact::dual::{self, Dual, Scalar, Seed, Vec3};
 use crate::fem::MAX_FACET_NODES;
 
 type D = Dual<{ super::system::SEGMENT_DOFS }>;

@@ -412,7 +412,7 @@ impl MortarPair {
             candidates: &live,
             ..*interface
         };
-        let covered = super::coverage::covered_facets(interface, &self.rules, &e.segments);
+        let covered = system::covered_facets(interface, &self.rules, &e.segments);
         let increments = self
             .friction
             .as_ref()

@@ -16,7 +16,8 @@
 //!   and, in dynamics, the damping `Δt ∂v/∂x`).
 use super::friction::{emit_outer, node_law, Increment, NodalFriction, NodeFriction};
 use super::rigid::{for_each_node, RigidFacet, RigidInterface, RD};
-use super::system::{NodalData, NodeDof, NodeState, Seed};
+use super::system::{NodalData, NodeDof, NodeState};
+use crate::contact::dual::Seed;
 use crate::contact::dual::{self, Scalar, Vec3};
 use crate::fem::MAX_FACET_NODES;
 

@@ -14,8 +14,9 @@ use super::rigid::{self, RigidFacet, RigidInterface, RD};
 use super::rigid_friction::{self, RigidSlip};
 use super::rigid_master::RigidMaster;
 use super::rows::Rows;
-use super::system::{self, NodeState, Seed};
+use super::system::{self, NodeState};
 use crate::assembly::{MatrixSink, PatternSink};
+use crate::contact::dual::Seed;
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
 

@@ -15,9 +15,9 @@
 //! on a closed node, `∂g̃_j/∂x` including the move of the auxiliary plane, of
 //! the clipped polygon and of the dual basis. It couples every DOF of every
 //! segment of node `j` with every other: see [`node_supports`].
-use super::coverage::{covered_facets, set_covered_diagonals};
+use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
-use crate::contact::dual::{Dual, Scalar, Vec3};
+use crate::contact::dual::{Dual, Scalar, Seed, Vec3};
 use crate::contact::multipliers::updated_multiplier;
 use crate::fem::{FacetType, MAX_FACET_NODES};
 
@@ -128,51 +128,6 @@ impl NodalData {
     }
 }
 
-/// A scalar that can be seeded as the `i`-th segment variable (f64 ignores
-/// the index: residual only).
-pub trait Seed: Scalar {
-    fn seed(v: f64, i: usize) -> Self;
-    /// Value `v` with derivative `slope` along variable `i` (an affine
-    /// function of that variable, such as a slip increment).
-    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self;
-    /// Adds `v` to the derivative along variable `i` (f64: nothing).
-    fn add_derivative(&mut self, i: usize, v: f64);
-}
-
-impl Seed for f64 {
-    fn seed(v: f64, _: usize) -> Self {
-        v
-    }
-
-    fn seed_scaled(v: f64, _: usize, _: f64) -> Self {
-        v
-    }
-
-    fn add_derivative(&mut self, _: usize, _: f64) {}
-}
-
-// One impl for every size: the segment variables (`D`) and a rigid
-// master's slave-facet variables alike.
-impl<const N: usize> Seed for Dual<N> {
-    fn seed(v: f64, i: usize) -> Self {
-        Dual::variable(v, i)
-    }
-
-    fn seed_scaled(v: f64, i: usize, slope: f64) -> Self {
-        let mut d = Dual::constant(v);
-        if let Some(e) = d.eps.get_mut(i) {
-            *e = slope;
-        }
-        d
-    }
-
-    fn add_derivative(&mut self, i: usize, v: f64) {
-        if let Some(e) = self.eps.get_mut(i) {
-            *e += v;
-        }
-    }
-}
-
 /// One segment's integrals, with the facets it came from.
 #[derive(Debug, Clone, Copy)]
 pub struct Segment<T> {
@@ -205,15 +160,51 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
     let mut out = Vec::with_capacity(interface.candidates.len());
     for_each_segment(interface, rules, &[], |seg| out.push(seg));
     let covered = covered_facets(interface, rules, &out);
-    set_covered_diagonals(interface, rules, &covered, &mut out);
+    coverage::set_diagonals(
+        &covered,
+        out.iter_mut().map(|s| (s.slave, &mut s.terms)),
+        |f| slave_nodal_areas(interface, f, rules),
+        interface.slave_type.nodes(),
+    );
     out
+}
+
+/// Per slave facet: whether the `segments` (in candidate order) cover it
+/// whole ([`coverage::covered_facets`]).
+pub fn covered_facets<T: Scalar>(
+    interface: &Interface,
+    rules: &MortarRules,
+    segments: &[Segment<T>],
+) -> Vec<bool> {
+    coverage::covered_facets(
+        interface.slave_facets.len(),
+        segments.iter().map(|s| (s.slave, s.terms.area.re())),
+        |f| slave_nodal_areas(interface, f, rules).iter().sum(),
+    )
+}
+
+/// `∫ N_j dA₀` of slave facet `f` (reference positions, the dual basis' rule).
+pub(super) fn slave_nodal_areas(
+    interface: &Interface,
+    f: u32,
+    rules: &MortarRules,
+) -> [f64; MAX_FACET_NODES] {
+    let ns = interface.slave_type.nodes();
+    let mut x_ref = [[0.0; 3]; MAX_FACET_NODES];
+    for (r, &n) in x_ref
+        .iter_mut()
+        .zip(&interface.slave_facets[f as usize][..ns])
+    {
+        *r = interface.reference[n as usize];
+    }
+    nodal_areas(interface.slave_type, &x_ref[..ns], rules)
 }
 
 /// Calls `visit` with every overlapping candidate's integrals, in candidate
 /// order. The tangent streams its `Dual` segments through here: 8 KB each,
 /// a vector of them was grown, copied and paged in at every Newton
 /// iteration (a fifth of a frictional mortar run). `covered` (per slave
-/// facet, or empty) are the facets `covered_facets` found on these
+/// facet, or empty) are the facets [`covered_facets`] found on these
 /// candidates' values: their `D` is set, not integrated.
 pub fn for_each_segment<T: Seed>(
     interface: &Interface,

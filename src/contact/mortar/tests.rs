@@ -1,12 +1,11 @@
 //! Geometry, dual basis and the consistency of the mortar tangent.
-use super::coverage::{covered_facets, slave_nodal_areas};
 use super::geometry::{
     boxes_apart, clip, inverse_map, overlap, shape_values, Plane, Polygon, BOX_MARGIN, GEOMETRY_TOL,
 };
 use super::segment::{dual_coefficients, dual_values, segment_terms, MortarRules};
 use super::system::{
-    for_each_segment, node_states, residual, segments, tangent, weighted_gaps, Interface,
-    NodalData, Segment,
+    covered_facets, for_each_segment, node_states, residual, segments, slave_nodal_areas, tangent,
+    weighted_gaps, Interface, NodalData, Segment,
 };
 use crate::contact::dual::Dual;
 use crate::fem::test_util::Lcg;
