@@ -25,8 +25,7 @@
 //! through the master's increment in the slip (`rigid_friction`).
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
 use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState};
-use crate::contact::dual::Seed;
-use crate::contact::dual::{self, Dual, Scalar, Vec3};
+use crate::contact::dual::{self, Dual, Scalar, Seed, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 use crate::model::RigidSurface;

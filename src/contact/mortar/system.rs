@@ -566,7 +566,8 @@ impl NormalTangent {
             let p = states[j].pressure;
             // A covered facet's D is diagonal and on its first segment
             // alone (`covered_facets`): its zeros add nothing.
-            let no_d = seg.terms.d[a].map(|d| d.is_zero());
+            let no_d: [bool; MAX_FACET_NODES] =
+                std::array::from_fn(|b| seg.terms.d[a][b].is_zero());
             for v in 0..SEGMENT_DOFS {
                 let id = ids[v / 3];
                 if id == u32::MAX {
