@@ -57,6 +57,9 @@ pub struct MortarSnapshot {
 /// friction) the nodes' friction.
 pub(super) struct Evaluation {
     pub segments: Vec<Segment<f64>>,
+    /// Per slave facet: whether the segments cover it whole (its `D` is
+    /// the exact diagonal, see `coverage`).
+    pub covered: Vec<bool>,
     pub states: Vec<NodeState>,
     pub frictions: Vec<NodeFriction>,
 }
@@ -278,46 +281,39 @@ impl MortarPair {
         rate: Option<&Rate>,
     ) -> Evaluation {
         let interface = self.interface(x);
-        let segments = self.nodal.cache.segments(&interface, &self.rules);
+        let (segments, facets_covered) = self.nodal.cache.segments(&interface, &self.rules);
         let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
         let states = system::node_states(&self.nodal, &gap, &covered);
-        self.with_friction(&interface, segments, states, x, u_local, rate)
+        let frictions = self.frictions(&interface, &segments, &states, x, u_local, rate);
+        Evaluation {
+            segments,
+            covered: facets_covered,
+            states,
+            frictions,
+        }
     }
 
-    /// Completes an evaluation with the nodes' friction (nothing for a
-    /// frictionless pair).
-    fn with_friction(
+    /// The nodes' friction at these states (none for a frictionless pair).
+    fn frictions(
         &self,
         interface: &Interface,
-        segments: Vec<Segment<f64>>,
-        states: Vec<NodeState>,
+        segments: &[Segment<f64>],
+        states: &[NodeState],
         x: &[[f64; 3]],
         u_local: &[f64],
         rate: Option<&Rate>,
-    ) -> Evaluation {
-        let frictions = match &self.friction {
+    ) -> Vec<NodeFriction> {
+        match &self.friction {
             Some(f) => {
                 let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
                 let inc = Increment {
                     value: &value,
                     slope,
                 };
-                let slips = friction::segment_slips(interface, &segments, &inc);
-                friction::node_frictions(
-                    interface,
-                    &self.nodal,
-                    &f.nodal,
-                    &states,
-                    &segments,
-                    &slips,
-                )
+                let slips = friction::segment_slips(interface, segments, &inc);
+                friction::node_frictions(interface, &self.nodal, &f.nodal, states, segments, &slips)
             }
             None => Vec::new(),
-        };
-        Evaluation {
-            segments,
-            states,
-            frictions,
         }
     }
 
@@ -412,7 +408,6 @@ impl MortarPair {
             candidates: &live,
             ..*interface
         };
-        let covered = system::covered_facets(interface, &self.rules, &e.segments);
         let increments = self
             .friction
             .as_ref()
@@ -431,7 +426,7 @@ impl MortarPair {
                     &e.states,
                     &e.frictions,
                 );
-                system::for_each_segment::<D>(&live, &self.rules, &covered, |seg| {
+                system::for_each_segment::<D>(&live, &self.rules, &e.covered, |seg| {
                     t.add(
                         &seg,
                         &friction::segment_slip(interface, &seg, &inc),
@@ -442,7 +437,7 @@ impl MortarPair {
             }
             _ => {
                 let mut t = system::FrictionlessTangent::new(interface, &self.nodal, &e.states);
-                system::for_each_segment::<D>(&live, &self.rules, &covered, |seg| {
+                system::for_each_segment::<D>(&live, &self.rules, &e.covered, |seg| {
                     t.add(&seg, &mut add)
                 });
                 t.finish(add);

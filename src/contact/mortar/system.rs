@@ -75,26 +75,32 @@ struct CachedSegments {
     positions: Vec<[f64; 3]>,
     candidates: Vec<(u32, u32)>,
     segments: Vec<Segment<f64>>,
+    covered: Vec<bool>,
 }
 
 impl SegmentCache {
-    /// `segments::<f64>` of the interface, from the cache when its
-    /// positions and candidates are those of the last call.
-    pub fn segments(&self, interface: &Interface, rules: &MortarRules) -> Vec<Segment<f64>> {
+    /// [`covered_segments`] in f64 of the interface, from the cache when
+    /// its positions and candidates are those of the last call.
+    pub fn segments(
+        &self,
+        interface: &Interface,
+        rules: &MortarRules,
+    ) -> (Vec<Segment<f64>>, Vec<bool>) {
         let mut last = self.0.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(c) = last
             .as_ref()
             .filter(|c| c.positions == interface.positions && c.candidates == interface.candidates)
         {
-            return c.segments.clone();
+            return (c.segments.clone(), c.covered.clone());
         }
-        let segments = segments::<f64>(interface, rules);
+        let (segments, covered) = covered_segments::<f64>(interface, rules);
         *last = Some(CachedSegments {
             positions: interface.positions.to_vec(),
             candidates: interface.candidates.to_vec(),
             segments: segments.clone(),
+            covered: covered.clone(),
         });
-        segments
+        (segments, covered)
     }
 }
 
@@ -157,6 +163,15 @@ fn seeded<T: Seed>(
 /// Every overlapping candidate's integrals, with the `D` of covered facets
 /// set to their diagonal ([`coverage`](super::coverage)).
 pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segment<T>> {
+    covered_segments(interface, rules).0
+}
+
+/// [`segments`] and, per slave facet, whether they cover it whole
+/// ([`covered_facets`]).
+pub fn covered_segments<T: Seed>(
+    interface: &Interface,
+    rules: &MortarRules,
+) -> (Vec<Segment<T>>, Vec<bool>) {
     let mut out = Vec::with_capacity(interface.candidates.len());
     for_each_segment(interface, rules, &[], |seg| out.push(seg));
     let covered = covered_facets(interface, rules, &out);
@@ -166,7 +181,7 @@ pub fn segments<T: Seed>(interface: &Interface, rules: &MortarRules) -> Vec<Segm
         |f| slave_nodal_areas(interface, f, rules),
         interface.slave_type.nodes(),
     );
-    out
+    (out, covered)
 }
 
 /// Per slave facet: whether the `segments` (in candidate order) cover it
