@@ -2,7 +2,7 @@
 //! home of these helpers for mesh, fem and contact. The operation order of
 //! each function is fixed (results are compared bit for bit in tests); the
 //! dual-number versions the contact kernel differentiates are generic
-//! counterparts in `contact::dual`.
+//! counterparts in `contact::autodiff`.
 
 pub type Vec3 = [f64; 3];
 

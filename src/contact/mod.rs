@@ -18,7 +18,7 @@
 //!   integration of the slave–master overlap).
 //!
 //! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
-pub mod dual;
+pub mod autodiff;
 pub mod held_master;
 pub mod kernel;
 pub mod mortar;

@@ -5,7 +5,7 @@ use super::friction::{friction_traction, slip_increment};
 use super::input::{dof_count, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory};
 use super::kinematics::{kinematics, tangential, Frame, Kinematics};
 use super::normal::trial_pressure;
-use crate::contact::dual::{self, Dual, Scalar, Vec3};
+use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::MAX_FACET_NODES;
 
@@ -30,9 +30,9 @@ pub(super) fn link_forces<T: Scalar>(
     // carries derivatives (in the f64 pass this changes nothing).
     let main_part = input.main_part_tangent && input.friction.is_none();
     let mut common = if main_part {
-        dual::scale(&dual::constant3::<T>(dual::re3(&kin.normal)), -pressure)
+        autodiff::scale(&autodiff::constant3::<T>(autodiff::re3(&kin.normal)), -pressure)
     } else {
-        dual::scale(&kin.normal, -pressure)
+        autodiff::scale(&kin.normal, -pressure)
     };
     let mut master_extra = [T::from_f64(0.0); MAX_FACET_NODES];
     let mut state = None;
@@ -46,14 +46,14 @@ pub(super) fn link_forces<T: Scalar>(
                 hessian: [h11, h12, h22],
                 master_dn,
             } => {
-                let t = [dual::dot(&traction, t1), dual::dot(&traction, t2)];
+                let t = [autodiff::dot(&traction, t1), autodiff::dot(&traction, t2)];
                 let det = *h11 * *h22 - *h12 * *h12;
                 let c1 = (*h22 * t[0] - *h12 * t[1]) / det;
                 let c2 = (*h11 * t[1] - *h12 * t[0]) / det;
                 for (extra, dn) in master_extra.iter_mut().zip(master_dn).take(n_master) {
                     *extra = c1 * dn[0] + c2 * dn[1];
                 }
-                let g = dual::add(&dual::scale(t1, c1), &dual::scale(t2, c2));
+                let g = autodiff::add(&autodiff::scale(t1, c1), &autodiff::scale(t2, c2));
                 let updated = SlipHistory::Convected {
                     xi_n: [xi[0].re(), xi[1].re()],
                     lambda: [t[0].re(), t[1].re()],
@@ -63,29 +63,29 @@ pub(super) fn link_forces<T: Scalar>(
             Frame::Rigid { scale, axis } => {
                 let along = match axis {
                     Some(a) => {
-                        let a = dual::constant3::<T>(*a);
-                        dual::scale(&a, dual::dot(&a, &traction))
+                        let a = autodiff::constant3::<T>(*a);
+                        autodiff::scale(&a, autodiff::dot(&a, &traction))
                     }
-                    None => dual::constant3([0.0; 3]),
+                    None => autodiff::constant3([0.0; 3]),
                 };
-                let across = tangential(&dual::sub(&traction, &along), &kin.normal);
-                let g = dual::add(&along, &dual::scale(&across, *scale));
+                let across = tangential(&autodiff::sub(&traction, &along), &kin.normal);
+                let g = autodiff::add(&along, &autodiff::scale(&across, *scale));
                 let updated = SlipHistory::Spatial {
-                    point_n: dual::re3(&kin.master_point),
-                    lambda: dual::re3(&traction),
+                    point_n: autodiff::re3(&kin.master_point),
+                    lambda: autodiff::re3(&traction),
                 };
                 (g, updated)
             }
         };
-        common = dual::add(&common, &g);
+        common = autodiff::add(&common, &g);
         state = Some(FrictionState {
-            traction: dual::re3(&traction).map(|v| -v),
-            slip: dual::re3(&slip),
+            traction: autodiff::re3(&traction).map(|v| -v),
+            slip: autodiff::re3(&slip),
             sliding,
             updated,
         });
     }
-    let common = dual::scale_f64(&common, input.weight);
+    let common = autodiff::scale_f64(&common, input.weight);
     for a in 0..ns {
         for (i, ci) in common.iter().enumerate() {
             emit(3 * a + i, *ci * s.n[a]);

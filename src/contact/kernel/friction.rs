@@ -4,13 +4,13 @@
 
 use super::input::{Friction, LinkInput, SlipHistory};
 use super::kinematics::{tangential, Frame, Kinematics};
-use crate::contact::dual::{self, Scalar, Vec3};
+use crate::contact::autodiff::{self, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 
 /// `Σ N_a (v̄_a + dv_dx (x_a − x̄_a))`: the integrator's velocity, affine in
 /// the positions, interpolated with shape values `n`.
 fn interpolated_velocity<T: Scalar>(n: &[T], x: &[Vec3<T>], v: &[[f64; 3]], dv_dx: f64) -> Vec3<T> {
-    let mut out = dual::constant3::<T>([0.0; 3]);
+    let mut out = autodiff::constant3::<T>([0.0; 3]);
     for ((na, xa), va) in n.iter().zip(x).zip(v) {
         for i in 0..3 {
             out[i] = out[i] + *na * ((xa[i] - xa[i].re()) * dv_dx + va[i]);
@@ -38,21 +38,21 @@ pub(super) fn slip_increment<T: Scalar>(
                 rate.master_v,
                 rate.dv_dx,
             ),
-            Frame::Rigid { .. } => dual::constant3(rate.master_v[0]),
+            Frame::Rigid { .. } => autodiff::constant3(rate.master_v[0]),
         };
-        return dual::scale_f64(&tangential(&dual::sub(&v1, &v2), &kin.normal), rate.dt);
+        return autodiff::scale_f64(&tangential(&autodiff::sub(&v1, &v2), &kin.normal), rate.dt);
     }
     match (&kin.frame, friction.history) {
-        (Frame::Facet { xi, tangents, .. }, SlipHistory::Convected { xi_n, .. }) => dual::add(
-            &dual::scale(&tangents[0], xi[0] - xi_n[0]),
-            &dual::scale(&tangents[1], xi[1] - xi_n[1]),
+        (Frame::Facet { xi, tangents, .. }, SlipHistory::Convected { xi_n, .. }) => autodiff::add(
+            &autodiff::scale(&tangents[0], xi[0] - xi_n[0]),
+            &autodiff::scale(&tangents[1], xi[1] - xi_n[1]),
         ),
         (Frame::Rigid { .. }, SlipHistory::Spatial { point_n, .. }) => tangential(
-            &dual::sub(&kin.master_point, &dual::constant3(point_n)),
+            &autodiff::sub(&kin.master_point, &autodiff::constant3(point_n)),
             &kin.normal,
         ),
         // `check_input` rejects a history that does not match the master.
-        _ => dual::constant3([0.0; 3]),
+        _ => autodiff::constant3([0.0; 3]),
     }
 }
 
@@ -66,16 +66,16 @@ fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Ve
             SlipHistory::Convected { lambda, .. },
         ) => {
             // Contravariant basis m^α = M^{αβ} τ_β, so that λT·τ_α = λ_α.
-            let (m11, m12, m22) = (dual::dot(t1, t1), dual::dot(t1, t2), dual::dot(t2, t2));
+            let (m11, m12, m22) = (autodiff::dot(t1, t1), autodiff::dot(t1, t2), autodiff::dot(t2, t2));
             let det = m11 * m22 - m12 * m12;
             let c1 = (m22 * lambda[0] - m12 * lambda[1]) / det;
             let c2 = (m11 * lambda[1] - m12 * lambda[0]) / det;
-            dual::add(&dual::scale(t1, c1), &dual::scale(t2, c2))
+            autodiff::add(&autodiff::scale(t1, c1), &autodiff::scale(t2, c2))
         }
         (_, SlipHistory::Spatial { lambda, .. }) => {
-            tangential(&dual::constant3(lambda), &kin.normal)
+            tangential(&autodiff::constant3(lambda), &kin.normal)
         }
-        _ => dual::constant3([0.0; 3]),
+        _ => autodiff::constant3([0.0; 3]),
     }
 }
 
@@ -88,11 +88,11 @@ pub(super) fn friction_traction<T: Scalar>(
     slip: &Vec3<T>,
 ) -> (Vec3<T>, bool) {
     let lambda = multiplier_vector(friction.history, kin);
-    let trial = dual::add(&lambda, &dual::scale_f64(slip, friction.penalty));
-    let size = dual::norm(&trial);
+    let trial = autodiff::add(&lambda, &autodiff::scale_f64(slip, friction.penalty));
+    let size = autodiff::norm(&trial);
     let limit = pressure * friction.mu;
     if size.re() > limit.re() && size.re() > 0.0 {
-        (dual::scale(&trial, limit / size), true)
+        (autodiff::scale(&trial, limit / size), true)
     } else {
         (trial, false)
     }

@@ -5,7 +5,7 @@
 
 use thiserror::Error;
 
-use crate::contact::dual::{self, Dual, Scalar, Vec3};
+use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 use crate::model::RigidSurface;
@@ -263,7 +263,7 @@ pub(super) fn facet_nodes(
 
 fn nonzero(what: &'static str, v: [f64; 3]) -> Result<(), LinkError> {
     finite(what, &v)?;
-    non_negative(what, dual::norm(&v), true)
+    non_negative(what, autodiff::norm(&v), true)
 }
 
 /// Checks everything [`evaluate`] relies on. The kernels call it themselves
@@ -387,18 +387,18 @@ pub fn reference_weights(
             let s = facet_shape(facet, zeta);
             let mut t = [[0.0; 3]; 2];
             for (xa, da) in x_ref.iter().zip(&s.dn) {
-                t[0] = dual::axpy(&t[0], da[0], xa);
-                t[1] = dual::axpy(&t[1], da[1], xa);
+                t[0] = autodiff::axpy(&t[0], da[0], xa);
+                t[1] = autodiff::axpy(&t[1], da[1], xa);
             }
-            (zeta, w * dual::norm(&dual::cross(&t[0], &t[1])))
+            (zeta, w * autodiff::norm(&autodiff::cross(&t[0], &t[1])))
         })
         .collect()
 }
 
 pub(super) fn nodes_as<T: Scalar>(x: &[[f64; 3]]) -> [Vec3<T>; MAX_FACET_NODES] {
-    let mut out = [dual::constant3([0.0; 3]); MAX_FACET_NODES];
+    let mut out = [autodiff::constant3([0.0; 3]); MAX_FACET_NODES];
     for (o, p) in out.iter_mut().zip(x) {
-        *o = dual::constant3(*p);
+        *o = autodiff::constant3(*p);
     }
     out
 }

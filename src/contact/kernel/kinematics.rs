@@ -3,7 +3,7 @@
 //! which the master point moves (convected on a facet, rigid otherwise).
 
 use super::input::{LinkInput, LinkMaster};
-use crate::contact::dual::{self, Scalar, Vec3};
+use crate::contact::autodiff::{self, Scalar, Vec3};
 use crate::contact::projection::mixed_second_derivative;
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, MAX_FACET_NODES};
@@ -11,9 +11,9 @@ use crate::fem::{FacetType, MAX_FACET_NODES};
 /// `x¹ = Σ N¹_a(ζ) x¹_a`.
 pub(super) fn slave_point<T: Scalar>(facet: FacetType, zeta: [f64; 2], x: &[Vec3<T>]) -> Vec3<T> {
     let s = facet_shape(facet, zeta);
-    let mut p = dual::constant3([0.0; 3]);
+    let mut p = autodiff::constant3([0.0; 3]);
     for (xa, na) in x.iter().zip(s.n) {
-        p = dual::axpy(&p, na, xa);
+        p = autodiff::axpy(&p, na, xa);
     }
     p
 }
@@ -62,20 +62,20 @@ fn facet_kinematics<T: Scalar>(
 ) -> Option<Kinematics<T>> {
     let s = facet_shape(facet, xi_bar);
     let m = mixed_second_derivative(facet);
-    let zero = dual::constant3::<T>([0.0; 3]);
+    let zero = autodiff::constant3::<T>([0.0; 3]);
     let (mut x2, mut t1, mut t2, mut t12) = (zero, zero, zero, zero);
     for (b, xb) in xm.iter().enumerate() {
-        x2 = dual::axpy(&x2, s.n[b], xb);
-        t1 = dual::axpy(&t1, s.dn[b][0], xb);
-        t2 = dual::axpy(&t2, s.dn[b][1], xb);
-        t12 = dual::axpy(&t12, m[b], xb);
+        x2 = autodiff::axpy(&x2, s.n[b], xb);
+        t1 = autodiff::axpy(&t1, s.dn[b][0], xb);
+        t2 = autodiff::axpy(&t2, s.dn[b][1], xb);
+        t12 = autodiff::axpy(&t12, m[b], xb);
     }
     // Newton step Δ = H⁻¹ F on F_α = (x¹ − x²)·τ_α.
-    let d = dual::sub(x1, &x2);
-    let f = [dual::dot(&d, &t1), dual::dot(&d, &t2)];
-    let h11 = dual::dot(&t1, &t1);
-    let h22 = dual::dot(&t2, &t2);
-    let h12 = dual::dot(&t1, &t2) - dual::dot(&d, &t12);
+    let d = autodiff::sub(x1, &x2);
+    let f = [autodiff::dot(&d, &t1), autodiff::dot(&d, &t2)];
+    let h11 = autodiff::dot(&t1, &t1);
+    let h22 = autodiff::dot(&t2, &t2);
+    let h12 = autodiff::dot(&t1, &t2) - autodiff::dot(&d, &t12);
     let det = h11 * h22 - h12 * h12;
     if !(h11.re() > 0.0 && det.re() > SINGULAR * h11.re() * h22.re()) {
         return None;
@@ -85,12 +85,12 @@ fn facet_kinematics<T: Scalar>(
     // N is at most bilinear, so its second-order Taylor expansion about ξ̄ is
     // exact: evaluate everything at ξ̄ + Δ without generic shape functions.
     let d12 = d1 * d2;
-    let x2 = dual::add(
-        &dual::add(&x2, &dual::scale(&t1, d1)),
-        &dual::add(&dual::scale(&t2, d2), &dual::scale(&t12, d12)),
+    let x2 = autodiff::add(
+        &autodiff::add(&x2, &autodiff::scale(&t1, d1)),
+        &autodiff::add(&autodiff::scale(&t2, d2), &autodiff::scale(&t12, d12)),
     );
-    let t1 = dual::add(&t1, &dual::scale(&t12, d2));
-    let t2 = dual::add(&t2, &dual::scale(&t12, d1));
+    let t1 = autodiff::add(&t1, &autodiff::scale(&t12, d2));
+    let t2 = autodiff::add(&t2, &autodiff::scale(&t12, d1));
     let mut master_n = [T::from_f64(0.0); MAX_FACET_NODES];
     let mut master_dn = [[T::from_f64(0.0); 2]; MAX_FACET_NODES];
     for b in 0..xm.len() {
@@ -98,18 +98,18 @@ fn facet_kinematics<T: Scalar>(
         master_dn[b] = [d2 * m[b] + s.dn[b][0], d1 * m[b] + s.dn[b][1]];
     }
     let normal = unit(
-        &dual::cross(&t1, &t2),
-        dual::norm(&t1).re() * dual::norm(&t2).re(),
+        &autodiff::cross(&t1, &t2),
+        autodiff::norm(&t1).re() * autodiff::norm(&t2).re(),
     )?;
-    let separation = dual::sub(x1, &x2);
+    let separation = autodiff::sub(x1, &x2);
     // The Hessian at ξ̄ + Δ (not ξ̄), so its derivative includes the move of ξ̄.
     let hessian = [
-        dual::dot(&t1, &t1),
-        dual::dot(&t1, &t2) - dual::dot(&separation, &t12),
-        dual::dot(&t2, &t2),
+        autodiff::dot(&t1, &t1),
+        autodiff::dot(&t1, &t2) - autodiff::dot(&separation, &t12),
+        autodiff::dot(&t2, &t2),
     ];
     Some(Kinematics {
-        gap: dual::dot(&separation, &normal),
+        gap: autodiff::dot(&separation, &normal),
         separation,
         normal,
         master_point: x2,
@@ -125,12 +125,12 @@ fn facet_kinematics<T: Scalar>(
 
 /// `v/|v|`, or `None` if `|v| ≤ SINGULAR · scale` (no direction).
 fn unit<T: Scalar>(v: &Vec3<T>, scale: f64) -> Option<Vec3<T>> {
-    let len = dual::norm(v);
-    (len.re() > SINGULAR * scale && len.re() > 0.0).then(|| dual::scale(v, len.recip()))
+    let len = autodiff::norm(v);
+    (len.re() > SINGULAR * scale && len.re() > 0.0).then(|| autodiff::scale(v, len.recip()))
 }
 
 fn unit_f64(v: [f64; 3]) -> [f64; 3] {
-    let len = dual::norm(&v);
+    let len = autodiff::norm(&v);
     v.map(|c| c / len)
 }
 
@@ -144,16 +144,16 @@ pub(super) fn rigid_kinematics<T: Scalar>(
     let one = T::from_f64(1.0);
     let (normal, gap, master_point, scale, axis) = match *master {
         LinkMaster::Plane { point, normal } => {
-            let n = dual::constant3::<T>(unit_f64(normal));
-            let gap = dual::dot(&dual::sub(x1, &dual::constant3(point)), &n);
-            let foot = dual::sub(x1, &dual::scale(&n, gap));
+            let n = autodiff::constant3::<T>(unit_f64(normal));
+            let gap = autodiff::dot(&autodiff::sub(x1, &autodiff::constant3(point)), &n);
+            let foot = autodiff::sub(x1, &autodiff::scale(&n, gap));
             (n, gap, foot, one, None)
         }
         LinkMaster::Sphere { centre, radius } => {
-            let c = dual::constant3::<T>(centre);
-            let n = unit(&dual::sub(x1, &c), radius)?;
-            let dist = dual::dot(&dual::sub(x1, &c), &n);
-            let foot = dual::add(&c, &dual::scale_f64(&n, radius));
+            let c = autodiff::constant3::<T>(centre);
+            let n = unit(&autodiff::sub(x1, &c), radius)?;
+            let dist = autodiff::dot(&autodiff::sub(x1, &c), &n);
+            let foot = autodiff::add(&c, &autodiff::scale_f64(&n, radius));
             (n, dist - radius, foot, dist.recip() * radius, None)
         }
         LinkMaster::Cylinder {
@@ -162,19 +162,19 @@ pub(super) fn rigid_kinematics<T: Scalar>(
             radius,
         } => {
             let a_f = unit_f64(axis);
-            let a = dual::constant3::<T>(a_f);
-            let d = dual::sub(x1, &dual::constant3(point));
-            let along = dual::scale(&a, dual::dot(&d, &a));
-            let n = unit(&dual::sub(&d, &along), radius)?;
-            let dist = dual::dot(&dual::sub(&d, &along), &n);
-            let base = dual::add(&dual::constant3(point), &along);
-            let foot = dual::add(&base, &dual::scale_f64(&n, radius));
+            let a = autodiff::constant3::<T>(a_f);
+            let d = autodiff::sub(x1, &autodiff::constant3(point));
+            let along = autodiff::scale(&a, autodiff::dot(&d, &a));
+            let n = unit(&autodiff::sub(&d, &along), radius)?;
+            let dist = autodiff::dot(&autodiff::sub(&d, &along), &n);
+            let base = autodiff::add(&autodiff::constant3(point), &along);
+            let foot = autodiff::add(&base, &autodiff::scale_f64(&n, radius));
             (n, dist - radius, foot, dist.recip() * radius, Some(a_f))
         }
         LinkMaster::Facet { .. } => return None,
     };
     Some(Kinematics {
-        separation: dual::sub(x1, &master_point),
+        separation: autodiff::sub(x1, &master_point),
         gap,
         normal,
         master_point,
@@ -185,7 +185,7 @@ pub(super) fn rigid_kinematics<T: Scalar>(
 
 /// `v − ν (ν·v)`.
 pub(super) fn tangential<T: Scalar>(v: &Vec3<T>, normal: &Vec3<T>) -> Vec3<T> {
-    dual::sub(v, &dual::scale(normal, dual::dot(normal, v)))
+    autodiff::sub(v, &autodiff::scale(normal, autodiff::dot(normal, v)))
 }
 
 /// Kinematics for either master kind, with slave and master nodal

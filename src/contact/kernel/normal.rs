@@ -5,7 +5,7 @@
 use super::evaluate;
 use super::input::{check_input, nodes_as, LinkInput, LinkMaster, LinkState};
 use super::kinematics::{rigid_kinematics, slave_point};
-use crate::contact::dual::Scalar;
+use crate::contact::autodiff::Scalar;
 use crate::contact::projection;
 
 /// `λN − εN gN`, the augmented normal traction: the link is closed when it

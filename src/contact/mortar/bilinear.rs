@@ -2,7 +2,7 @@
 //! f64, and its inversion by Newton (the mortar's segment points are mapped
 //! back to both facets through it; `geometry::PlanarMap` adds the
 //! derivative in `T`).
-use crate::contact::dual::Scalar;
+use crate::contact::autodiff::Scalar;
 use crate::fem::FacetType;
 
 type Vec2 = [f64; 2];

@@ -8,7 +8,7 @@
 //! covers in part (at the master's edge) keeps its segments' `D`, the part
 //! that matches `M` there.
 use super::segment::SegmentTerms;
-use crate::contact::dual::Scalar;
+use crate::contact::autodiff::Scalar;
 use crate::fem::MAX_FACET_NODES;
 
 /// Relative tolerance on a slave facet's area for its segments to cover it

@@ -26,7 +26,7 @@ use super::system::{
     emit_local, for_each_slave_node, segment_nodes, Block, Interface, Merger, NodalData, NodeDof,
     NodeState, NormalTangent, Segment, SEGMENT_DOFS,
 };
-use crate::contact::dual::{self, Dual, Scalar, Seed, Vec3};
+use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
 use crate::fem::MAX_FACET_NODES;
 
 type D = Dual<{ super::system::SEGMENT_DOFS }>;
@@ -96,7 +96,7 @@ pub fn segment_slip<T: Seed>(
     // only, as `value + slope (x − x_current)`, so each term is `D_ak`
     // scaled by the value, plus `D_ak slope` on that one derivative (a
     // product in `T` passed over every variable: a sixth of the tangent).
-    let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+    let mut slip = [autodiff::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
     let sides = [
         (s_nodes, &seg.terms.d, 0, 1.0),
         (m_nodes, &seg.terms.m, super::system::MASTER_OFFSET, -1.0),
@@ -117,7 +117,7 @@ pub fn segment_slip<T: Seed>(
         }
     }
     SegmentSlip {
-        normal: dual::scale(&seg.terms.normal, seg.terms.area),
+        normal: autodiff::scale(&seg.terms.normal, seg.terms.area),
         slip,
     }
 }
@@ -141,15 +141,15 @@ pub fn traction<T: Scalar>(
     law: &Law,
 ) -> (Vec3<T>, Vec3<T>, bool) {
     let pressure = T::from_f64(law.lambda_n) - gap * (law.penalty_n / law.area);
-    let n = dual::scale(normal_sum, dual::norm(normal_sum).recip());
-    let tangential = |v: &Vec3<T>| dual::sub(v, &dual::scale(&n, dual::dot(v, &n)));
-    let lambda = tangential(&dual::constant3(law.lambda_t));
-    let mean_slip = dual::scale_f64(&tangential(slip), 1.0 / law.area);
-    let trial = dual::add(&lambda, &dual::scale_f64(&mean_slip, law.penalty_t));
-    let size = dual::norm(&trial);
+    let n = autodiff::scale(normal_sum, autodiff::norm(normal_sum).recip());
+    let tangential = |v: &Vec3<T>| autodiff::sub(v, &autodiff::scale(&n, autodiff::dot(v, &n)));
+    let lambda = tangential(&autodiff::constant3(law.lambda_t));
+    let mean_slip = autodiff::scale_f64(&tangential(slip), 1.0 / law.area);
+    let trial = autodiff::add(&lambda, &autodiff::scale_f64(&mean_slip, law.penalty_t));
+    let size = autodiff::norm(&trial);
     let limit = pressure * law.mu;
     if size.re() > limit.re() && size.re() > 0.0 {
-        (dual::scale(&trial, limit / size), mean_slip, true)
+        (autodiff::scale(&trial, limit / size), mean_slip, true)
     } else {
         (trial, mean_slip, false)
     }
@@ -230,8 +230,8 @@ pub(super) fn node_law(
     NodeFriction {
         active: true,
         sliding,
-        traction: dual::re3(&t),
-        slip: dual::re3(&s),
+        traction: autodiff::re3(&t),
+        slip: autodiff::re3(&s),
         derivative: t.map(|c| c.eps),
     }
 }

@@ -7,7 +7,7 @@ use super::friction::{
 use super::segment::MortarRules;
 use super::system::{self, node_states, segments, weighted_gaps, Segment};
 use super::tests::{parallelogram_case, random_case, Case};
-use crate::contact::dual::Dual;
+use crate::contact::autodiff::Dual;
 use crate::fem::test_util::Lcg;
 use crate::fem::FacetType::{Quad4, Tri3};
 
@@ -152,7 +152,7 @@ fn frictional_tangent_matches_finite_differences_in_stick_and_slip() {
                     "seed {seed}: {sliding} of {active} sliding at μ = {mu}"
                 );
                 for n in nf.iter().filter(|n| n.active) {
-                    let t = crate::contact::dual::norm(&n.traction);
+                    let t = crate::contact::autodiff::norm(&n.traction);
                     assert!(t > 0.0);
                 }
             }
@@ -197,7 +197,7 @@ fn sliding_nodes_carry_mu_times_their_pressure_and_mu_zero_is_frictionless() {
     let states = node_states(nodal, &gap, &covered);
     let (_, nf) = f.residual(positions);
     for (s, n) in states.iter().zip(&nf).filter(|(_, n)| n.sliding) {
-        let t = crate::contact::dual::norm(&n.traction);
+        let t = crate::contact::autodiff::norm(&n.traction);
         assert!(
             (t - 0.2 * s.pressure).abs() <= 1e-14 * t,
             "{t} vs {}",

@@ -10,7 +10,7 @@
 //! then that of the current clipping pattern, which is the derivative almost
 //! everywhere.
 use super::bilinear::Bilinear;
-use crate::contact::dual::{self, Scalar, Vec3};
+use crate::contact::autodiff::{self, Scalar, Vec3};
 use crate::fem::{FacetType, MAX_FACET_NODES};
 
 /// A 2-vector in the auxiliary plane.
@@ -41,22 +41,22 @@ impl<T: Scalar> Plane<T> {
     pub fn of_facet(facet: FacetType, x: &[Vec3<T>]) -> Option<Self> {
         let centre = crate::contact::projection::reference_centre(facet);
         let s = crate::fem::shape::facet_shape(facet, centre);
-        let zero = dual::constant3::<T>([0.0; 3]);
+        let zero = autodiff::constant3::<T>([0.0; 3]);
         let (mut origin, mut t1, mut t2) = (zero, zero, zero);
         for (a, xa) in x.iter().enumerate().take(facet.nodes()) {
-            origin = dual::axpy(&origin, s.n[a], xa);
-            t1 = dual::axpy(&t1, s.dn[a][0], xa);
-            t2 = dual::axpy(&t2, s.dn[a][1], xa);
+            origin = autodiff::axpy(&origin, s.n[a], xa);
+            t1 = autodiff::axpy(&t1, s.dn[a][0], xa);
+            t2 = autodiff::axpy(&t2, s.dn[a][1], xa);
         }
-        let (l1, l2) = (dual::norm(&t1), dual::norm(&t2));
-        let n = dual::cross(&t1, &t2);
-        let ln = dual::norm(&n);
+        let (l1, l2) = (autodiff::norm(&t1), autodiff::norm(&t2));
+        let n = autodiff::cross(&t1, &t2);
+        let ln = autodiff::norm(&n);
         if !(l1.re() > 0.0 && l2.re() > 0.0 && ln.re() > 1e-12 * l1.re() * l2.re()) {
             return None;
         }
-        let normal = dual::scale(&n, ln.recip());
-        let e1 = dual::scale(&t1, l1.recip());
-        let e2 = dual::cross(&normal, &e1);
+        let normal = autodiff::scale(&n, ln.recip());
+        let e1 = autodiff::scale(&t1, l1.recip());
+        let e2 = autodiff::cross(&normal, &e1);
         Some(Plane {
             origin,
             normal,
@@ -67,8 +67,8 @@ impl<T: Scalar> Plane<T> {
 
     /// In-plane coordinates of the projection of `x` along the normal.
     pub fn coordinates(&self, x: &Vec3<T>) -> Vec2<T> {
-        let d = dual::sub(x, &self.origin);
-        [dual::dot(&d, &self.e1), dual::dot(&d, &self.e2)]
+        let d = autodiff::sub(x, &self.origin);
+        [autodiff::dot(&d, &self.e1), autodiff::dot(&d, &self.e2)]
     }
 }
 
@@ -492,7 +492,7 @@ pub struct SegmentPoint<T> {
 /// the geometric tolerance is scaled with.
 pub fn facet_size<T: Scalar>(x: &[Vec3<T>]) -> f64 {
     x.iter()
-        .map(|p| dual::norm(&dual::sub(&dual::re3(p), &dual::re3(&x[0]))))
+        .map(|p| autodiff::norm(&autodiff::sub(&autodiff::re3(p), &autodiff::re3(&x[0]))))
         .fold(0.0, f64::max)
 }
 

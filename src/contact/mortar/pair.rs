@@ -17,7 +17,7 @@ use super::segment::MortarRules;
 use super::system::{self, Interface, NodalData, NodeState, Segment};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
-use crate::contact::dual::Dual;
+use crate::contact::autodiff::Dual;
 use crate::contact::outcome::UzawaStats;
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
@@ -489,7 +489,7 @@ impl MortarPair {
             let area = self.nodal.area[j];
             if let Some(f) = &mut self.friction {
                 let n = &frictions[j];
-                let change = crate::contact::dual::norm(&crate::contact::dual::sub(
+                let change = crate::contact::autodiff::norm(&crate::contact::autodiff::sub(
                     &n.traction,
                     &f.nodal.lambda[j],
                 ));

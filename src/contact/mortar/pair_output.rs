@@ -75,7 +75,7 @@ impl MortarPair {
             for (f, tc) in force.force.iter_mut().zip(t) {
                 *f -= tc * d;
             }
-            force.tangential += crate::contact::dual::norm(t) * d;
+            force.tangential += crate::contact::autodiff::norm(t) * d;
         }
         let n = self.owned_mesh_nodes;
         let mut out = NodeFields {
@@ -108,7 +108,7 @@ impl MortarPair {
             if let Some(lt) = &mut out.lambda_t {
                 lt[l] = *lambda_t(j);
             }
-            let len = crate::contact::dual::norm(&normal_sum[j]);
+            let len = crate::contact::autodiff::norm(&normal_sum[j]);
             if len > 0.0 {
                 let t = lambda_t(j);
                 out.traction[l] =

@@ -25,7 +25,7 @@ fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
 fn shortest_edge(x: &[[f64; 3]]) -> f64 {
     (0..x.len())
         .map(|i| {
-            crate::contact::dual::norm(&crate::contact::dual::sub(&x[i], &x[(i + 1) % x.len()]))
+            crate::contact::autodiff::norm(&crate::contact::autodiff::sub(&x[i], &x[(i + 1) % x.len()]))
         })
         .fold(f64::INFINITY, f64::min)
 }

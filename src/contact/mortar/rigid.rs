@@ -25,7 +25,7 @@
 //! through the master's increment in the slip (`rigid_friction`).
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
 use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState};
-use crate::contact::dual::{self, Dual, Scalar, Seed, Vec3};
+use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 use crate::model::RigidSurface;
@@ -84,26 +84,26 @@ pub fn facet_rule(facet: FacetType, rules: &MortarRules) -> Rule {
 /// cylinder's axis).
 pub fn distance<T: Scalar>(surface: &RigidSurface, x: &Vec3<T>) -> Option<(T, Vec3<T>)> {
     let radial = |v: Vec3<T>, radius: f64| {
-        let len = dual::norm(&v);
-        (len.re() > 1e-12 * radius).then(|| (len - radius, dual::scale(&v, len.recip())))
+        let len = autodiff::norm(&v);
+        (len.re() > 1e-12 * radius).then(|| (len - radius, autodiff::scale(&v, len.recip())))
     };
     match *surface {
         RigidSurface::Plane { point, normal } => {
-            let n = dual::constant3::<T>(normal);
-            Some((dual::dot(&dual::sub(x, &dual::constant3(point)), &n), n))
+            let n = autodiff::constant3::<T>(normal);
+            Some((autodiff::dot(&autodiff::sub(x, &autodiff::constant3(point)), &n), n))
         }
         RigidSurface::Sphere { centre, radius } => {
-            radial(dual::sub(x, &dual::constant3(centre)), radius)
+            radial(autodiff::sub(x, &autodiff::constant3(centre)), radius)
         }
         RigidSurface::Cylinder {
             point,
             axis,
             radius,
         } => {
-            let d = dual::sub(x, &dual::constant3(point));
-            let a = dual::constant3::<T>(axis);
-            let along = dual::scale(&a, dual::dot(&d, &a));
-            radial(dual::sub(&d, &along), radius)
+            let d = autodiff::sub(x, &autodiff::constant3(point));
+            let a = autodiff::constant3::<T>(axis);
+            let along = autodiff::scale(&a, autodiff::dot(&d, &a));
+            radial(autodiff::sub(&d, &along), radius)
         }
     }
 }
@@ -113,10 +113,10 @@ fn reference_jacobian(facet: FacetType, x_ref: &[[f64; 3]], zeta: [f64; 2]) -> f
     let s = facet_shape(facet, zeta);
     let (mut t1, mut t2) = ([0.0; 3], [0.0; 3]);
     for (x, d) in x_ref.iter().zip(&s.dn) {
-        t1 = dual::axpy(&t1, d[0], x);
-        t2 = dual::axpy(&t2, d[1], x);
+        t1 = autodiff::axpy(&t1, d[0], x);
+        t2 = autodiff::axpy(&t2, d[1], x);
     }
-    dual::norm(&dual::cross(&t1, &t2))
+    autodiff::norm(&autodiff::cross(&t1, &t2))
 }
 
 /// Every candidate facet's integrals (a facet with a point where the
@@ -152,7 +152,7 @@ pub fn facets<T: Seed>(interface: &RigidInterface, rules: &MortarRules) -> Vec<R
             let w0 = w * reference_jacobian(ft, &x_ref[..ns], *zeta);
             let mut x = [zero; 3];
             for (na, xa) in s.n.iter().zip(&xs).take(ns) {
-                x = dual::add(&x, &dual::scale_f64(xa, *na));
+                x = autodiff::add(&x, &autodiff::scale_f64(xa, *na));
             }
             let Some((gap, n)) = distance(&interface.surface, &x) else {
                 continue 'facets;
@@ -164,9 +164,9 @@ pub fn facets<T: Seed>(interface: &RigidInterface, rules: &MortarRules) -> Vec<R
                 for k in 0..ns {
                     let c = pw * s.n[k];
                     terms.d[j][k] += c;
-                    terms.force[j][k] = dual::sub(&terms.force[j][k], &dual::scale_f64(&n, c));
+                    terms.force[j][k] = autodiff::sub(&terms.force[j][k], &autodiff::scale_f64(&n, c));
                 }
-                terms.normal[j] = dual::add(&terms.normal[j], &dual::scale_f64(&n, s.n[j] * w0));
+                terms.normal[j] = autodiff::add(&terms.normal[j], &autodiff::scale_f64(&n, s.n[j] * w0));
             }
         }
         out.push(terms);

@@ -17,7 +17,7 @@
 use super::friction::{emit_outer, node_law, Increment, NodalFriction, NodeFriction};
 use super::rigid::{for_each_node, RigidFacet, RigidInterface, RD};
 use super::system::{NodalData, NodeDof, NodeState};
-use crate::contact::dual::{self, Scalar, Seed, Vec3};
+use crate::contact::autodiff::{self, Scalar, Seed, Vec3};
 use crate::fem::MAX_FACET_NODES;
 
 /// One facet's weighted slip per row, `Σ_k D_ak Δ_k − d_a Δc`.
@@ -39,17 +39,17 @@ pub fn facet_slips<T: Seed>(
         .iter()
         .map(|f| {
             let nodes = &interface.facets[f.facet as usize][..ns];
-            let mut delta = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+            let mut delta = [autodiff::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
             for (a, (o, &n)) in delta.iter_mut().zip(nodes).enumerate() {
                 let v = inc.value[n as usize];
                 *o = [0, 1, 2].map(|i| T::seed_scaled(v[i], 3 * a + i, inc.slope));
             }
-            let mut slip = [dual::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
+            let mut slip = [autodiff::constant3::<T>([0.0; 3]); MAX_FACET_NODES];
             for (a, s) in slip.iter_mut().enumerate().take(ns) {
                 let row: f64 = f.d[a][..ns].iter().sum();
-                *s = dual::constant3(master.map(|c| -row * c));
+                *s = autodiff::constant3(master.map(|c| -row * c));
                 for (dak, x) in f.d[a].iter().zip(&delta).take(ns) {
-                    *s = dual::add(s, &dual::scale_f64(x, *dak));
+                    *s = autodiff::add(s, &autodiff::scale_f64(x, *dak));
                 }
             }
             RigidSlip { slip }

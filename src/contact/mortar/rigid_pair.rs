@@ -16,7 +16,7 @@ use super::rigid_master::RigidMaster;
 use super::rows::Rows;
 use super::system::{self, NodeState};
 use crate::assembly::{MatrixSink, PatternSink};
-use crate::contact::dual::Seed;
+use crate::contact::autodiff::Seed;
 use crate::dofs::{DofMap, GlobalDof, DIM};
 use crate::error::Result;
 

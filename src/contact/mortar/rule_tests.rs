@@ -5,7 +5,7 @@ use super::geometry::NEAR_AFFINE;
 use super::segment::{reference_distortion, MortarRules};
 use super::system::{segments, Interface, Segment};
 use super::tests::{case_with, parallelogram_case, random_case, Case};
-use crate::contact::dual::Dual;
+use crate::contact::autodiff::Dual;
 use crate::fem::test_util::Lcg;
 use crate::fem::FacetType::{Quad4, Tri3};
 

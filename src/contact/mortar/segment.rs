@@ -21,7 +21,7 @@
 //! (biorthogonality), a constant: such a facet takes that diagonal instead
 //! of the segments' sum (`system::covered_facets`).
 use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
-use crate::contact::dual::{self, Scalar, Vec3};
+use crate::contact::autodiff::{self, Scalar, Vec3};
 use crate::fem::shape::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
 
@@ -185,14 +185,14 @@ fn facet_moments<T: Scalar>(
     for (zeta, w) in rules.facet(facet) {
         let s = facet_shape(facet, *zeta);
         let (mut t1, mut t2) = (
-            dual::constant3::<T>([0.0; 3]),
-            dual::constant3::<T>([0.0; 3]),
+            autodiff::constant3::<T>([0.0; 3]),
+            autodiff::constant3::<T>([0.0; 3]),
         );
         for (a, xa) in x.iter().enumerate().take(n) {
-            t1 = dual::axpy(&t1, s.dn[a][0], xa);
-            t2 = dual::axpy(&t2, s.dn[a][1], xa);
+            t1 = autodiff::axpy(&t1, s.dn[a][0], xa);
+            t2 = autodiff::axpy(&t2, s.dn[a][1], xa);
         }
-        let jw = dual::norm(&dual::cross(&t1, &t2)) * *w;
+        let jw = autodiff::norm(&autodiff::cross(&t1, &t2)) * *w;
         for ((dj, mj), nj) in d.iter_mut().zip(m.iter_mut()).zip(&s.n).take(n) {
             *dj = *dj + jw * *nj;
             for (mjk, nk) in mj.iter_mut().zip(&s.n).take(n) {
@@ -325,7 +325,7 @@ fn interpolate<T: Scalar>(s: &FacetShape, h: &[T], zeta: &[T; 2]) -> T {
 fn heights<T: Scalar>(normal: &Vec3<T>, x: &[Vec3<T>]) -> [T; MAX_FACET_NODES] {
     let mut h = [T::from_f64(0.0); MAX_FACET_NODES];
     for (ha, xa) in h.iter_mut().zip(x) {
-        *ha = dual::dot(normal, xa);
+        *ha = autodiff::dot(normal, xa);
     }
     h
 }
@@ -336,20 +336,20 @@ fn heights<T: Scalar>(normal: &Vec3<T>, x: &[Vec3<T>]) -> [T; MAX_FACET_NODES] {
 /// linearised, instead of carrying every segment variable through the
 /// cross product (a tenth of a frictional mortar run).
 fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T; 2]) -> T {
-    use crate::contact::dual::Dual;
+    use crate::contact::autodiff::Dual;
     let z: [Dual<2>; 2] = [
         Dual::variable(zeta[0].re(), 0),
         Dual::variable(zeta[1].re(), 1),
     ];
     let dn = shape_gradients(facet, &z);
-    let zero = dual::constant3::<Dual<2>>([0.0; 3]);
+    let zero = autodiff::constant3::<Dual<2>>([0.0; 3]);
     let (mut t1, mut t2) = (zero, zero);
     for (d, x) in dn.iter().zip(x_ref).take(facet.nodes()) {
-        let x = dual::constant3::<Dual<2>>(*x);
-        t1 = dual::add(&t1, &dual::scale(&x, d[0]));
-        t2 = dual::add(&t2, &dual::scale(&x, d[1]));
+        let x = autodiff::constant3::<Dual<2>>(*x);
+        t1 = autodiff::add(&t1, &autodiff::scale(&x, d[0]));
+        t2 = autodiff::add(&t2, &autodiff::scale(&x, d[1]));
     }
-    let j = dual::norm(&dual::cross(&t1, &t2));
+    let j = autodiff::norm(&autodiff::cross(&t1, &t2));
     T::linearised(j.re, j.eps, zeta)
 }
 
@@ -367,7 +367,7 @@ pub(super) fn reference_distortion(facet: FacetType, x: &[[f64; 3]]) -> f64 {
             let a1 = combine([-1.0, 1.0, 1.0, -1.0]);
             let a2 = combine([-1.0, -1.0, 1.0, 1.0]);
             let b = combine([1.0, -1.0, 1.0, -1.0]);
-            super::bilinear::distortion(dual::norm(&b), dual::norm(&dual::cross(&a1, &a2)))
+            super::bilinear::distortion(autodiff::norm(&b), autodiff::norm(&autodiff::cross(&a1, &a2)))
         }
     }
 }

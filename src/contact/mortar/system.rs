@@ -17,7 +17,7 @@
 //! segment of node `j` with every other: see [`node_supports`].
 use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
-use crate::contact::dual::{Dual, Scalar, Seed, Vec3};
+use crate::contact::autodiff::{Dual, Scalar, Seed, Vec3};
 use crate::contact::multipliers::updated_multiplier;
 use crate::fem::{FacetType, MAX_FACET_NODES};
 

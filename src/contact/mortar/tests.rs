@@ -7,7 +7,7 @@ use super::system::{
     covered_facets, for_each_segment, node_states, residual, segments, slave_nodal_areas, tangent,
     weighted_gaps, Interface, NodalData, Segment,
 };
-use crate::contact::dual::Dual;
+use crate::contact::autodiff::Dual;
 use crate::fem::test_util::Lcg;
 use crate::fem::FacetType::{self, Quad4, Tri3};
 
@@ -215,7 +215,7 @@ fn dual_basis_is_biorthogonal_and_sums_to_one() {
             let t = |c: usize| -> [f64; 3] {
                 [0, 1, 2].map(|i| (0..n).map(|k| s.dn[k][c] * x[k][i]).sum())
             };
-            let jw = crate::contact::dual::norm(&crate::contact::dual::cross(&t(0), &t(1))) * w;
+            let jw = crate::contact::autodiff::norm(&crate::contact::autodiff::cross(&t(0), &t(1))) * w;
             let phi = dual_values(&a, &s.n, n);
             assert!((phi[..n].iter().sum::<f64>() - 1.0).abs() < 1e-13);
             for j in 0..n {

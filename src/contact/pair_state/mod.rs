@@ -23,7 +23,7 @@ pub use links::Link;
 pub use output::PointValues;
 pub use snapshot::{FrictionRows, MortarRows, PairSnapshot, RestartRows};
 
-use super::dual::{norm, sub};
+use super::autodiff::{norm, sub};
 use super::held_master::HeldMaster;
 use super::mortar::pair::{MortarMaster, MortarPair};
 use super::multipliers::Multipliers;

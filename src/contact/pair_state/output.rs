@@ -1,7 +1,7 @@
 //! A pair's values for the result file: per slave point, per owned slave
 //! node, and this rank's part of the contact force.
 use super::ContactPair;
-use crate::contact::dual::norm;
+use crate::contact::autodiff::norm;
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::contact::outcome::PairForce;
 use crate::error::Result;

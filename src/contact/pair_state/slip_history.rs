@@ -4,7 +4,7 @@
 //! started at first contact and renewed by every Uzawa update.
 use super::links::Link;
 use super::{ContactPair, MasterSide};
-use crate::contact::dual::dot;
+use crate::contact::autodiff::dot;
 use crate::contact::held_master::HeldMaster;
 use crate::contact::kernel::{LinkState, SlipHistory};
 use crate::contact::multipliers::{PointFriction, PointState};
@@ -224,7 +224,7 @@ fn rebase_lambda(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::dual::{norm, sub};
+    use crate::contact::autodiff::{norm, sub};
     use crate::fem::FacetType;
 
     /// Two unit quads side by side in z = 0 (x ∈ [0, 1] and [1, 2]), the

@@ -1,6 +1,6 @@
 //! The Uzawa update of a pair's multipliers, and its penalty.
 use super::ContactPair;
-use crate::contact::dual::{norm, sub};
+use crate::contact::autodiff::{norm, sub};
 use crate::contact::multipliers::{updated_multiplier, PointState};
 use crate::contact::outcome::UzawaStats;
 use crate::error::Result;

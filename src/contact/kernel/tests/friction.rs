@@ -14,7 +14,7 @@ fn with_friction(case: &Case, ratio: f64, dynamic: bool, rng: &mut Lcg) -> Case 
             lambda: [0.1 * rng.next(), 0.1 * rng.next()],
         },
         OwnedMaster::Rigid(_) => SlipHistory::Spatial {
-            point_n: dual::add(&s.master_point, &rng.vec3(0.05)),
+            point_n: autodiff::add(&s.master_point, &rng.vec3(0.05)),
             lambda: rng.vec3(0.1),
         },
     };
@@ -37,7 +37,7 @@ fn with_friction(case: &Case, ratio: f64, dynamic: bool, rng: &mut Lcg) -> Case 
         rate,
     });
     // With μ huge the link sticks and |traction| = |tT*|.
-    let trial = dual::norm(&evaluate(&c.input()).friction.unwrap().traction);
+    let trial = autodiff::norm(&evaluate(&c.input()).friction.unwrap().traction);
     if let Some(f) = &mut c.friction {
         f.mu = trial / (ratio * s.pressure);
     }
@@ -67,7 +67,7 @@ fn friction_cases_stick_and_slip_as_intended() {
         let f = s.friction.expect("closed link with friction");
         assert_eq!(f.sliding, name.contains("slip"), "{name}");
         let limit = case.friction.as_ref().unwrap().mu * s.pressure;
-        let t = dual::norm(&f.traction);
+        let t = autodiff::norm(&f.traction);
         if f.sliding {
             assert!((t - limit).abs() < 1e-12 * limit, "{name}: {t} vs {limit}");
         } else {
@@ -155,8 +155,8 @@ fn friction_forces_balance_for_facet_masters() {
         let scale = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let force = r
             .chunks_exact(3)
-            .fold([0.0; 3], |f, v| dual::add(&f, &[v[0], v[1], v[2]]));
-        assert!(dual::norm(&force) < 1e-13 * scale, "{name}: {force:?}");
+            .fold([0.0; 3], |f, v| autodiff::add(&f, &[v[0], v[1], v[2]]));
+        assert!(autodiff::norm(&force) < 1e-13 * scale, "{name}: {force:?}");
         let kscale = k.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for i in 0..3 {
             for col in 0..n {

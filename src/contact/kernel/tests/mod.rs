@@ -113,7 +113,7 @@ impl Case {
 
     fn translated(&self, t: [f64; 3]) -> Case {
         let mut c = self.clone();
-        let shift = |p: &mut [f64; 3]| *p = dual::add(p, &t);
+        let shift = |p: &mut [f64; 3]| *p = autodiff::add(p, &t);
         c.slave_x.iter_mut().for_each(shift);
         if let OwnedMaster::Facet(_, x) = &mut c.master {
             x.iter_mut().for_each(shift);
@@ -187,7 +187,7 @@ fn random_zeta(facet: FacetType, rng: &mut Lcg) -> [f64; 2] {
 
 fn perturbed(base: &[[f64; 2]], z: f64, amp: f64, rng: &mut Lcg) -> Vec<[f64; 3]> {
     base.iter()
-        .map(|p| dual::add(&[p[0], p[1], z], &rng.vec3(amp)))
+        .map(|p| autodiff::add(&[p[0], p[1], z], &rng.vec3(amp)))
         .collect()
 }
 

@@ -86,19 +86,19 @@ fn forces_and_moments_balance_for_facet_masters() {
         let mut moment = [0.0; 3];
         for (x, f) in case.nodes().iter().zip(r.chunks_exact(3)) {
             let f = [f[0], f[1], f[2]];
-            force = dual::add(&force, &f);
-            moment = dual::add(&moment, &dual::cross(x, &f));
+            force = autodiff::add(&force, &f);
+            moment = autodiff::add(&moment, &autodiff::cross(x, &f));
         }
         let size = case
             .nodes()
             .iter()
-            .fold(0.0f64, |m, x| m.max(dual::norm(x)));
+            .fold(0.0f64, |m, x| m.max(autodiff::norm(x)));
         assert!(
-            dual::norm(&force) < 1e-14 * scale,
+            autodiff::norm(&force) < 1e-14 * scale,
             "{name}: force {force:?}"
         );
         assert!(
-            dual::norm(&moment) < 1e-14 * scale * size,
+            autodiff::norm(&moment) < 1e-14 * scale * size,
             "{name}: moment {moment:?}"
         );
         // Balance holds for every u, so its derivative does too: the
@@ -206,7 +206,7 @@ fn pressed_totals(
         let ns = slave.nodes();
         for (a, f) in r.chunks_exact(3).enumerate() {
             let target = if a < ns { &mut fs } else { &mut fm };
-            *target = dual::add(target, &[f[0], f[1], f[2]]);
+            *target = autodiff::add(target, &[f[0], f[1], f[2]]);
         }
     }
     (fs, fm)
