@@ -47,7 +47,8 @@ pub fn a_mortar_pair_holds_only_the_master_near_its_slave_facets(
         .run(rt, &mut Discard, false, None)
         .map_err(|e| e.to_string())?;
     let pair = sim.contact().first().ok_or("no contact pair")?;
-    let (held, whole) = pair.held_master_facets().ok_or("no held master")?;
+    let facets = pair.held_facets().ok_or("no held master")?;
+    let (held, whole) = (facets.held, facets.whole);
     let world = rt.world();
     let mut holding = 0u64;
     world.all_reduce_into(&u64::from(held > 0), &mut holding, SystemOperation::sum());

@@ -310,12 +310,12 @@ impl StepSink for HertzObserver {
         // Nodal pressures: the point multipliers of an over-constrained slave
         // surface are not unique, the nodal forces they add up to are.
         let points: Vec<f64> = fields
-            .values
+            .output
             .nodes
             .iter()
             .flat_map(|(x, _)| x.iter().copied())
             .collect();
-        let pressure: Vec<f64> = fields.values.nodes.iter().map(|(_, p)| *p).collect();
+        let pressure: Vec<f64> = fields.output.nodes.iter().map(|(_, p)| *p).collect();
         let points = gather_all(&self.world, &points);
         let pressure = gather_all(&self.world, &pressure);
         let points: Vec<[f64; 3]> = points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();

@@ -14,17 +14,17 @@
 //!   datasets' shapes. Any rank's mismatch is every rank's error, naming the
 //!   first node that moved;
 //! - the displacement of its owned nodes;
-//! - a links pair's λN and friction history of its own slave points;
-//! - a mortar pair's nodal λ, λT and slip origins of the pair nodes it
-//!   holds.
+//! - every contact pair's fields its formulation asks for
+//!   (`ContactPair::restart_request`: a links pair's λN and friction
+//!   history of its own slave points, a mortar pair's nodal λ, λT and slip
+//!   origins of the pair nodes it holds).
 //!
 //! The file must come from the same scene: same mesh (node count and
 //! coordinates, cell count), same contact pairs; anything else is an error
 //! naming the file and what differs, raised before any solve.
 mod fetch;
 
-use crate::contact::multipliers::FrictionRecord;
-use crate::contact::pair_state::{FrictionRows, MortarRows, RestartRows};
+use crate::contact::fields::{RestartRows, RowSpace};
 use crate::contact::ContactPair;
 use crate::distribution::LocalMesh;
 use crate::dofs::{even_block, LocalNode, DIM};
@@ -250,11 +250,10 @@ impl Reader<'_> {
         Ok(x)
     }
 
-    /// Collective: this rank's rows of one pair.
+    /// Collective: this rank's rows of one pair, the fields its
+    /// formulation asks for (`ContactPair::restart_request`).
     fn pair(&self, step: usize, pair: &ContactPair, load_factor: f64) -> Result<RestartRows> {
-        let name = &pair.spec.name;
-        let field = |f: &str| layout::pair_dataset(name, f);
-        let friction = pair.restarts_friction();
+        let field = |f: &str| layout::pair_dataset(pair.name(), f);
         // Files from before penalties were written have none: keep the
         // scene's. Agreed (a rank whose read failed alone takes the others'
         // value), since every rank must go on with the same penalty.
@@ -264,77 +263,26 @@ impl Reader<'_> {
             .filter(|p| p.is_finite() && *p > 0.0);
         let [agreed] = parallel::max(self.world, [penalty.unwrap_or(-1.0)]);
         let penalty = (agreed > 0.0).then_some(agreed);
-        if let Some(m) = &pair.mortar {
-            let nodes = m.restart_nodes();
-            // One row per mesh node (zero off the pair).
-            let n = Some(self.nodes);
-            let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
-                Ok(triples(&self.fetch(step, &field(f), n, 3, nodes)?.1))
+        // Point fields have the dataset's own row count, the first one read
+        // fixes it for the rest; nodal fields one row per mesh node.
+        let mut point_rows = None;
+        let mut fields = Vec::new();
+        for f in pair.restart_request().fields {
+            let rows = match f.space {
+                RowSpace::Points => point_rows,
+                RowSpace::Nodes => Some(self.nodes),
             };
-            let (lambda_t, slip_origin) = if friction {
-                (
-                    Some(triples(layout::PAIR_NODE_LAMBDA_T)?),
-                    Some(triples(layout::PAIR_NODE_SLIP_ORIGIN)?),
-                )
-            } else {
-                (None, None)
-            };
-            let lambda = self
-                .fetch(step, &field(layout::PAIR_NODE_LAMBDA), n, 1, nodes)?
-                .1;
-            return Ok(RestartRows {
-                penalty,
-                lambda: Vec::new(),
-                friction: None,
-                mortar: Some(MortarRows {
-                    lambda,
-                    lambda_t,
-                    slip_origin,
-                    load_factor,
-                }),
-            });
+            let (have, values) = self.fetch(step, &field(f.name), rows, f.cols, &f.rows)?;
+            if f.space == RowSpace::Points {
+                point_rows = Some(have);
+            }
+            fields.push(values);
         }
-        let points = pair.restart_points();
-        let (rows, lambda) = self.fetch(step, &field(layout::PAIR_LAMBDA_N), None, 1, &points)?;
-        let friction = if friction {
-            let rows = Some(rows);
-            let triples = |f: &str| -> Result<Vec<[f64; 3]>> {
-                Ok(triples(&self.fetch(step, &field(f), rows, 3, &points)?.1))
-            };
-            let (lambda_t, origin, ids) = (
-                triples(layout::PAIR_LAMBDA_T)?,
-                triples(layout::PAIR_SLIP_ORIGIN)?,
-                triples(layout::PAIR_HISTORY_IDS)?,
-            );
-            let records = lambda_t
-                .into_iter()
-                .zip(origin)
-                .zip(ids)
-                .map(|((lambda, origin), ids)| FrictionRecord {
-                    lambda,
-                    origin,
-                    ids,
-                })
-                .collect();
-            Some(FrictionRows {
-                records,
-                state: self
-                    .fetch(step, &field(layout::PAIR_STATE), rows, 1, &points)?
-                    .1,
-                traction: triples(layout::PAIR_TRACTION_T)?,
-            })
-        } else {
-            None
-        };
         Ok(RestartRows {
             penalty,
-            lambda,
-            friction,
-            mortar: None,
+            load_factor,
+            fields,
         })
     }
 }
 
-fn triples(flat: &[f64]) -> Vec<[f64; 3]> {
-    flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
-}

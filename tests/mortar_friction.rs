@@ -101,10 +101,10 @@ fn history(h5: &Path) -> Vec<HashMap<String, f64>> {
         .collect()
 }
 
-/// Largest slip of the step at a contact point.
+/// Largest mean slip of the step at a slave node.
 fn largest_slip(out: &Path, step: usize) -> f64 {
-    read_dataset::<f64>(out, &format!("/steps/{step:06}/contact/interface/slip"))
-        .expect("slip")
+    read_dataset::<f64>(out, &format!("/steps/{step:06}/contact/interface/node_slip"))
+        .expect("node_slip")
         .0
         .chunks_exact(3)
         .map(|s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt())
@@ -153,15 +153,15 @@ fn mortar_block_sticks_below_mu_n_and_transmits_mu_n_while_sliding() {
     assert!(worst <= 1e-10, "Fx/Fz off μ by {worst:e}");
     assert!(stuck >= 6, "too few sticking steps ({stuck})");
     assert!(sliding >= 5, "too few fully sliding steps ({sliding})");
-    // Every contact point of the last step is sliding.
+    // Every slave node in contact at the last step is sliding.
     let last = *steps.last().unwrap();
     let read = |name: &str| {
         read_dataset::<f64>(&out, &format!("/steps/{last:06}/contact/interface/{name}"))
             .expect(name)
             .0
     };
-    for (s, p) in read("state").iter().zip(&read("pressure")) {
-        assert_eq!(*s, if *p > 0.0 { 2.0 } else { 0.0 });
+    for (s, l) in read("node_state").iter().zip(&read("node_lambda")) {
+        assert_eq!(*s, if *l > 0.0 { 2.0 } else { 0.0 });
     }
 }
 

@@ -1,33 +1,44 @@
-//! Contact: the ContactLink3D condition (docs/formulation.md §2–§5, §9).
+//! Contact: the ContactLink3D condition and its mortar counterpart
+//! (docs/formulation.md §2–§5, §9, §13).
 //!
-//! - `surfaces`: the slave and master sides as one rank sees them;
-//! - `held_master`: the master facets of a links pair one rank holds, and
-//!   the bounding-box exchange that decides them at every search;
-//! - `search`: spatial index, outer and inner search;
-//! - `projection`: closest-point projection onto a master facet;
-//! - `kernel`: the kernel of one link: gap, normal, contact pressure
-//!   pN = ⟨λN − εN gN⟩, Coulomb friction (trial traction, stick/slip, return
-//!   map), residual and consistent tangent;
-//! - `multipliers`: λN and the friction state (λT, slip origin, stick/slip)
-//!   at the slave points, the Uzawa update rule, halo exchange;
-//! - `outcome`: what a pair's evaluation reports (Uzawa statistics, force),
-//!   shared by both formulations;
-//! - `pair_state`: a pair at run time ([`ContactPair`]: search per step,
-//!   assembly, Uzawa update, snapshots and restart, output values);
-//! - `mortar`: the mortar formulation (nodal dual multipliers, segment-based
-//!   integration of the slave–master overlap).
+//! The solver holds a [`ContactPair`] per pair and asks it the duties of
+//! [`formulation::Formulation`]; each formulation is one module:
+//! - `links`: one link per slave quadrature point (its kernel, multipliers
+//!   per point, slip history);
+//! - `mortar`: dual multipliers at the slave nodes, segment-based
+//!   integration of the slave–master overlap.
 //!
-//! Nothing here calls the solver: `solve` drives the Uzawa loop around SNES.
+//! What they share:
+//! - `pair`: [`ContactPair`], a pair at run time (its specification,
+//!   reported penalty, slip rate, and its formulation);
+//! - `penalty`: the normal law pN = ⟨λN − εN gN⟩, the default penalty and
+//!   the policy that raises or softens it within a step;
+//! - `fields`: the fields a pair writes to and reads back from a result
+//!   file, and their names;
+//! - `outcome`: what an evaluation reports (Uzawa statistics, force);
+//! - `surfaces`: the slave side as one rank sees it; `master`: the master
+//!   side (held facets of a deformable body, or a rigid surface);
+//!   `held_master`: the facets a rank holds and the exchange that decides
+//!   them;
+//! - `search`, `projection`: spatial index and closest-point projection;
+//! - `autodiff`: dual numbers for the exact tangents.
+//!
+//! Nothing here calls the solver or PETSc: `solve` drives the Uzawa loop
+//! around SNES.
 pub mod autodiff;
+pub mod fields;
+pub mod formulation;
 pub mod held_master;
-pub mod kernel;
+pub mod links;
+pub mod master;
 pub mod mortar;
-pub mod multipliers;
 pub mod outcome;
-pub mod pair_state;
+pub mod pair;
+pub mod penalty;
 pub mod projection;
 pub mod search;
 pub mod surfaces;
 
+pub use formulation::{Census, SlipRate, Traits};
 pub use outcome::{PairForce, UzawaStats};
-pub use pair_state::ContactPair;
+pub use pair::ContactPair;

@@ -2,7 +2,7 @@
 //!
 //! Slave facets belong to the rank that owns their cell; that rank evaluates
 //! their links. The master facets a rank holds are `held_master`'s.
-use super::kernel::reference_weights;
+use super::autodiff;
 use crate::distribution::{LocalFacetSet, LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
@@ -35,6 +35,10 @@ pub struct SlaveSurface {
     pub qp_weight: Vec<f64>,
     /// Facets in the whole set (all ranks).
     pub global_facets: usize,
+    /// Global number of every slave facet of the set (by set index):
+    /// contiguous per rank, like the DOFs; points are numbered facet-major
+    /// after it (the rows of the pair's point output).
+    pub global_facet: Vec<usize>,
     /// Mean shortest edge of the set's facets (identical on every rank): the
     /// element size the penalty and the penetration tolerance scale with.
     /// The shortest edge, not √area, so one-cell-thick plane-strain slabs
@@ -88,6 +92,13 @@ impl SlaveSurface {
             });
         }
         let global_facets = local_set.global_len;
+        if piece.owners.len() != global_facets {
+            return Err(Error::Internal(format!(
+                "slave set '{set}' has {global_facets} facets but {} facet owners",
+                piece.owners.len()
+            )));
+        }
+        let owner: Vec<usize> = piece.owners.iter().map(|&o| o as usize).collect();
         Ok(SlaveSurface {
             set: set.to_owned(),
             facet_type,
@@ -96,8 +107,15 @@ impl SlaveSurface {
             qp_zeta,
             qp_weight,
             global_facets,
+            global_facet: contiguous_numbering(&owner, dofs.nranks),
             h: piece.mean_edge,
         })
+    }
+
+    /// Global number of slave point `q` of facet `set_index` (contiguous
+    /// per rank), for redistribution to output order.
+    pub fn global_point(&self, set_index: usize, q: usize) -> usize {
+        self.global_facet[set_index] * self.nqp + q
     }
 
     pub fn num_qps(&self) -> usize {
@@ -163,4 +181,70 @@ fn unknown_set(set: &str, known: Vec<&str>) -> Error {
             known.join(", ")
         ),
     )
+}
+
+/// Slave quadrature points and their reference weights: Gauss weight ×
+/// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` on the reference (undeformed) slave facet `x_ref`.
+/// Empty for bad input (wrong node count, non-finite values, malformed rule).
+pub fn reference_weights(
+    facet: FacetType,
+    x_ref: &[[f64; 3]],
+    rule: &QuadRule,
+) -> Vec<([f64; 2], f64)> {
+    let usable = x_ref.len() == facet.nodes() && x_ref.as_flattened().iter().all(|v| v.is_finite());
+    if !usable || rule.check().is_err() {
+        return Vec::new();
+    }
+    rule.points
+        .iter()
+        .zip(&rule.weights)
+        .map(|(p, w)| {
+            let zeta = [p[0], p[1]];
+            let s = facet_shape(facet, zeta);
+            let mut t = [[0.0; 3]; 2];
+            for (xa, da) in x_ref.iter().zip(&s.dn) {
+                t[0] = autodiff::axpy(&t[0], da[0], xa);
+                t[1] = autodiff::axpy(&t[1], da[1], xa);
+            }
+            (zeta, w * autodiff::norm(&autodiff::cross(&t[0], &t[1])))
+        })
+        .collect()
+}
+
+/// Numbers items rank by rank (each rank's in their given order), the same
+/// way `DofMap` numbers nodes.
+fn contiguous_numbering(owner: &[usize], nranks: usize) -> Vec<usize> {
+    let mut count = vec![0usize; nranks];
+    for &o in owner {
+        count[o] += 1;
+    }
+    let mut next: Vec<usize> = count
+        .iter()
+        .scan(0, |acc, &c| {
+            let start = *acc;
+            *acc += c;
+            Some(start)
+        })
+        .collect();
+    owner
+        .iter()
+        .map(|&o| {
+            let n = next[o];
+            next[o] += 1;
+            n
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbering_is_contiguous_per_rank() {
+        assert_eq!(
+            contiguous_numbering(&[1, 0, 1, 0, 2], 3),
+            vec![2, 0, 3, 1, 4]
+        );
+    }
 }

@@ -56,31 +56,14 @@ pub const MOMENTUM: &str = "momentum";
 /// `/steps/<NNNNNN>/contact/`: one group per contact pair.
 pub const CONTACT: &str = "contact";
 
-/// Members of a pair group `contact/<pair>/`: per-point arrays...
-pub const PAIR_POINTS: &str = "points";
-pub const PAIR_PRESSURE: &str = "pressure";
-pub const PAIR_GAP: &str = "gap";
-pub const PAIR_LAMBDA_N: &str = "lambda_n";
-pub const PAIR_WEIGHT: &str = "weight";
-/// ...with friction...
-pub const PAIR_TRACTION_T: &str = "traction_t";
-pub const PAIR_SLIP: &str = "slip";
-pub const PAIR_STATE: &str = "state";
-pub const PAIR_LAMBDA_T: &str = "lambda_t";
-pub const PAIR_SLIP_ORIGIN: &str = "slip_origin";
-pub const PAIR_HISTORY_IDS: &str = "history_ids";
-/// ...mortar nodal fields (mesh-node rows)...
-pub const PAIR_NODE_LAMBDA: &str = "node_lambda";
-pub const PAIR_NODE_WEIGHTED_GAP: &str = "node_weighted_gap";
-pub const PAIR_NODE_AREA: &str = "node_area";
-pub const PAIR_NODE_TRACTION: &str = "node_traction";
-/// A frictional mortar pair's history for `--restart` (N,3): λT_j, and
-/// where the next step measures slip from (the pair nodes' positions).
-pub const PAIR_NODE_LAMBDA_T: &str = "node_lambda_t";
-pub const PAIR_NODE_SLIP_ORIGIN: &str = "node_slip_origin";
-/// ...and the pair's totals, `(3,)` and `(1,)`.
-pub const PAIR_FORCE: &str = "force";
-pub const PAIR_PENALTY: &str = "penalty";
+/// Members of a pair group `contact/<pair>/`: each formulation names the
+/// fields it writes (`contact::fields`).
+pub use crate::contact::fields::{
+    PAIR_FORCE, PAIR_GAP, PAIR_HISTORY_IDS, PAIR_LAMBDA_N, PAIR_LAMBDA_T, PAIR_NODE_AREA,
+    PAIR_NODE_LAMBDA, PAIR_NODE_LAMBDA_T, PAIR_NODE_SLIP, PAIR_NODE_SLIP_ORIGIN, PAIR_NODE_STATE,
+    PAIR_NODE_TRACTION, PAIR_NODE_WEIGHTED_GAP, PAIR_PENALTY, PAIR_POINTS, PAIR_PRESSURE,
+    PAIR_SLIP, PAIR_SLIP_ORIGIN, PAIR_STATE, PAIR_TRACTION_T, PAIR_WEIGHT,
+};
 
 /// Root attributes: the scene text and its `--set` overrides.
 pub const SCENE_ATTR: &str = "scene";

@@ -44,10 +44,11 @@ impl Hdf5Sink {
         let dofs = sim.dofs();
         let mut pairs = Vec::new();
         for p in sim.contact() {
-            let nqp = p.slave.nqp;
-            let rows = p.slave.global_facets * nqp;
-            let petsc_row = |nat: usize| p.multipliers.global_point(nat / nqp, nat % nqp, nqp);
-            let owned = p.slave.num_qps();
+            let slave = p.slave();
+            let nqp = slave.nqp;
+            let rows = slave.global_facets * nqp;
+            let petsc_row = |nat: usize| slave.global_point(nat / nqp, nat % nqp);
+            let owned = slave.num_qps();
             pairs.push(PairOrder {
                 scalar: NaturalOrder::new(rows, 1, owned, petsc_row, dofs.rank, dofs.nranks)?,
                 vector: NaturalOrder::new(rows, 3, owned, petsc_row, dofs.rank, dofs.nranks)?,
@@ -63,6 +64,10 @@ impl Hdf5Sink {
         })
     }
 
+    /// A pair's fields of one step: its point fields (rows: the pair's
+    /// slave points in input order) and nodal fields (rows: mesh nodes in
+    /// input order), whichever its formulation writes, then its force and
+    /// penalty (raised when Uzawa was slow, for a restart).
     fn write_pair(
         &mut self,
         step: usize,
@@ -70,67 +75,44 @@ impl Hdf5Sink {
         fields: &PairFields,
         report: &StepReport,
     ) -> Result<()> {
-        let name = &fields.pair.spec.name;
-        let v = &fields.values;
-        let flat = |a: &[[f64; 3]]| -> Vec<f64> { a.iter().flatten().copied().collect() };
-        let mut vectors = vec![(layout::PAIR_POINTS, flat(&v.points))];
-        let mut scalars = vec![
-            (layout::PAIR_PRESSURE, v.pressure.clone()),
-            (layout::PAIR_GAP, v.gap.clone()),
-            (layout::PAIR_LAMBDA_N, v.lambda.clone()),
-            (layout::PAIR_WEIGHT, v.weight.clone()),
-        ];
-        // Decided by the pair, not by this rank's points: a rank may own no
-        // slave point, and every rank must write the same datasets.
-        if fields.pair.has_friction() {
-            vectors.push((layout::PAIR_TRACTION_T, flat(&v.traction)));
-            vectors.push((layout::PAIR_SLIP, flat(&v.slip)));
-            // 0 open, 1 stick, 2 slip (stored as f64 like every step array).
-            scalars.push((
-                layout::PAIR_STATE,
-                v.state.iter().map(|&s| f64::from(s)).collect(),
-            ));
-            // The friction history, so `run --restart` continues exactly.
-            let records = &v.records;
-            vectors.push((
-                layout::PAIR_LAMBDA_T,
-                flat(&records.iter().map(|r| r.lambda).collect::<Vec<_>>()),
-            ));
-            vectors.push((
-                layout::PAIR_SLIP_ORIGIN,
-                flat(&records.iter().map(|r| r.origin).collect::<Vec<_>>()),
-            ));
-            vectors.push((
-                layout::PAIR_HISTORY_IDS,
-                flat(&records.iter().map(|r| r.ids).collect::<Vec<_>>()),
-            ));
-        }
+        let name = fields.pair.name();
+        let output = &fields.output;
         let order = &mut self.pairs[i];
-        let rows = order.rows;
-        for (cols, label, values) in vectors
-            .iter()
-            .map(|(l, d)| (3, l, d))
-            .chain(scalars.iter().map(|(l, d)| (1, l, d)))
-        {
-            let scatter = if cols == 3 {
+        for f in &output.point_fields {
+            let scatter = if f.cols == 3 {
                 &mut order.vector
             } else {
                 &mut order.scalar
             };
-            let (start, data) = scatter.block_of_owned(values)?;
+            let (start, data) = scatter.block_of_owned(&f.values)?;
             self.file.write_step_block(
                 step,
-                &layout::pair_dataset(name, label),
+                &layout::pair_dataset(name, f.name),
                 BlockRows {
-                    global_rows: rows,
+                    global_rows: order.rows,
                     start,
-                    cols,
+                    cols: f.cols,
                     data: &data,
                 },
             )?;
         }
-        if let Some(m) = &v.mortar {
-            self.write_mortar_nodes(step, name, m)?;
+        for f in &output.node_fields {
+            let scatter = if f.cols == 3 {
+                &mut self.natural
+            } else {
+                &mut self.natural_scalar
+            };
+            let (start, data) = scatter.block_of_owned(&f.values)?;
+            self.file.write_step_block(
+                step,
+                &layout::pair_dataset(name, f.name),
+                BlockRows {
+                    global_rows: self.nodes,
+                    start,
+                    cols: f.cols,
+                    data: &data,
+                },
+            )?;
         }
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
         self.file.write_step_small(
@@ -138,59 +120,11 @@ impl Hdf5Sink {
             &layout::pair_dataset(name, layout::PAIR_FORCE),
             &force,
         )?;
-        // The pair's penalty (raised when Uzawa was slow), for a restart.
         self.file.write_step_small(
             step,
             &layout::pair_dataset(name, layout::PAIR_PENALTY),
-            &[fields.pair.penalty],
+            &[fields.pair.penalty()],
         )?;
-        Ok(())
-    }
-}
-
-impl Hdf5Sink {
-    /// A mortar pair's nodal fields, mesh-node rows in input order (zero off
-    /// the slave surface): `node_lambda`, `node_weighted_gap`, `node_area`,
-    /// `node_traction` and, with friction, `node_lambda_t` and `node_slip_origin`.
-    fn write_mortar_nodes(
-        &mut self,
-        step: usize,
-        name: &str,
-        m: &crate::contact::mortar::pair::NodeFields,
-    ) -> Result<()> {
-        let traction: Vec<f64> = m.traction.iter().flatten().copied().collect();
-        let flat = |v: &Option<Vec<[f64; 3]>>| -> Option<Vec<f64>> {
-            v.as_ref().map(|l| l.iter().flatten().copied().collect())
-        };
-        let (lambda_t, origin) = (flat(&m.lambda_t), flat(&m.slip_origin));
-        let mut fields = vec![
-            (layout::PAIR_NODE_LAMBDA, 1, &m.lambda),
-            (layout::PAIR_NODE_WEIGHTED_GAP, 1, &m.weighted_gap),
-            (layout::PAIR_NODE_AREA, 1, &m.area),
-            (layout::PAIR_NODE_TRACTION, 3, &traction),
-        ];
-        if let (Some(l), Some(o)) = (&lambda_t, &origin) {
-            fields.push((layout::PAIR_NODE_LAMBDA_T, 3, l));
-            fields.push((layout::PAIR_NODE_SLIP_ORIGIN, 3, o));
-        }
-        for (label, cols, values) in fields {
-            let order = if cols == 3 {
-                &mut self.natural
-            } else {
-                &mut self.natural_scalar
-            };
-            let (start, data) = order.block_of_owned(values)?;
-            self.file.write_step_block(
-                step,
-                &layout::pair_dataset(name, label),
-                BlockRows {
-                    global_rows: self.nodes,
-                    start,
-                    cols,
-                    data: &data,
-                },
-            )?;
-        }
         Ok(())
     }
 }

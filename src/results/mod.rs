@@ -89,6 +89,28 @@ pub struct PairPoints {
     /// A mortar pair's active slave nodes (λ_j > 0), the constraints its
     /// Uzawa loop counts; None for a links pair, whose points are those.
     pub active_nodes: Option<ActiveNodes>,
+    /// A frictional pair's constraints sticking and slipping, from the
+    /// state its formulation writes (a links pair's points, `state`; a
+    /// mortar pair's slave nodes, `node_state`); None without friction.
+    pub friction: Option<StickSlip>,
+}
+
+/// Constraints in contact that stick, and that slip.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StickSlip {
+    pub stick: usize,
+    pub slip: usize,
+}
+
+impl StickSlip {
+    /// Counts a state field (0 open, 1 stick, 2 slip).
+    pub fn count(state: &[f64]) -> Self {
+        let n = |v: f64| state.iter().filter(|&&s| s == v).count();
+        StickSlip {
+            stick: n(crate::contact::fields::STICK),
+            slip: n(crate::contact::fields::SLIP),
+        }
+    }
 }
 
 /// A mortar pair's active slave nodes: how many, and the slave area they
@@ -139,7 +161,14 @@ impl PairPoints {
         } else {
             None
         };
+        let friction = [layout::PAIR_NODE_STATE, layout::PAIR_STATE]
+            .into_iter()
+            .find(|name| has_dataset(path, step, &rel(name)))
+            .map(|name| read_nodal(path, step, &rel(name)))
+            .transpose()?
+            .map(|(state, _, _)| StickSlip::count(&state));
         Ok(PairPoints {
+            friction,
             points: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
             pressure,
             weight: weight.map(|(w, _)| w),

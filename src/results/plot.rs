@@ -395,6 +395,7 @@ mod tests {
             weight: None,
             force: [0.0, 0.0, 10.0],
             active_nodes: None,
+            friction: None,
         }
     }
 

@@ -1,6 +1,7 @@
 //! `contactlink summary OUT.h5`: one row per step with the solver effort
 //! and, per contact pair, the total force, the normal force Σ pN·w, the
-//! contact area Σ w (pN > 0), the peak pressure and the active points.
+//! contact area Σ w (pN > 0), the peak pressure, the active constraints and,
+//! with friction, how many of them stick and slip.
 use super::{nodal_pressure, open_steps, pair_names, slave_nodes, PairPoints, ResultsError};
 use crate::dofs::NaturalNode;
 use crate::output::{read_step_attrs, StepInfo};
@@ -28,6 +29,9 @@ pub struct PairRow {
     /// point values are interpolated from the nodes, so a point next to an
     /// active node is positive without being a constraint).
     pub active: usize,
+    /// With friction: of the constraints in contact, how many stick and
+    /// slip (points or slave nodes, as `active`); None without friction.
+    pub friction: Option<super::StickSlip>,
 }
 
 /// One step of the result file.
@@ -93,6 +97,7 @@ fn pair_row(
         max_pressure,
         max_point_pressure: p.pressure.iter().copied().fold(0.0, f64::max),
         active: p.active_nodes.map_or(active.len(), |n| n.count),
+        friction: p.friction,
     })
 }
 
@@ -123,13 +128,15 @@ pub fn table(path: &Path, rows: &[StepRow]) -> String {
     );
     for name in &pairs {
         head += &format!(
-            " | {:<34} {:>11} {:>11} {:>11} {:>11} {:>6}",
+            " | {:<34} {:>11} {:>11} {:>11} {:>11} {:>6} {:>6} {:>6}",
             format!("{name}: force [x, y, z]"),
             "normal",
             "area",
             "max p",
             "max λN",
-            "active"
+            "active",
+            "stick",
+            "slip"
         );
     }
     out += head.trim_end();
@@ -142,8 +149,11 @@ pub fn table(path: &Path, rows: &[StepRow]) -> String {
         );
         for p in &r.pairs {
             let [x, y, z] = p.force;
+            let (stick, slip) = p.friction.map_or(("-".into(), "-".into()), |f| {
+                (f.stick.to_string(), f.slip.to_string())
+            });
             line += &format!(
-                " | {:>34} {:>11} {:>11} {:>11} {:>11.4e} {:>6}",
+                " | {:>34} {:>11} {:>11} {:>11} {:>11.4e} {:>6} {stick:>6} {slip:>6}",
                 format!("[{x:.3e}, {y:.3e}, {z:.3e}]"),
                 number(p.normal),
                 number(p.area),
@@ -191,6 +201,8 @@ pub fn csv(rows: &[StepRow]) -> String {
             "max_pressure",
             "max_point_pressure",
             "active",
+            "stick",
+            "slip",
         ] {
             head.push(format!("{name}.{k}"));
         }
@@ -217,6 +229,10 @@ pub fn csv(rows: &[StepRow]) -> String {
             row.extend(p.force.iter().map(|&v| num(v)));
             row.extend([p.normal, p.area, p.max_pressure, p.max_point_pressure].map(num));
             row.push(p.active.to_string());
+            // Empty without friction.
+            let count = |c: Option<usize>| c.map_or(String::new(), |c| c.to_string());
+            row.push(count(p.friction.map(|f| f.stick)));
+            row.push(count(p.friction.map(|f| f.slip)));
         }
         out += &(row.join(",") + "\n");
     }
@@ -246,6 +262,7 @@ mod tests {
                 max_pressure: 9.75,
                 max_point_pressure: 11.0,
                 active: 12,
+                friction: None,
             }],
         }]
     }

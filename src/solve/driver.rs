@@ -24,7 +24,8 @@ use super::start::{initial_state, mechanics, prepare_time_step, time_stepper, Pa
 use super::uzawa::{chain, uzawa_loop, StepContext, StepResult};
 use super::RestartState;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
-use crate::contact::pair_state::{PairSnapshot, PointValues};
+use crate::contact::fields::PairOutput;
+use crate::contact::formulation::PairSnapshot;
 use crate::contact::{ContactPair, PairForce, UzawaStats};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, DIM};
@@ -328,7 +329,7 @@ impl LoadSteps<'_> {
             let searched = self.stages.scope(Phase::ContactSearch, || {
                 mech.exchange_masters(x)?;
                 // The pairs are the same on every rank: so is this choice.
-                if mech.contact.iter().any(|p| p.starts_slip_from_committed()) {
+                if mech.contact.iter().any(|p| p.measures_slip_from_committed()) {
                     // `x_prev`: the last converged state, with a restart's
                     // slip origins at the owned nodes until its first step
                     // has converged.
@@ -448,7 +449,7 @@ impl LoadSteps<'_> {
             softening: solver.first_contact_softening,
             main_part_tangent: solver.first_contact_main_tangent,
             acceleration: super::tolerance::inner_acceleration(solver.uzawa_acceleration, krylov),
-            rate_rule: super::tolerance::rate_rule(krylov),
+            rate_rule: crate::contact::penalty::rate_rule(krylov),
         };
         self.stage_solve
             .scope(|| uzawa_loop(world, &mut ctx, mech, target))
@@ -576,7 +577,8 @@ impl LoadSteps<'_> {
     ) -> Result<()> {
         let output_mark = PhaseMark::new(&self.mech.times, self.mech.contact);
         let reactions = self.reactions()?;
-        let (fields, forces) = self.point_values()?;
+        let outputs = self.pair_outputs()?;
+        let forces: Vec<PairForce> = outputs.iter().map(|o| o.force).collect();
         let contact = contact_reports(&self.world, self.mech.contact, &forces, &stats);
         let nodal_pressure = parallel::agree(
             &self.world,
@@ -605,8 +607,8 @@ impl LoadSteps<'_> {
             .mech
             .contact
             .iter()
-            .zip(fields)
-            .map(|(pair, values)| PairFields { pair, values })
+            .zip(outputs)
+            .map(|(pair, output)| PairFields { pair, output })
             .collect();
         report.phases = self.times.plus(&self.mech.times).since(&start.times);
         let velocity = self.stepper.as_ref().map(|s| s.velocity());
@@ -643,17 +645,13 @@ impl LoadSteps<'_> {
         support_reactions(&self.world, self.mech.dirichlet, &mut self.reaction, start)
     }
 
-    /// Collective: every pair's values at its points and its force.
-    fn point_values(&mut self) -> Result<(Vec<PointValues>, Vec<PairForce>)> {
+    /// Collective: every pair's output fields and force.
+    fn pair_outputs(&mut self) -> Result<Vec<PairOutput>> {
         let target = self.done;
-        let values = self.mech.with_state(&self.x, |u, pairs| {
-            let values = pairs
-                .iter_mut()
-                .map(|p| p.point_values(u, target))
-                .collect::<Result<Vec<_>>>()?;
-            Ok(values.into_iter().unzip::<_, PairForce, Vec<_>, Vec<_>>())
+        let outputs = self.mech.with_state(&self.x, |u, pairs| {
+            pairs.iter_mut().map(|p| p.output(u, target)).collect()
         });
-        parallel::agree(&self.world, values)
+        parallel::agree(&self.world, outputs)
     }
 
     /// Collective: the run's report, with the final displacement on rank 0
@@ -691,7 +689,7 @@ impl LoadSteps<'_> {
                 [mech
                     .contact
                     .iter()
-                    .map(|p| p.multipliers.ghost_values())
+                    .map(|p| p.multiplier_halo().1)
                     .sum()],
             )[0],
         })

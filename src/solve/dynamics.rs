@@ -4,12 +4,12 @@
 //! mass matrix is assembled once; a static scene never builds it.
 //!
 //! Friction in dynamics measures slip from the relative velocity, which the
-//! integrator makes affine in `u` (`v = γ/(βΔt) u + …`): the links get that
-//! map ([`SlipRateMap`]) and their tangent then carries the friction damping
+//! integrator makes affine in `u` (`v = γ/(βΔt) u + …`): the pairs get that
+//! map ([`SlipRate`]) and their tangent then carries the friction damping
 //! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
 use super::newmark::Coefficients;
 use crate::assembly::BulkAssembler;
-use crate::contact::pair_state::SlipRateMap;
+use crate::contact::SlipRate;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
@@ -135,7 +135,7 @@ impl TimeStepper {
         c: &Coefficients,
         dt: f64,
         rigid_velocity: [f64; 3],
-    ) -> Result<SlipRateMap> {
+    ) -> Result<SlipRate> {
         let (u_n, v_n, a_n) = (&self.u_n, &self.v_n, &self.a_n);
         combine(
             self.ghosted.global_mut(),
@@ -143,7 +143,7 @@ impl TimeStepper {
         )?;
         self.ghosted.update_ghosts()?;
         let offset = self.ghosted.with_local(|a| a.to_vec())?;
-        Ok(SlipRateMap {
+        Ok(SlipRate {
             dt,
             dv_du: c.v_u,
             offset,

@@ -1,10 +1,10 @@
 //! Why a load increment failed, as every rank sees it, and the text the
-//! cutback line and the final error print: the failing iterate's link
-//! states, a failed linear solve's KSP reason and the rank whose Jacobian
-//! rows are not finite.
+//! cutback line and the final error print: the contact constraints at the
+//! failing iterate, a failed linear solve's KSP reason and the rank whose
+//! Jacobian rows are not finite.
 use super::mechanics::Mechanics;
-use super::penalty::{PENALTY_RAISE, PENALTY_RAISES};
-use crate::contact::UzawaStats;
+use crate::contact::penalty::{ROUND_RAISE, ROUND_RAISES};
+use crate::contact::{Census, UzawaStats};
 use crate::error::Result;
 use crate::parallel;
 use crate::petsc::{Matrix, SnesOutcome, SnesReason, Vector};
@@ -14,11 +14,12 @@ use mpi::traits::Communicator;
 pub(super) enum StepFailure {
     /// The step's first residual, before Newton, failed on some rank.
     Residual(String),
-    /// Newton failed; with the link states at the failing iterate, and for
-    /// a failed linear solve the rank whose Jacobian rows are not finite.
+    /// Newton failed; with each pair's constraints at the failing iterate
+    /// (one clause each, over all ranks), and for a failed linear solve the
+    /// rank whose Jacobian rows are not finite.
     Newton {
         outcome: SnesOutcome,
-        links: Vec<(String, LinkSummary)>,
+        contact: Vec<String>,
         jacobian: Option<String>,
     },
     Uzawa {
@@ -39,18 +40,6 @@ impl StepFailure {
     }
 }
 
-/// One pair's links at an iterate: points pressed together (gap < 0 or a
-/// positive multiplier), sliding, and the deepest penetration (totals and
-/// maxima over ranks). A mortar pair's are its slave nodes (p_j > 0) and
-/// their deepest mean penetration g̃_j / A_j relative to the element size.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct LinkSummary {
-    pressed: usize,
-    sliding: usize,
-    max_penetration: f64,
-    mortar: bool,
-}
-
 /// Collective, on a failed Newton solve (the same on every rank): the link
 /// states at the failing iterate, and for a failed linear solve the lowest
 /// rank whose Jacobian rows hold non-finite values.
@@ -69,61 +58,46 @@ pub(super) fn newton_failure(
     } else {
         None
     };
-    // A NaN iterate has no meaningful link states (and no gap to compute).
-    let links = if x.norm2()?.is_finite() {
-        links_at(world, mech, x, factor)?
+    // A NaN iterate has no meaningful contact states (and no gap to compute).
+    let contact = if x.norm2()?.is_finite() {
+        censuses(world, mech, x, factor)?
     } else {
         Vec::new()
     };
     Ok(StepFailure::Newton {
         outcome,
-        links,
+        contact,
         jacobian,
     })
 }
 
-/// Collective: [`LinkSummary`] of every pair at the iterate `x`.
-fn links_at(
+/// Collective: every pair's constraints at the iterate `x`, summed and
+/// maximised over the ranks, as one clause each.
+fn censuses(
     world: &impl Communicator,
     mech: &mut Mechanics,
     x: &Vector,
     factor: f64,
-) -> Result<Vec<(String, LinkSummary)>> {
+) -> Result<Vec<String>> {
     let local = mech.with_state(x, |u, pairs| {
         pairs
             .iter_mut()
-            .map(|p| {
-                if let Some(s) = p.mortar_census(u, factor) {
-                    return Ok((s.active, s.sliding, s.max_penetration));
-                }
-                let (v, _) = p.point_values(u, factor)?;
-                let pressed = v
-                    .gap
-                    .iter()
-                    .zip(&v.lambda)
-                    .filter(|(g, l)| **g < 0.0 || **l > 0.0)
-                    .count();
-                let sliding = v.state.iter().filter(|s| **s == 2).count();
-                let depth = v.gap.iter().fold(0.0f64, |m, g| m.max(-g));
-                Ok((pressed, sliding, depth))
-            })
-            .collect::<Result<Vec<_>>>()
+            .map(|p| p.census(u, factor))
+            .collect::<Result<Vec<Census>>>()
     });
     let local = parallel::agree(world, local)?;
     Ok(mech
         .contact
         .iter()
         .zip(local)
-        .map(|(p, (pressed, sliding, depth))| {
-            let [pressed, sliding] = parallel::sum_usize(world, [pressed, sliding]);
-            let [max_penetration] = parallel::max(world, [depth]);
-            let summary = LinkSummary {
+        .map(|(p, c)| {
+            let [pressed, sliding] = parallel::sum_usize(world, [c.pressed, c.sliding]);
+            let [max_penetration] = parallel::max(world, [c.max_penetration]);
+            p.describe_census(&Census {
                 pressed,
                 sliding,
                 max_penetration,
-                mortar: p.is_mortar(),
-            };
-            (p.spec.name.clone(), summary)
+            })
         })
         .collect())
 }
@@ -133,7 +107,7 @@ pub(super) fn failure_text(f: &StepFailure) -> String {
         StepFailure::Residual(why) => format!("the step's first residual failed: {why}"),
         StepFailure::Newton {
             outcome: o,
-            links,
+            contact,
             jacobian,
         } => {
             let mut text = match (&o.domain_error, o.reason) {
@@ -150,25 +124,15 @@ pub(super) fn failure_text(f: &StepFailure) -> String {
             if let Some(j) = jacobian {
                 text += &format!(" ({j})");
             }
-            for (name, s) in links {
-                let sticking = s.pressed - s.sliding.min(s.pressed);
-                text += &if s.mortar {
-                    format!(
-                        "; slave nodes of mortar pair '{name}' at the failing iterate: {} pressed together (p > 0), {} sliding, {sticking} sticking, max mean penetration {:.3e} of the element size",
-                        s.pressed, s.sliding, s.max_penetration
-                    )
-                } else {
-                    format!(
-                        "; links of pair '{name}' at the failing iterate: {} pressed together (gap < 0 or λN > 0), {} sliding, {sticking} sticking, max penetration {:.3e}",
-                        s.pressed, s.sliding, s.max_penetration
-                    )
-                };
+            for clause in contact {
+                text += "; ";
+                text += clause;
             }
             text
         }
         StepFailure::Uzawa { iterations, stats } => format!(
             "Uzawa loop did not converge in {iterations} iterations, the last ones with the penalty raised {}× (max penetration {:.3e} of the element size, max nodal contact force change {:.3e} of max {:.3e})",
-            PENALTY_RAISE.powi(PENALTY_RAISES as i32),
+            ROUND_RAISE.powi(ROUND_RAISES as i32),
             stats.max_penetration, stats.max_change, stats.max_force
         ),
         StepFailure::Uncovered { uzawa, .. } => format!(

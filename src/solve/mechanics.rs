@@ -160,7 +160,7 @@ impl<'a> Mechanics<'a> {
         Ok(())
     }
 
-    /// The box exchange of every links pair's master at `x`, then the tail
+    /// The master exchange of every pair at `x`, then the tail
     /// scatter for the facets now held. Collective.
     pub fn exchange_masters(&mut self, x: &Vector) -> Result<()> {
         let dofs = self.dofs;
@@ -183,7 +183,7 @@ impl<'a> Mechanics<'a> {
         let tail = self.tail.values(offset)?;
         let n = DIM * self.dofs.num_local_nodes();
         for pair in self.contact.iter_mut() {
-            if let Some(rate) = &mut pair.rate {
+            if let Some(rate) = pair.slip_rate_mut() {
                 rate.offset.truncate(n);
                 rate.offset.extend_from_slice(&tail);
             }
@@ -221,7 +221,7 @@ impl<'a> Mechanics<'a> {
     fn bulk_residual(&mut self, x: &Vector, out: &mut Vector, free_rows_only: bool) -> Result<()> {
         let lift_local = self.prepare_shared(x, free_rows_only)?;
         self.load_state(x)?;
-        let (bulk, loads, dofs, factor) = (self.bulk, self.loads, self.dofs, self.factor);
+        let (bulk, loads, factor) = (self.bulk, self.loads, self.factor);
         let linear = match &self.linear_k {
             Some(LinearStiffness::Separate(_)) => true,
             Some(LinearStiffness::Shared(_)) => free_rows_only,
@@ -255,7 +255,7 @@ impl<'a> Mechanics<'a> {
                     fault::check(FaultPhase::ContactAssembly)?;
                     if u_tail.is_empty() {
                         for pair in contact.iter_mut() {
-                            pair.add_residual(dofs, u_local, factor, r_local)?;
+                            pair.add_residual(u_local, factor, r_local)?;
                         }
                         return Ok(());
                     }
@@ -264,7 +264,7 @@ impl<'a> Mechanics<'a> {
                     let u_ext = extended(u_local, u_tail);
                     let mut r_ext = extended(r_local, &r_tail);
                     for pair in contact.iter_mut() {
-                        pair.add_residual(dofs, &u_ext, factor, &mut r_ext)?;
+                        pair.add_residual(&u_ext, factor, &mut r_ext)?;
                     }
                     let n = r_local.len();
                     r_local.copy_from_slice(&r_ext[..n]);
@@ -394,7 +394,7 @@ impl<'a> Mechanics<'a> {
     /// a local failure is returned after the sums.
     fn contact_residual(&mut self, x: &Vector, out: &mut Vector, faults: bool) -> Result<()> {
         self.load_state(x)?;
-        let (dofs, factor) = (self.dofs, self.factor);
+        let factor = self.factor;
         let (u, u_tail, contact) = (&self.u, &self.u_tail, &mut *self.contact);
         let mut r_tail = vec![0.0; u_tail.len()];
         let (stages, times) = (self.stages, &mut self.times);
@@ -408,7 +408,7 @@ impl<'a> Mechanics<'a> {
                     let u_ext = extended(u_local, u_tail);
                     let mut r_ext = extended(r_local, &r_tail);
                     for pair in contact.iter_mut() {
-                        pair.add_residual(dofs, &u_ext, factor, &mut r_ext)?;
+                        pair.add_residual(&u_ext, factor, &mut r_ext)?;
                     }
                     let n = r_local.len();
                     r_local.copy_from_slice(&r_ext[..n]);
@@ -482,7 +482,7 @@ impl<'a> Mechanics<'a> {
                         fault::check(FaultPhase::ContactAssembly)?;
                         let u_ext = extended(u_local, u_tail);
                         for pair in contact.iter_mut() {
-                            pair.add_tangent(dofs, &u_ext, factor, j)?;
+                            pair.add_tangent(&u_ext, factor, j)?;
                         }
                         Ok(())
                     })?
@@ -520,7 +520,7 @@ impl<'a> Mechanics<'a> {
                 fault::check(FaultPhase::ContactAssembly)?;
                 let u_ext = extended(u_local, u_tail);
                 for pair in contact.iter_mut() {
-                    pair.add_tangent(dofs, &u_ext, factor, j)?;
+                    pair.add_tangent(&u_ext, factor, j)?;
                 }
                 Ok(())
             })?
@@ -668,7 +668,7 @@ impl NonlinearProblem for Mechanics<'_> {
         // The same on every rank: the pairs are the scene's, the condensed
         // state is switched collectively.
         let condensed = self.condensed.as_ref().is_some_and(|c| c.is_active());
-        if condensed || !self.state_change_steps || !self.contact.iter().any(|p| p.mortar.is_some())
+        if condensed || !self.state_change_steps || !self.contact.iter().any(|p| p.traits().state_change_steps)
         {
             return Ok(None);
         }

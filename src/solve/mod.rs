@@ -19,7 +19,6 @@ mod master_tail;
 pub mod mechanics;
 pub mod natural;
 pub mod newmark;
-mod penalty;
 pub mod phases;
 mod predictor;
 mod reactions;

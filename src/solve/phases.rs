@@ -166,7 +166,7 @@ impl PhaseMark {
 }
 
 fn multiplier_halo_seconds(pairs: &[ContactPair]) -> f64 {
-    pairs.iter().map(|p| p.multipliers.exchange_seconds).sum()
+    pairs.iter().map(|p| p.multiplier_halo().0).sum()
 }
 
 #[cfg(test)]

@@ -3,11 +3,11 @@
 //! the step line `-v` prints.
 use super::dynamics::DynamicsReport;
 use super::phases::PhaseTimes;
-use crate::contact::pair_state::PairForce;
+use crate::contact::fields::PairOutput;
+use crate::contact::PairForce;
 use crate::contact::{ContactPair, UzawaStats};
 use crate::dofs::DofMap;
 use crate::error::Result;
-use crate::model::Formulation;
 use crate::parallel;
 use crate::petsc::Vector;
 use mpi::traits::*;
@@ -86,7 +86,7 @@ pub struct RunReport {
 /// This rank's contact values of one pair at a converged step, for output.
 pub struct PairFields<'a> {
     pub pair: &'a ContactPair,
-    pub values: crate::contact::pair_state::PointValues,
+    pub output: PairOutput,
 }
 
 /// Receives every converged step (the output file, a progress printer, ...).
@@ -116,8 +116,8 @@ pub(super) fn contact_reports(
         .map(|(i, (p, f))| {
             let total = PairForce::from_array(parallel::sum(world, f.to_array()));
             let s = stats.get(i).copied().unwrap_or_default();
-            let master_held = p.held_master_facets().map(|(held, whole)| {
-                let received = p.received_master_facets().unwrap_or(0) as f64;
+            let master_held = p.held_facets().map(|h| {
+                let (held, whole, received) = (h.held, h.whole, h.received as f64);
                 let [neg_min, max, max_received] =
                     parallel::max(world, [-(held as f64), held as f64, received]);
                 [
@@ -135,12 +135,9 @@ pub(super) fn contact_reports(
                 tangential_force: total.tangential,
                 max_penetration: s.max_penetration,
                 active_points: s.active,
-                active_what: match p.spec.formulation {
-                    Formulation::Links => "points",
-                    Formulation::Mortar => "nodes",
-                },
+                active_what: p.traits().unit,
                 sliding_points: s.sliding,
-                penalty: p.penalty,
+                penalty: p.penalty(),
             }
         })
         .collect()

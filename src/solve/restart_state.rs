@@ -1,7 +1,7 @@
 //! What a run continues from: the state a restart hands the solver. The
 //! reading of a result file into it lives in `crate::restart`, above the
 //! solver, so the solver never depends on the file format.
-use crate::contact::pair_state::RestartRows;
+use crate::contact::fields::RestartRows;
 use crate::contact::ContactPair;
 use crate::dofs::DofMap;
 use crate::error::{Error, Result};

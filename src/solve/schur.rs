@@ -183,10 +183,10 @@ impl PatternSink for Touched {
 
 /// Every DOF the contact pairs' current pattern couples, with the DOFs of
 /// the nodes it names (whole nodes: a node's three DOFs go together).
-pub(super) fn contact_dofs(pairs: &[ContactPair], dofs: &DofMap) -> Result<Vec<PetscInt>> {
+pub(super) fn contact_dofs(pairs: &[ContactPair], _dofs: &DofMap) -> Result<Vec<PetscInt>> {
     let mut t = Touched::default();
     for p in pairs {
-        p.add_pattern(dofs, &mut t)?;
+        p.add_pattern(&mut t)?;
     }
     Ok(whole_nodes(&t.0))
 }

@@ -32,9 +32,9 @@ pub(super) struct TangentKind {
     pub(super) contact: bool,
     /// Some contact pair has friction (a nonsmooth stick/slip switch).
     pub(super) frictional: bool,
-    /// Some contact pair is a mortar pair (its Newton wants accurate
-    /// Krylov solves, see `set_solver_defaults`).
-    pub(super) mortar: bool,
+    /// Some contact pair's Newton wants accurate linear solves
+    /// (`contact::Traits::accurate_linear_solves`).
+    pub(super) accurate_linear_solves: bool,
     /// Nothing is ever added to the linear stiffness (linear bodies, no
     /// contact, inertia or follower load): the Jacobian never changes, so
     /// the preconditioner is set up once.
@@ -48,9 +48,8 @@ pub(super) fn tangent_kind(
     loads: &SurfaceLoads,
     contact: &[ContactPair],
 ) -> TangentKind {
-    // Frictionless links and frictionless mortar pairs on rigid masters
-    // keep the tangent symmetric (it is the Hessian of a potential);
-    // friction, other mortar pairs and follower loads do not.
+    // Each pair's formulation says whether its tangent is symmetric (the
+    // Hessian of a potential); a follower load's is not.
     // A follower load's facets may sit on some ranks only: the choice is
     // agreed, or the ranks would factor one matrix as LU and LDLᵀ at once.
     let unsymmetric = contact.iter().any(|p| !p.tangent_is_symmetric());
@@ -63,7 +62,7 @@ pub(super) fn tangent_kind(
         linear_bulk,
         contact: !contact.is_empty(),
         frictional: contact.iter().any(ContactPair::has_friction),
-        mortar: contact.iter().any(ContactPair::is_mortar),
+        accurate_linear_solves: contact.iter().any(|p| p.traits().accurate_linear_solves),
         constant: linear_bulk && contact.is_empty() && !follower && model.dynamics.is_none(),
     }
 }
@@ -89,7 +88,7 @@ pub(super) fn set_solver_defaults(
         linear_bulk,
         contact,
         frictional,
-        mortar,
+        accurate_linear_solves,
         constant,
     } = tangent;
     petsc::options::clear_defaults()?;
@@ -105,14 +104,9 @@ pub(super) fn set_solver_defaults(
         //
         // Not with friction: its return map switches between stick and
         // slip along a Newton direction, where ‖R‖ has a kink, and l2's
-        // secant step has no decrease test. On the mortar block slide
-        // (scripts/scenes/block-slide-stacked.toml, load 0.35, second Uzawa
-        // iteration) it sampled ‖R‖ = 0.489 / 0.450 at λ = 1 / 0.5 from
-        // 0.249, took λ = 1.07 to 0.498, and from there alternated between
-        // ~0.17–0.27 and ~0.46–0.57 for 30 iterations (a cutback).
-        // Backtracking keeps ‖R‖ decreasing: 4 iterations there, no
-        // cutback (mortar 118 -> 115 Newton over the run, links 160 -> 154;
-        // block-slide unchanged, 60 / 59).
+        // secant step has no decrease test (on a stacked block slide it
+        // alternated between two residual levels until a cutback), while
+        // backtracking keeps ‖R‖ decreasing.
         let search = if frictional { "bt" } else { "l2" };
         petsc::options::set_default("-snes_linesearch_type", search)?;
     }
@@ -160,16 +154,12 @@ pub(super) fn set_solver_defaults(
     // memory (hertz-sphere's largest of 4 ranks 265 MiB against 309, 1 rank
     // 806 against 843).
     petsc::options::set_default("-pc_gamg_agg_nsmooths", "0")?;
-    // A mortar pair's Newton converges in one or two iterations per Uzawa
-    // iteration when its linear solves are accurate, and crawls when they
-    // are loose: GMRES to a fixed 1e-4 instead of Eisenstat–Walker
-    // (hertz-sphere h = 0.35, 2 ranks: 38 -> 7 Newton, 257 -> 116 GMRES;
-    // h = 0.5 14 -> 7, 80 -> 94; h = 0.7 (1 rank) 12 -> 6, 76 -> 84;
-    // hertz-cylinder h = 0.4 on GMRES + GAMG 18 -> 9, 111 -> 122; less
-    // time on all four, as each Newton iteration assembles the mortar
-    // tangent; 1e-5 took 10-14 % more GMRES for the same Newton counts).
-    // The links keep Eisenstat–Walker, which suits them (below).
-    let rtol = if mortar { "1e-4" } else { "1e-10" };
+    // A pair whose Newton converges in one or two iterations per Uzawa
+    // iteration only when its linear solves are accurate gets GMRES to a
+    // fixed 1e-4 instead of Eisenstat–Walker (a loose solve makes its
+    // Newton crawl); the others
+    // keep Eisenstat–Walker, which suits them (below).
+    let rtol = if accurate_linear_solves { "1e-4" } else { "1e-10" };
     petsc::options::set_default("-ksp_rtol", rtol)?;
     if constant && settings.reuse.linear_stiffness {
         // The Jacobian is set once, so GAMG's set-up runs once: free the
@@ -204,7 +194,7 @@ pub(super) fn set_solver_defaults(
         // 31 / 10 / 333 iterations, 451 MiB), so contact keeps PETSc's.
         petsc::options::set_default("-mat_product_clear", "true")?;
     }
-    if contact && !mortar {
+    if contact && !accurate_linear_solves {
         // Eisenstat–Walker: each linear solve only as tight as Newton's
         // progress needs (hertz-sphere h = 0.35, 2 ranks: 977 -> 152 GMRES
         // iterations for 12 -> 31 Newton iterations, 241 s -> 100 s on a
@@ -334,7 +324,7 @@ pub(super) fn build_jacobian(
         loads.add_pattern(&mut pattern)?;
     }
     for pair in contact {
-        pair.add_pattern(dofs, &mut pattern)?;
+        pair.add_pattern(&mut pattern)?;
     }
     let mut jac = pattern.build()?;
     let coords = owned_coordinates(mesh, dofs)?;

@@ -150,7 +150,7 @@ pub(super) fn prepare_time_step(
     for pair in mech.contact.iter_mut().filter(|p| p.has_friction()) {
         let (a, b) = (pair.rigid_shift(from), pair.rigid_shift(to));
         let rigid_velocity = [0, 1, 2].map(|i| (b[i] - a[i]) / dt);
-        pair.rate = Some(stepper.slip_rate(&c, dt, rigid_velocity)?);
+        pair.set_slip_rate(Some(stepper.slip_rate(&c, dt, rigid_velocity)?));
     }
     Ok(c)
 }

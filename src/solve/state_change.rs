@@ -21,7 +21,7 @@
 //! (`Mechanics::state_change_steps`), where friction takes the contact
 //! Schur path, whose condensed Newton has no step end positions and must
 //! match the whole-vector Newton.
-use crate::contact::pair_state::ContactPair;
+use crate::contact::ContactPair;
 
 /// How far past the last node's change a shortened step goes, as a
 /// fraction of the rest of the step: the node must have changed at the

@@ -60,23 +60,6 @@ pub fn inner_acceleration(setting: Option<usize>, krylov: bool) -> usize {
     }
 }
 
-/// Whether the Uzawa rate rule (`penalty::RATE_LIMIT`) may raise a stalled
-/// pair's penalty: on the direct path only. It was made for the graded
-/// line meshes' direct solves, where a stiffer contact block costs a
-/// factorisation; on the Krylov path the raised penalty (×10) meets an AMG
-/// hierarchy built for the elastic bodies, and Newton then crawls in runs
-/// of one-GMRES-iteration steps. Measured without it on the Krylov path
-/// (one run each, `contactlink run SCENE -v`): default hertz-sphere
-/// (167k DOFs) on 1 rank 59 / 6 / 228 Newton / Uzawa / GMRES, 19.2 s ->
-/// 20 / 7 / 211, 15.7 s; on 2 ranks 35 / 9 / 262, 12.8 s -> 20 / 7 / 201,
-/// 9.8 s; h = 0.4 on 2 ranks 50 / 10 / 223 -> 22 / 10 / 171; hertz-cylinder
-/// h = 0.4 on GMRES + GAMG 40 / 7 / 203 -> 15 / 6 / 129; where the rule
-/// did not fire (sphere h = 0.3, 0.35, 0.5, 0.7, the mortar) the same
-/// counts.
-pub fn rate_rule(krylov: bool) -> bool {
-    !krylov
-}
-
 /// On the Krylov path with contact, a Newton iteration's GMRES stops once
 /// its residual is below this fraction of what the Newton solve still has
 /// to remove (`Snes::set_linear_floor`), however tight the Eisenstat–Walker
@@ -213,11 +196,6 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_rate_rule_raises_penalties_on_the_direct_path_only() {
-        assert!(rate_rule(false));
-        assert!(!rate_rule(true));
-    }
 
     #[test]
     fn a_loose_pass_is_confirmed_before_the_step_ends() {

@@ -1,18 +1,16 @@
 //! The Uzawa loop of one load step (docs/formulation.md §6.2): Newton with
-//! the multipliers λ fixed, then λ ← ⟨λ − εN gN⟩ at every link, until every
+//! the multipliers λ fixed, then every pair's multiplier update, until every
 //! pair's penetration and multiplier change are within its tolerances on
-//! every rank. A frictionless pair whose multiplier change stalls far above
-//! its tolerance has its penalty raised once (the rate rule,
-//! `penalty::RATE_LIMIT`); a pair still unconverged after `max_uzawa` has
-//! it raised (at most `PENALTY_RAISES` times a step) before the step counts
-//! as failed.
+//! every rank. Where the loop is slow the pairs' penalties are raised, and
+//! a step's first contact may be solved with a softer one, as the penalty
+//! policy decides (`contact::penalty`).
 use super::anderson::Anderson;
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
-use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
 use super::schur;
 use super::tolerance;
+use crate::contact::penalty::{PairProgress, StepPenalties, RATE_RAISE, ROUND_RAISE};
 use crate::contact::{ContactPair, UzawaStats};
 use crate::error::Result;
 use crate::parallel::{self, fault, fault::FaultPhase};
@@ -40,16 +38,16 @@ pub(super) struct StepContext<'s> {
     /// 0: none).
     pub(super) linear_floor: f64,
     /// Penalty divisor of a contact-free step's first Uzawa iteration
-    /// (1: off; see `soften_first_contact`).
+    /// (1: off; see `StepPenalties::soften`).
     pub(super) softening: f64,
     /// Whether a contact-free step's first Uzawa iteration assembles the
-    /// links' main-part tangent (see `main_part_tangent`).
+    /// pairs' main-part tangent (see `main_part_tangent`).
     pub(super) main_part_tangent: bool,
     /// Anderson depth of the frictionless pairs' multiplier updates (0:
     /// off; see `anderson`).
     pub(super) acceleration: usize,
-    /// Whether the rate rule may raise a stalled pair's penalty
-    /// (`penalty::RATE_LIMIT`; `tolerance::rate_rule`).
+    /// Whether the penalty policy's rate rule applies
+    /// (`contact::penalty::rate_rule`).
     pub(super) rate_rule: bool,
 }
 
@@ -77,9 +75,13 @@ pub(super) fn uzawa_loop(
         ctx.forcing
     };
     let inner = tolerance::InnerTolerance::new(tight, forcing);
+    let mut penalties = StepPenalties::new(mech.contact.len(), ctx.rate_rule);
     let softening = ctx.softening;
-    let mut softened =
-        softening > 1.0 && !frictional && soften_first_contact(world, mech.contact, softening);
+    let no_contact =
+        softening > 1.0 && !frictional && no_multiplier_in_contact(world, mech.contact);
+    if let Some(f) = penalties.soften(softening, frictional, no_contact) {
+        raise_all(mech.contact, f);
+    }
     let mut main_part =
         ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
     // The condensed Newton iterates are the whole vector's only with no
@@ -95,7 +97,7 @@ pub(super) fn uzawa_loop(
         factor,
         &inner,
         (stol, max_it, condensed),
-        (&mut softened, &mut main_part),
+        (&mut penalties, &mut main_part),
     );
     if schur::condenses(ctx.snes) {
         // The converged step's interior, formed once (a failed one is
@@ -121,7 +123,7 @@ pub(super) fn uzawa_loop(
             }
         }
     }
-    restore_penalties(mech, &mut softened, softening);
+    unsoften(mech, &mut penalties);
     if main_part {
         main_part_tangent(world, mech.contact, false);
     }
@@ -147,9 +149,35 @@ pub(super) fn chain((first, uzawa): (SnesOutcome, usize), second: &mut StepResul
     *more += uzawa;
 }
 
+/// The Newton solves of a step's Uzawa iterations, added up.
+#[derive(Default)]
+struct Tally {
+    newton: usize,
+    linear: usize,
+    history: Vec<f64>,
+    /// Uzawa iterations over every round.
+    uzawa: usize,
+}
+
+impl Tally {
+    fn add(&mut self, o: &SnesOutcome) {
+        self.newton += o.iterations;
+        self.linear += o.linear_iterations;
+        self.history.extend_from_slice(&o.history);
+    }
+
+    /// The last solve's outcome with the counts and history of all.
+    fn outcome(&self, mut last: SnesOutcome) -> SnesOutcome {
+        last.iterations = self.newton;
+        last.linear_iterations = self.linear;
+        last.history = self.history.clone();
+        last
+    }
+}
+
 /// The Uzawa iterations of one step, in rounds of at most `max_uzawa`; a
 /// round that ends unconverged raises the slow pairs' penalties and starts
-/// the next, up to `PENALTY_RAISES` times.
+/// the next, as long as the penalty policy allows.
 fn uzawa_rounds(
     world: &impl Communicator,
     ctx: &mut StepContext,
@@ -157,65 +185,30 @@ fn uzawa_rounds(
     factor: f64,
     inner: &tolerance::InnerTolerance,
     (stol, max_it, condensed): (f64, usize, bool),
-    (softened, main_part): (&mut bool, &mut bool),
+    (penalties, main_part): (&mut StepPenalties, &mut bool),
 ) -> Result<StepResult> {
-    let softening = ctx.softening;
-    let linear_floor = ctx.linear_floor;
-    let rate_rule = ctx.rate_rule;
-    let mut accel = Anderson::new(ctx.acceleration);
-    let StepContext {
-        snes,
-        x,
-        r,
-        jac,
-        stages,
-        times,
-        reuse_preconditioner,
-        ..
-    } = ctx;
-    let reuse_preconditioner = *reuse_preconditioner;
     let max_uzawa = max_uzawa(mech.contact);
-    let mut newton = 0usize;
-    let mut linear = 0usize;
-    let mut history = Vec::new();
-    let mut k = 0;
-    let mut raises = 0;
-    // Uzawa iterations over every round (k counts within one).
-    let mut total = 0;
+    let mut accel = Anderson::new(ctx.acceleration);
+    let mut tally = Tally::default();
+    // Uzawa iterations in this round.
+    let mut round = 0;
     let mut solve_tight = !inner.is_inexact();
-    let mut progress = vec![Progress::default(); mech.contact.len()];
-    let mut rate_raises = 0;
     // A raised penalty changes the tangent: the next solve refactors.
     let mut refactor = false;
     loop {
-        k += 1;
-        total += 1;
-        let tol = inner.for_solve(solve_tight);
-        snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
-        if linear_floor > 0.0 {
-            let contact = !mech.contact.is_empty();
-            snes.set_linear_floor(if contact { linear_floor } else { 0.0 })?;
-        }
+        round += 1;
+        tally.uzawa += 1;
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
-        snes.set_lag_preconditioner(
-            if k == 1
-                || std::mem::take(&mut refactor)
-                || mech.contact.is_empty()
-                || !reuse_preconditioner
-            {
-                1
-            } else {
-                -1
-            },
-        )?;
-        let mark = PhaseMark::new(&mech.times, mech.contact);
-        let mut outcome = stages.scope(Phase::LinearSolve, || snes.solve(mech, x, r, jac))?;
-        mark.book(Phase::LinearSolve, times, &mech.times, mech.contact);
-        newton += outcome.iterations;
-        linear += outcome.linear_iterations;
-        history.extend_from_slice(&outcome.history);
+        let fresh = round == 1
+            || std::mem::take(&mut refactor)
+            || mech.contact.is_empty()
+            || !ctx.reuse_preconditioner;
+        let tol = inner.for_solve(solve_tight);
+        let outcome = newton(ctx, mech, (tol, stol, max_it), fresh)?;
+        tally.add(&outcome);
         if !outcome.converged {
+            let (x, jac) = (&*ctx.x, &*ctx.jac);
             return Ok(Err(newton_failure(world, mech, x, jac, factor, outcome)?));
         }
         if mech.contact.is_empty() {
@@ -224,46 +217,44 @@ fn uzawa_rounds(
         let before = accel.is_on().then(|| normal_multipliers(mech.contact));
         // A condensed iterate's off-contact DOFs are not the state yet: the
         // caller checks its candidates once the step has expanded it.
-        let (stats, covered) =
-            update_multipliers(world, stages, times, mech, x, (factor, !condensed))?;
+        let (stats, covered) = update_multipliers(
+            world,
+            (ctx.stages, &mut *ctx.times),
+            mech,
+            ctx.x,
+            (factor, !condensed),
+        )?;
         if !covered {
             // No more Uzawa work on a set of segments that misses part of
             // the contact: the caller searches from here and goes on.
-            outcome.iterations = newton;
-            outcome.linear_iterations = linear;
-            outcome.history = history;
             return Ok(Err(StepFailure::Uncovered {
-                outcome,
-                uzawa: total,
+                outcome: tally.outcome(outcome),
+                uzawa: tally.uzawa,
             }));
         }
         if std::mem::take(main_part) {
             // The multipliers carry the contact from here: the full tangent.
             main_part_tangent(world, mech.contact, false);
         }
-        if *softened {
+        if penalties.is_softened() {
             // The soft iteration has given the multipliers a first
             // estimate: from here on the pairs' own penalties, and fresh
             // factors (the soft tangent no longer fits); the Uzawa rounds
             // count from here.
-            restore_penalties(mech, softened, softening);
-            k = 0;
-            progress.iter_mut().for_each(Progress::forget);
+            unsoften(mech, penalties);
+            round = 0;
             accel.forget();
         }
-        let pair_ok: Vec<bool> = mech
+        let progress: Vec<PairProgress> = mech
             .contact
             .iter()
             .zip(&stats)
-            .map(|(p, s)| pair_converged(p, s))
+            .map(|(p, s)| p.progress(s))
             .collect();
-        let converged = pair_ok.iter().all(|c| *c);
-        match tolerance::round_end(converged, solve_tight) {
+        let converged: Vec<bool> = progress.iter().map(|p| p.converged).collect();
+        match tolerance::round_end(converged.iter().all(|c| *c), solve_tight) {
             tolerance::RoundEnd::Converged => {
-                outcome.iterations = newton;
-                outcome.linear_iterations = linear;
-                outcome.history = history;
-                return Ok(Ok((outcome, total, stats)));
+                return Ok(Ok((tally.outcome(outcome), tally.uzawa, stats)));
             }
             tolerance::RoundEnd::Confirm => {
                 solve_tight = true;
@@ -277,66 +268,92 @@ fn uzawa_rounds(
                 }
             }
         }
-        if rate_rule
-            && rate_raises < RATE_RAISES
-            && raise_stalled_penalties(mech.contact, &stats, &pair_ok, &mut progress)
-        {
-            rate_raises += 1;
+        let stalled = penalties.stalled(&progress);
+        if stalled.iter().any(|r| *r) {
+            raise(mech.contact, &stalled, RATE_RAISE);
             refactor = true;
             accel.forget();
             if let Some(lag) = mech.lag.as_mut() {
                 lag.reset();
             }
         }
-        if k >= max_uzawa && raises < PENALTY_RAISES {
-            // Converging too slowly (soft bodies, long sliding): the
-            // augmented Lagrangian keeps its solution for any penalty and
-            // converges faster with a larger one, so raise it for the pairs
-            // still outside their tolerances and give Uzawa another round.
-            raises += 1;
-            raise_slow_penalties(mech.contact, &stats);
-            progress.iter_mut().for_each(Progress::forget);
+        if round >= max_uzawa {
+            // Converging too slowly (soft bodies, long sliding): a larger
+            // penalty for the pairs still outside their tolerances and
+            // another round, or the step fails.
+            let Some(slow) = penalties.round_end(&converged) else {
+                return Ok(Err(StepFailure::Uzawa {
+                    iterations: tally.uzawa,
+                    stats: worst(&stats),
+                }));
+            };
+            raise(mech.contact, &slow, ROUND_RAISE);
             accel.forget();
-            k = 0;
-            continue;
-        }
-        if k >= max_uzawa {
-            return Ok(Err(StepFailure::Uzawa {
-                iterations: total,
-                stats: worst(&stats),
-            }));
+            round = 0;
         }
     }
 }
 
-/// Collective: divides every pair's penalty by `softening` when no pair has
-/// a multiplier in contact on any rank; whether it did (`[solver]
-/// first_contact_softening`, off by default).
-///
-/// With λN = 0 the whole load goes through the penalty at once, and with
-/// the full penalty (10 E / h) on a fine graded mesh Newton crawls while
-/// the contact zone settles: the edge points flip open and closed between
-/// iterations (graded Hertz line, h_c = b/40: 18 Newton iterations in the
-/// first Uzawa iteration, 1–2 in each later one). A softer penalty makes
-/// that first solve smoother; its multiplier update is a first estimate of
-/// the pressure, and the later iterations, at the full penalty, converge
-/// to the same solution (it does not depend on the penalty, only the speed
-/// does). Measured at 10: Newton b/40 25 → 16, b/20 15 → 11, hertz-cylinder
-/// 12 → 11, but b/10 12 → 16, so it is not the default.
-fn soften_first_contact(
-    world: &impl Communicator,
-    pairs: &mut [ContactPair],
-    softening: f64,
-) -> bool {
+/// One Newton solve of the Uzawa loop at the tolerance `tol` (`fresh`:
+/// with a new preconditioner), booked as the linear-solve phase.
+fn newton(
+    ctx: &mut StepContext,
+    mech: &mut Mechanics,
+    (tol, stol, max_it): (tolerance::NewtonTolerance, f64, usize),
+    fresh: bool,
+) -> Result<SnesOutcome> {
+    let StepContext {
+        snes,
+        x,
+        r,
+        jac,
+        stages,
+        times,
+        linear_floor,
+        ..
+    } = ctx;
+    snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
+    if *linear_floor > 0.0 {
+        let contact = !mech.contact.is_empty();
+        snes.set_linear_floor(if contact { *linear_floor } else { 0.0 })?;
+    }
+    snes.set_lag_preconditioner(if fresh { 1 } else { -1 })?;
+    let mark = PhaseMark::new(&mech.times, mech.contact);
+    let outcome = stages.scope(Phase::LinearSolve, || snes.solve(mech, x, r, jac))?;
+    mark.book(Phase::LinearSolve, times, &mech.times, mech.contact);
+    Ok(outcome)
+}
+
+/// Multiplies the penalty of every pair `which` marks by `factor`.
+fn raise(pairs: &mut [ContactPair], which: &[bool], factor: f64) {
+    for (p, _) in pairs.iter_mut().zip(which).filter(|(_, r)| **r) {
+        p.raise_penalty(factor);
+    }
+}
+
+/// Multiplies every pair's penalty by `factor`.
+fn raise_all(pairs: &mut [ContactPair], factor: f64) {
+    for p in pairs.iter_mut() {
+        p.raise_penalty(factor);
+    }
+}
+
+/// Collective: whether no pair has a multiplier in contact on any rank.
+fn no_multiplier_in_contact(world: &impl Communicator, pairs: &[ContactPair]) -> bool {
     let local: usize = pairs.iter().map(|p| p.multiplier_states().0).sum();
     let [active] = parallel::sum_usize(world, [local]);
-    let soften = !pairs.is_empty() && active == 0;
-    if soften {
-        for p in pairs.iter_mut() {
-            p.raise_penalty(1.0 / softening);
+    !pairs.is_empty() && active == 0
+}
+
+/// Ends a softened first iteration (once): every pair's own penalty back,
+/// and the preconditioner built for the soft tangent forgotten.
+fn unsoften(mech: &mut Mechanics, penalties: &mut StepPenalties) {
+    if let Some(f) = penalties.unsoften() {
+        raise_all(mech.contact, f);
+        if let Some(lag) = mech.lag.as_mut() {
+            lag.reset();
         }
     }
-    soften
 }
 
 /// Collective: with `on`, switches every pair to the main-part tangent
@@ -374,20 +391,6 @@ fn main_part_tangent(world: &impl Communicator, pairs: &mut [ContactPair], on: b
     switch && on
 }
 
-/// Undoes `soften_first_contact` (once) and forgets the preconditioner
-/// built for the soft tangent.
-fn restore_penalties(mech: &mut Mechanics, softened: &mut bool, softening: f64) {
-    if !std::mem::take(softened) {
-        return;
-    }
-    for p in mech.contact.iter_mut() {
-        p.raise_penalty(softening);
-    }
-    if let Some(lag) = mech.lag.as_mut() {
-        lag.reset();
-    }
-}
-
 /// Uzawa iterations in one round: the largest any pair allows (at least one).
 fn max_uzawa(pairs: &[ContactPair]) -> usize {
     pairs
@@ -404,8 +407,7 @@ fn max_uzawa(pairs: &[ContactPair]) -> usize {
 /// on every rank (`ContactPair::covers`; true without it).
 fn update_multipliers(
     world: &impl Communicator,
-    stages: &Stages,
-    times: &mut PhaseTimes,
+    (stages, times): (&Stages, &mut PhaseTimes),
     mech: &mut Mechanics,
     x: &Vector,
     (factor, check_cover): (f64, bool),
@@ -479,43 +481,6 @@ fn accelerate(
     Ok(())
 }
 
-/// The penalty policy: raise the penalty of every pair still outside its
-/// tolerances (the raised penalty stays for the run).
-fn raise_slow_penalties(pairs: &mut [ContactPair], stats: &[UzawaStats]) {
-    for (p, s) in pairs.iter_mut().zip(stats) {
-        if !pair_converged(p, s) {
-            p.raise_penalty(PENALTY_RAISE);
-        }
-    }
-}
-
-/// The rate rule (`penalty::RATE_LIMIT`): raises the penalty of every
-/// frictionless pair whose multiplier change contracted too slowly in this
-/// Uzawa iteration, and says whether any was raised. The figures are
-/// reduced over the ranks, so every rank decides alike. Friction keeps its
-/// penalty: its stick/slip classification, not the rate, sets its pace.
-fn raise_stalled_penalties(
-    pairs: &mut [ContactPair],
-    stats: &[UzawaStats],
-    converged: &[bool],
-    progress: &mut [Progress],
-) -> bool {
-    let mut raised = false;
-    for ((p, s), (ok, pr)) in pairs
-        .iter_mut()
-        .zip(stats)
-        .zip(converged.iter().zip(progress.iter_mut()))
-    {
-        let relative = s.max_change / s.max_force.max(p.force_floor());
-        if pr.stalls(relative, p.spec.multiplier_tol, *ok) && !p.has_friction() {
-            p.raise_penalty(RATE_RAISE);
-            pr.forget();
-            raised = true;
-        }
-    }
-    raised
-}
-
 /// The figures a failed Uzawa loop reports: maxima and counts over the pairs.
 fn worst(stats: &[UzawaStats]) -> UzawaStats {
     stats
@@ -529,13 +494,6 @@ fn worst(stats: &[UzawaStats]) -> UzawaStats {
             active: a.active + s.active,
             sliding: a.sliding + s.sliding,
         })
-}
-
-/// The Uzawa test of one pair: penetration and multiplier change within the
-/// pair's tolerances.
-fn pair_converged(p: &ContactPair, s: &UzawaStats) -> bool {
-    s.max_penetration <= p.spec.penetration_tol
-        && s.max_change <= p.spec.multiplier_tol * s.max_force.max(p.force_floor())
 }
 
 /// Collective: each pair's Uzawa figures over all ranks.

@@ -30,6 +30,7 @@
 mod bilinear;
 pub mod coverage;
 mod facet_search;
+mod formulation;
 pub mod friction;
 pub mod geometry;
 mod halo;
@@ -37,7 +38,7 @@ mod holding;
 mod main_part;
 pub mod pair;
 mod pair_output;
-pub mod pair_restart;
+mod pair_restart;
 mod pair_setup;
 pub mod rigid;
 pub mod rigid_friction;
@@ -47,6 +48,8 @@ mod rows;
 pub mod segment;
 pub mod system;
 mod tangential;
+
+pub use pair::MortarPair;
 
 #[cfg(test)]
 mod friction_tests;

@@ -18,32 +18,13 @@ use super::system::{self, Interface, NodalData, NodeState, Segment};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::autodiff::Dual;
+use crate::contact::held_master::HeldMaster;
+use crate::contact::surfaces::SlaveSurface;
 use crate::contact::outcome::UzawaStats;
-use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use crate::fem::{FacetType, MAX_FACET_NODES};
 use crate::model::RigidSurface;
-
-/// The nodal fields the output writes, one entry per owned mesh node of
-/// this rank (zero at nodes off the slave surface).
-#[derive(Debug, Clone, Default)]
-pub struct NodeFields {
-    /// The multipliers λ_j (contact pressure).
-    pub lambda: Vec<f64>,
-    /// Weighted gaps g̃_j = ∫ Φ_j g dA.
-    pub weighted_gap: Vec<f64>,
-    /// The slave area each node carries, A_j = ∫ N_j dA (reference): Σ
-    /// over the active nodes is the contact area.
-    pub area: Vec<f64>,
-    /// Contact traction on the slave at the node: −λ_j ν_j − λT_j, ν_j the
-    /// D-weighted mean of its segments' normals (λT_j = 0 frictionless).
-    pub traction: Vec<[f64; 3]>,
-    /// A frictional pair's history a restart reads back (None frictionless):
-    /// the nodal λT_j, and where the next step measures slip from (every
-    /// pair node's position at the end of the step, master nodes included).
-    pub lambda_t: Option<Vec<[f64; 3]>>,
-    pub slip_origin: Option<Vec<[f64; 3]>>,
-}
 
 /// What a cut-back step restores: λ_j and λT_j of the last converged step.
 #[derive(Debug, Clone)]
@@ -65,6 +46,15 @@ pub(super) struct Evaluation {
 }
 
 pub struct MortarPair {
+    pub(super) name: String,
+    /// This rank's slave facets and points: the output's point rows.
+    pub(super) slave: SlaveSurface,
+    /// A deformable master's facets this rank holds (None: rigid master).
+    pub(super) held: Option<Box<HeldMaster>>,
+    /// See `Formulation::tangent_signature`.
+    pub(super) tangent_signature: u64,
+    /// See `Formulation::set_main_part_tangent`.
+    pub(super) main_part_tangent: bool,
     pub(super) facet_type: FacetType,
     /// Slave nodes are ids `0..n_slave`, held master nodes follow.
     pub(super) n_slave: usize,
@@ -175,7 +165,7 @@ impl MortarPair {
     /// alone the graded Hertz line at h_c = b/40 (one cell thick, so its
     /// facets' shortest edge is the thickness) found the outer third of its
     /// contact zone only after Uzawa had converged, and solved again.
-    pub fn search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
+    pub(super) fn search_candidates(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
         if self.rigid.is_some() {
             return self.rigid_search(u_local, factor, motion);
         }
@@ -209,7 +199,7 @@ impl MortarPair {
     /// of a Hertz contact whose zone grows past that margin) leaves facets
     /// without segments, unconstrained, and only a search from the solved
     /// state finds them.
-    pub fn covers(&self, u_local: &[f64], factor: f64) -> bool {
+    pub(super) fn candidates_cover(&self, u_local: &[f64], factor: f64) -> bool {
         if self.rigid.is_some() {
             return self.rigid_covers(u_local, factor);
         }
@@ -224,7 +214,7 @@ impl MortarPair {
     /// contact Schur complement keeps its factor of the bulk stiffness (a
     /// contact zone that grows past the candidates' margin within one step
     /// costs a second search, not a second factorisation).
-    pub fn reserve_dofs(&self) -> Vec<GlobalDof> {
+    pub(super) fn reserved_dofs(&self) -> Vec<GlobalDof> {
         self.reserve
             .iter()
             .flat_map(|&n| self.node_dofs[n as usize])
@@ -235,15 +225,15 @@ impl MortarPair {
         DIM * self.node_local[id as usize] as usize + c
     }
 
-    pub(super) fn global_dof(&self, _dofs: &DofMap, id: u32, c: usize) -> GlobalDof {
+    pub(super) fn global_dof(&self, id: u32, c: usize) -> GlobalDof {
         self.node_dofs[id as usize][c]
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
     /// (all nodes of its candidate segments), squared into the pattern.
-    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
+    pub(super) fn pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
         if self.rigid.is_some() {
-            return self.rigid_pattern(dofs, pattern);
+            return self.rigid_pattern(pattern);
         }
         let nf = self.facet_type.nodes();
         let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
@@ -267,7 +257,7 @@ impl MortarPair {
             nodes.dedup();
             d.clear();
             for n in nodes {
-                d.extend((0..DIM).map(|c| self.global_dof(dofs, n, c)));
+                d.extend((0..DIM).map(|c| self.global_dof(n, c)));
             }
             pattern.add_square(&d)?;
         }
@@ -317,7 +307,7 @@ impl MortarPair {
         }
     }
 
-    pub fn add_residual(
+    pub(super) fn residual(
         &self,
         u_local: &[f64],
         rate: Option<&Rate>,
@@ -345,26 +335,25 @@ impl MortarPair {
     /// solver may keep the preconditioner of an earlier one). With
     /// `main_part` a frictionless pair adds only the main part (see
     /// `main_part`).
-    pub fn add_tangent(
+    pub(super) fn tangent(
         &self,
-        dofs: &DofMap,
         u_local: &[f64],
         rate: Option<&Rate>,
         (factor, main_part): (f64, bool),
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
         if self.rigid.is_some() {
-            return self.rigid_tangent(dofs, u_local, rate, factor, k);
+            return self.rigid_tangent(u_local, rate, factor, k);
         }
         let x = self.positions(u_local);
         if main_part && self.friction.is_none() {
-            return self.add_main_part(dofs, &x, u_local, k);
+            return self.add_main_part(&x, u_local, k);
         }
         let e = self.evaluate(&x, u_local, rate);
         let interface = self.interface(&x);
         let mut rows = Rows::new(self.node_local.len());
         self.stream_tangent(&interface, &e, &x, u_local, rate, &mut rows);
-        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
+        rows.add_to(|id, c| self.global_dof(id, c), k)?;
         Ok(signature(
             &e.segments,
             &e.states,
@@ -447,7 +436,6 @@ impl MortarPair {
 
     fn add_main_part(
         &self,
-        dofs: &DofMap,
         x: &[[f64; 3]],
         u_local: &[f64],
         k: &mut dyn MatrixSink,
@@ -457,7 +445,7 @@ impl MortarPair {
         let mut rows = Rows::new(self.node_local.len());
         let add = |r, c, v| rows.add(r, c, v);
         super::main_part::tangent(&interface, &self.nodal, &e.segments, &e.states, add);
-        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
+        rows.add_to(|id, c| self.global_dof(id, c), k)?;
         Ok(signature(
             &e.segments,
             &e.states,
@@ -471,7 +459,7 @@ impl MortarPair {
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
     /// weighted gap is complete on this rank; statistics over the nodes this
     /// rank owns.
-    pub fn uzawa_update(
+    pub(super) fn update(
         &mut self,
         u_local: &[f64],
         rate: Option<&Rate>,
@@ -519,7 +507,7 @@ impl MortarPair {
     /// The nodes' states at `u_local` as the Uzawa update would find
     /// them, nothing changed: its statistics without the multiplier
     /// changes (a failed Newton solve's report).
-    pub fn census(&self, u_local: &[f64], rate: Option<&Rate>, factor: f64) -> UzawaStats {
+    pub(super) fn node_census(&self, u_local: &[f64], rate: Option<&Rate>, factor: f64) -> UzawaStats {
         let x = self.positions(u_local);
         let (states, frictions) = self.trial(&x, u_local, rate, factor);
         self.census_of(&states, &frictions)
@@ -530,7 +518,7 @@ impl MortarPair {
     /// pressure `λ_j − ε_j g̃_j / A_j` crossing zero: the largest fraction
     /// of the way from `u0` to `u1` at which one of them changes state
     /// (the trial pressure interpolated linearly); None if none changes.
-    pub fn state_change_fraction(
+    pub(super) fn change_fraction(
         &self,
         u0: &[f64],
         u1: &[f64],
@@ -600,7 +588,7 @@ impl MortarPair {
 
     /// λ of the nodes this rank updates (complete here; the others are
     /// kept at 0 by the setter) and whether this rank owns them.
-    pub fn normal_multipliers(&self) -> (Vec<f64>, Vec<bool>) {
+    pub(super) fn nodal_multipliers(&self) -> (Vec<f64>, Vec<bool>) {
         let counted = self
             .complete
             .iter()
@@ -611,7 +599,7 @@ impl MortarPair {
     }
 
     /// Sets λ at the nodes this rank updates (the others keep theirs).
-    pub fn set_normal_multipliers(&mut self, lambda: &[f64]) {
+    pub(super) fn set_nodal_multipliers(&mut self, lambda: &[f64]) {
         for (j, l) in lambda.iter().enumerate().take(self.complete.len()) {
             if self.complete[j] {
                 self.nodal.lambda[j] = *l;
@@ -620,7 +608,7 @@ impl MortarPair {
     }
 
     /// A converged step is final: the next one measures slip from here.
-    pub fn commit(&mut self) {
+    pub(super) fn commit_step(&mut self) {
         self.pending_origins = None;
         if let Some(f) = &mut self.friction {
             f.start.clone_from(&f.last);
@@ -630,14 +618,14 @@ impl MortarPair {
         }
     }
 
-    pub fn snapshot(&self) -> MortarSnapshot {
+    pub(super) fn take_snapshot(&self) -> MortarSnapshot {
         MortarSnapshot {
             lambda: self.nodal.lambda.clone(),
             lambda_t: self.friction.as_ref().map(|f| f.nodal.lambda.clone()),
         }
     }
 
-    pub fn restore(&mut self, snap: MortarSnapshot) {
+    pub(super) fn restore_snapshot(&mut self, snap: MortarSnapshot) {
         if snap.lambda.len() == self.nodal.lambda.len() {
             self.nodal.lambda = snap.lambda;
         }

@@ -2,8 +2,9 @@
 //! slave nodes, the pair's force, and point values interpolated from the
 //! nodes.
 use super::friction::Rate;
-use super::pair::{Evaluation, MortarPair, NodeFields};
+use super::pair::{Evaluation, MortarPair};
 use super::system::NodeState;
+use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;
 use crate::fem::shape::facet_shape;
 
@@ -14,7 +15,7 @@ pub(super) type OutputRows = Vec<(usize, f64, [f64; 3])>;
 
 impl MortarPair {
     /// Owned slave nodes: reference position and λ_j.
-    pub fn node_values(&self) -> Vec<([f64; 3], f64)> {
+    fn node_values(&self) -> Vec<([f64; 3], f64)> {
         (0..self.owned.len())
             .filter(|&j| self.owned[j])
             .map(|j| {
@@ -26,16 +27,52 @@ impl MortarPair {
             .collect()
     }
 
-    /// Nodal output of the owned nodes and this rank's part of the pair's
+    /// The pair's fields: per slave point its position, the pressure
+    /// interpolated from the nodes with the standard shape functions
+    /// (Σ N_a λ_a, the smooth nodal traction; the mortar field Σ Φ_a λ_a
+    /// itself oscillates inside a facet) and its area weight; per owned
+    /// mesh node λ_j, the weighted gap, the nodal area, the traction and,
+    /// with friction, the stick/slip state, the step's slip and the history
+    /// a restart reads; and this rank's part of the force.
+    pub(super) fn fields(&self, u_local: &[f64], rate: Option<&Rate>, factor: f64) -> PairOutput {
+        let slave = &self.slave;
+        let lambda = self.lambda_by_local_node();
+        let nq = slave.num_qps();
+        let mut pressure = vec![0.0; nq];
+        for (q, p) in pressure.iter_mut().enumerate() {
+            let facet = &slave.facets[q / slave.nqp];
+            let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
+            *p = facet
+                .nodes
+                .iter()
+                .zip(s.n)
+                .map(|(n, na)| na * lambda.get(&n.to_u32()).copied().unwrap_or(0.0))
+                .sum();
+        }
+        let points: Vec<[f64; 3]> = (0..nq).map(|q| slave.qp_position(q, u_local)).collect();
+        let (node_fields, force) = self.node_fields(u_local, rate, factor);
+        PairOutput {
+            point_fields: vec![
+                Field::vector(fields::PAIR_POINTS, &points),
+                Field::scalar(fields::PAIR_PRESSURE, pressure),
+                Field::scalar(fields::PAIR_WEIGHT, slave.qp_weight.clone()),
+            ],
+            node_fields,
+            force,
+            nodes: self.node_values(),
+        }
+    }
+
+    /// Nodal fields of the owned nodes and this rank's part of the pair's
     /// force on the slave: `Σ_j λ_j D_jk ν` summed over `k` (`D` of the
     /// current segments), or `Σ_j λ_j c_jk` against a rigid master, so the
     /// force is the one the residual applied.
-    pub fn output(
+    fn node_fields(
         &self,
         u_local: &[f64],
         rate: Option<&Rate>,
         factor: f64,
-    ) -> (NodeFields, PairForce) {
+    ) -> (Vec<Field>, PairForce) {
         let x = self.positions(u_local);
         // Per assembled facet row: (slot, Σ_k D_jk, its force direction Σ_k D_jk ν).
         let (states, rows): (Vec<NodeState>, OutputRows) = match &self.rigid {
@@ -78,49 +115,64 @@ impl MortarPair {
             force.tangential += crate::contact::autodiff::norm(t) * d;
         }
         let n = self.owned_mesh_nodes;
-        let mut out = NodeFields {
-            lambda: vec![0.0; n],
-            weighted_gap: vec![0.0; n],
-            area: vec![0.0; n],
-            traction: vec![[0.0; 3]; n],
-            lambda_t: self.friction.as_ref().map(|_| vec![[0.0; 3]; n]),
-            // Every owned node of either surface (held here or not): where
-            // it was at the last Uzawa update, the state written.
-            slip_origin: self.friction.as_ref().map(|_| {
-                let mut origin = vec![[0.0; 3]; n];
-                for &(l, x) in &self.owned_pair_nodes {
-                    if let Some(o) = origin.get_mut(l as usize) {
-                        let u = crate::dofs::LocalNode::from_u32(l).value(u_local);
-                        *o = [x[0] + u[0], x[1] + u[1], x[2] + u[2]];
-                    }
-                }
-                origin
-            }),
-        };
+        let friction = self.friction.as_ref();
+        let (mut lambda, mut weighted_gap, mut area) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut traction = vec![[0.0; 3]; n];
+        let (mut state, mut slip, mut lambda_tf) =
+            (vec![0.0; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
         for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
             let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
             if l >= n {
                 continue;
             }
-            out.lambda[l] = self.nodal.lambda[j];
-            out.weighted_gap[l] = states[j].weighted_gap;
-            out.area[l] = self.nodal.area[j];
-            if let Some(lt) = &mut out.lambda_t {
-                lt[l] = *lambda_t(j);
+            lambda[l] = self.nodal.lambda[j];
+            weighted_gap[l] = states[j].weighted_gap;
+            area[l] = self.nodal.area[j];
+            if let Some(f) = friction {
+                lambda_tf[l] = f.nodal.lambda[j];
+                slip[l] = f.slip[j];
+                state[l] = match (self.nodal.lambda[j] > 0.0, f.sliding[j]) {
+                    (false, _) => fields::OPEN,
+                    (true, false) => fields::STICK,
+                    (true, true) => fields::SLIP,
+                };
             }
             let len = crate::contact::autodiff::norm(&normal_sum[j]);
             if len > 0.0 {
                 let t = lambda_t(j);
-                out.traction[l] =
+                traction[l] =
                     [0, 1, 2].map(|i| -self.nodal.lambda[j] * normal_sum[j][i] / len - t[i]);
             }
+        }
+        let mut out = vec![
+            Field::scalar(fields::PAIR_NODE_LAMBDA, lambda),
+            Field::scalar(fields::PAIR_NODE_WEIGHTED_GAP, weighted_gap),
+            Field::scalar(fields::PAIR_NODE_AREA, area),
+            Field::vector(fields::PAIR_NODE_TRACTION, &traction),
+        ];
+        if friction.is_some() {
+            // Every owned node of either surface (held here or not): where
+            // it was at the last Uzawa update, the state written.
+            let mut origin = vec![[0.0; 3]; n];
+            for &(l, x) in &self.owned_pair_nodes {
+                if let Some(o) = origin.get_mut(l as usize) {
+                    let u = crate::dofs::LocalNode::from_u32(l).value(u_local);
+                    *o = [x[0] + u[0], x[1] + u[1], x[2] + u[2]];
+                }
+            }
+            out.extend([
+                Field::scalar(fields::PAIR_NODE_STATE, state),
+                Field::vector(fields::PAIR_NODE_SLIP, &slip),
+                Field::vector(fields::PAIR_NODE_LAMBDA_T, &lambda_tf),
+                Field::vector(fields::PAIR_NODE_SLIP_ORIGIN, &origin),
+            ]);
         }
         (out, force)
     }
 
     /// Adds λ_j of every owned node into the nodal contact-pressure field
     /// (indexed by owned local node; the denominator counts the pairs).
-    pub fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) {
+    pub(super) fn add_nodal_pressure(&self, numerator: &mut [f64], denominator: &mut [f64]) {
         for j in (0..self.owned.len()).filter(|&j| self.owned[j]) {
             let l = self.node_local[self.nodal.nodes[j] as usize] as usize;
             if let (Some(n), Some(d)) = (numerator.get_mut(l), denominator.get_mut(l)) {
@@ -130,50 +182,9 @@ impl MortarPair {
         }
     }
 
-    /// Friction at the slave points of `slave` (output): the nodal traction
-    /// on the slave (−λT_j) and slip interpolated like the pressure, and the
-    /// state (0 open where `pressure` is 0, else 2 if a node of the facet
-    /// slides, else 1). Empty for a frictionless pair.
-    pub fn point_friction(
-        &self,
-        slave: &crate::contact::surfaces::SlaveSurface,
-        pressure: &[f64],
-    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) {
-        use crate::contact::multipliers::PointState;
-        let Some(f) = &self.friction else {
-            return Default::default();
-        };
-        let by_node: std::collections::HashMap<u32, usize> = (0..self.nodal.nodes.len())
-            .map(|j| (self.node_local[self.nodal.nodes[j] as usize], j))
-            .collect();
-        let mut out: (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<i8>) = Default::default();
-        for (q, p) in pressure.iter().enumerate() {
-            let s = facet_shape(slave.facet_type, slave.qp_zeta[q]);
-            let (mut t, mut slip, mut sliding) = ([0.0; 3], [0.0; 3], false);
-            for (n, na) in slave.facets[q / slave.nqp].nodes.iter().zip(s.n) {
-                if let Some(&j) = by_node.get(&n.to_u32()) {
-                    for c in 0..3 {
-                        t[c] -= na * f.nodal.lambda[j][c];
-                        slip[c] += na * f.slip[j][c];
-                    }
-                    sliding |= f.sliding[j];
-                }
-            }
-            let state = match (*p > 0.0, sliding) {
-                (false, _) => PointState::Open,
-                (true, false) => PointState::Stick,
-                (true, true) => PointState::Slip,
-            };
-            out.0.push(t);
-            out.1.push(slip);
-            out.2.push(state as i8);
-        }
-        out
-    }
-
     /// λ_j by the slave node's local index, for the nodes this rank holds
     /// (the point output interpolates them with the standard shape functions).
-    pub fn lambda_by_local_node(&self) -> std::collections::HashMap<u32, f64> {
+    fn lambda_by_local_node(&self) -> std::collections::HashMap<u32, f64> {
         self.nodal
             .nodes
             .iter()

@@ -3,46 +3,42 @@
 //! `node_lambda`, `node_lambda_t` and `node_slip_origin` datasets, rows by
 //! natural node).
 use super::pair::MortarPair;
-
-/// What a result file holds of a mortar pair at one step, the rows of this
-/// pair's nodes only, in the order of [`MortarPair::restart_nodes`].
-#[derive(Debug, Clone, Default)]
-pub struct MortarRows {
-    pub lambda: Vec<f64>,
-    /// Frictional pairs: λT_j and every pair node's slip origin.
-    pub lambda_t: Option<Vec<[f64; 3]>>,
-    pub slip_origin: Option<Vec<[f64; 3]>>,
-    /// The step's load factor (a rigid master's placement it ended at).
-    pub load_factor: f64,
-}
+use crate::contact::fields::{self, RestartField, RestartRequest, RestartRows, RowSpace};
 
 impl MortarPair {
-    /// The natural (file) rows a restart reads: the slave nodes this rank
-    /// holds (in id order), then its owned nodes of either surface (whose
-    /// slip origins it hands on, see [`MortarPair::committed_origins`]).
-    pub fn restart_nodes(&self) -> &[usize] {
-        &self.restart_rows
+    /// The fields a restart reads (λ_j and, with friction, λT_j and the
+    /// slip origins), and their natural (file) rows: the slave nodes this
+    /// rank holds (in id order), then its owned nodes of either surface
+    /// (whose slip origins it hands on, see [`MortarPair::committed_origins`]).
+    pub(super) fn request(&self) -> RestartRequest {
+        let field = |name, cols| RestartField {
+            name,
+            cols,
+            space: RowSpace::Nodes,
+            rows: self.restart_rows.clone(),
+        };
+        let mut fields = vec![field(fields::PAIR_NODE_LAMBDA, 1)];
+        if self.friction.is_some() {
+            fields.push(field(fields::PAIR_NODE_LAMBDA_T, 3));
+            fields.push(field(fields::PAIR_NODE_SLIP_ORIGIN, 3));
+        }
+        RestartRequest { fields }
     }
 
-    /// Whether a restart reads λT and the slip origins.
-    pub fn restarts_friction(&self) -> bool {
-        self.friction.is_some()
-    }
-
-    /// Takes over `rows` as the end of a converged step (then committed, as
-    /// the step end did). On a mismatch, says which dataset does not fit.
-    pub fn restart(&mut self, rows: &MortarRows) -> Result<(), &'static str> {
+    /// Takes over `rows` (see `request`) as the end of a converged step
+    /// (then committed, as the step end did). On a mismatch, says which
+    /// dataset does not fit.
+    pub(super) fn restart(&mut self, rows: &RestartRows) -> Result<(), &'static str> {
         let slots: Vec<usize> = self.nodal.nodes.iter().map(|&id| id as usize).collect();
         let lambda = slots
             .iter()
-            .map(|&r| rows.lambda.get(r).copied())
+            .map(|&r| rows.field(0).get(r).copied())
             .collect::<Option<Vec<f64>>>()
             .filter(|l| l.iter().all(|v| v.is_finite() && *v >= 0.0))
             .ok_or("node_lambda")?;
         let mut pending = None;
         if let Some(f) = &mut self.friction {
-            let lambda_t = rows.lambda_t.as_ref().ok_or("node_lambda_t")?;
-            let origin = rows.slip_origin.as_ref().ok_or("node_slip_origin")?;
+            let (lambda_t, origin) = (&rows.triples(1), &rows.triples(2));
             let take = |v: &[[f64; 3]], at: &mut dyn Iterator<Item = usize>, what| {
                 at.map(|r| {
                     v.get(r)
@@ -65,7 +61,7 @@ impl MortarPair {
         if let Some(r) = &mut self.rigid {
             r.last_factor = rows.load_factor;
         }
-        self.commit();
+        self.commit_step();
         self.pending_origins = pending;
         Ok(())
     }
@@ -75,7 +71,7 @@ impl MortarPair {
     /// node, origin − reference position). The solver writes them into the
     /// committed state the search hands [`MortarPair::start_slip_from`],
     /// so every rank holding a node measures from the file's origin.
-    pub fn committed_origins(&self) -> Vec<(u32, [f64; 3])> {
+    pub(super) fn committed_origins(&self) -> Vec<(u32, [f64; 3])> {
         let Some(origins) = &self.pending_origins else {
             return Vec::new();
         };

@@ -9,6 +9,8 @@ use super::segment::MortarRules;
 use super::system::NodalData;
 use super::tangential::PairFriction;
 use crate::assembly::RankExchange;
+use crate::contact::held_master::HeldMaster;
+use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
@@ -37,7 +39,7 @@ impl MortarPair {
     /// it computes any (μ > 0); `(margin, reach)`: the candidates' search
     /// margin and the distance within which nodes are reserved for the
     /// contact DOFs (see [`MortarPair::reserve_dofs`]).
-    pub fn new(
+    pub(super) fn build(
         mesh: &LocalMesh,
         dofs: &DofMap,
         spec: &PairSpec,
@@ -45,6 +47,7 @@ impl MortarPair {
         penalty: impl Fn(f64) -> f64,
         (search_distance, reach): (f64, f64),
         friction: Option<FrictionSpec>,
+        (slave, held): (SlaveSurface, Option<Box<HeldMaster>>),
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let nf = facet_type.nodes();
@@ -132,7 +135,7 @@ impl MortarPair {
         for &f in &evaluated {
             let nodes = &slave_facets[f as usize][..nf];
             let x: Vec<[f64; 3]> = nodes.iter().map(|&n| x_ref[n as usize]).collect();
-            let weights = crate::contact::kernel::reference_weights(facet_type, &x, &rule);
+            let weights = reference_weights(facet_type, &x, &rule);
             let h = shortest_edge(&x);
             for (zeta, w) in weights {
                 let s = facet_shape(facet_type, zeta);
@@ -188,6 +191,11 @@ impl MortarPair {
         let node_dofs = nodes.iter().map(|v| v.1).collect();
         let friction = friction.map(|f| PairFriction::new(f, &nodal.penalty, &x_ref));
         Ok(MortarPair {
+            name: spec.name.clone(),
+            slave,
+            held,
+            tangent_signature: 0,
+            main_part_tangent: false,
             facet_type,
             n_slave,
             node_local,

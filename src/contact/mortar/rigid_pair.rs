@@ -17,7 +17,7 @@ use super::rows::Rows;
 use super::system::{self, NodeState};
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::autodiff::Seed;
-use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 
 /// One evaluation against the rigid master.
@@ -112,7 +112,7 @@ impl MortarPair {
 
     /// For each complete node: the nodes of its candidate facets, squared
     /// into the pattern (slave–slave couplings only).
-    pub(super) fn rigid_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
+    pub(super) fn rigid_pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
         let nf = self.facet_type.nodes();
         let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
         for &f in &self.rigid_master().candidates {
@@ -132,7 +132,7 @@ impl MortarPair {
             nodes.dedup();
             d.clear();
             for n in nodes {
-                d.extend((0..DIM).map(|c| self.global_dof(dofs, n, c)));
+                d.extend((0..DIM).map(|c| self.global_dof(n, c)));
             }
             pattern.add_square(&d)?;
         }
@@ -219,7 +219,6 @@ impl MortarPair {
     /// See [`MortarPair::add_tangent`].
     pub(super) fn rigid_tangent(
         &self,
-        dofs: &DofMap,
         u_local: &[f64],
         rate: Option<&Rate>,
         factor: f64,
@@ -241,7 +240,7 @@ impl MortarPair {
                 &mut add,
             );
         }
-        rows.add_to(|id, c| self.global_dof(dofs, id, c), k)?;
+        rows.add_to(|id, c| self.global_dof(id, c), k)?;
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         for f in &e.facets {

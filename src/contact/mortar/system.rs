@@ -6,7 +6,7 @@
 //! surface, see `segment_terms`). With `A_j = ∫ N_j dA₀` its reference nodal
 //! area, `ḡ_j = g̃_j / A_j` is the node's mean gap and the pressure of the
 //! converged Newton solution is `p_j = ⟨λ_j − ε_j ḡ_j⟩` (the links' own rule,
-//! [`updated_multiplier`]). The residual, added to `R = f_int − f_ext`, is
+//! [`contact_pressure`]). The residual, added to `R = f_int − f_ext`, is
 //! the mortar force `r = −Σ_j p_j c_j` with `c_j = ∂g̃_j/∂x` at fixed `D`,
 //! `M` and `ν`: `+p_j D_jk ν` on slave node `k`, `−p_j M_jl ν` on master node
 //! `l` (for a uniform `p` these are the exact consistent nodal forces on
@@ -18,7 +18,7 @@
 use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
 use crate::contact::autodiff::{Dual, Scalar, Seed, Vec3};
-use crate::contact::multipliers::updated_multiplier;
+use crate::contact::penalty::contact_pressure;
 use crate::fem::{FacetType, MAX_FACET_NODES};
 
 /// Variables of one segment: slave nodes at `3a + i`, master nodes at
@@ -335,7 +335,7 @@ pub fn node_states(nodal: &NodalData, gap: &[f64], covered: &[bool]) -> Vec<Node
             NodeState {
                 weighted_gap: gap[j],
                 pressure: if covered[j] {
-                    updated_multiplier(nodal.lambda[j], nodal.penalty[j], mean)
+                    contact_pressure(nodal.lambda[j], nodal.penalty[j], mean)
                 } else {
                     0.0
                 },

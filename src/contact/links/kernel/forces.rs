@@ -4,7 +4,7 @@
 use super::friction::{friction_traction, slip_increment};
 use super::input::{dof_count, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory};
 use super::kinematics::{kinematics, tangential, Frame, Kinematics};
-use super::normal::trial_pressure;
+use crate::contact::penalty::trial_pressure;
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
 use crate::fem::shape::facet_shape;
 use crate::fem::MAX_FACET_NODES;

@@ -1,6 +1,7 @@
 //! Frictionless links: residual, tangent, balance, closed forms, bad input.
 
 use super::*;
+use crate::contact::surfaces::reference_weights;
 
 #[test]
 fn cases_cover_penetration_and_separation() {

@@ -2,15 +2,24 @@
 //! and its λT, expressed on the link's current master facet (carried over as
 //! the same material point and the same vector when the link changes facet),
 //! started at first contact and renewed by every Uzawa update.
-use super::links::Link;
-use super::{ContactPair, MasterSide};
+use super::kernel::{LinkState, SlipHistory};
+use super::link::Link;
+use super::multipliers::{PointFriction, PointState};
+use super::LinksPair;
 use crate::contact::autodiff::dot;
 use crate::contact::held_master::HeldMaster;
-use crate::contact::kernel::{LinkState, SlipHistory};
-use crate::contact::multipliers::{PointFriction, PointState};
+use crate::contact::master::MasterSide;
 use crate::contact::projection;
 
-impl ContactPair {
+impl LinksPair {
+    /// The translation of a rigid master at `factor` (zero otherwise).
+    fn rigid_shift(&self, factor: f64) -> [f64; 3] {
+        match &self.master {
+            MasterSide::Rigid(r) => r.shift(factor),
+            MasterSide::Facets(_) => [0.0; 3],
+        }
+    }
+
     /// The point's slip origin and λT in the terms of the link's current
     /// master: on a facet other than the one they were stored on, they are
     /// carried over (the origin as the same material point of the reference
@@ -23,7 +32,7 @@ impl ContactPair {
         u_local: &[f64],
     ) -> SlipHistory {
         match &self.master {
-            MasterSide::Deformable(m) => {
+            MasterSide::Facets(m) => {
                 // The history names facets by set index (it outlives the
                 // step's held numbering). A facet no longer held (the point
                 // slid beyond the search margin within one step) starts
@@ -50,14 +59,14 @@ impl ContactPair {
                 };
                 SlipHistory::Convected { xi_n, lambda }
             }
-            MasterSide::Rigid(spec) => {
+            MasterSide::Rigid(r) => {
                 let shift = self.rigid_shift(factor);
                 let point_n = match p.origin {
                     Some((o, _)) => [o[0] + shift[0], o[1] + shift[1], o[2] + shift[2]],
                     // No history (the step's search sets one for every
                     // link): no slip yet.
-                    None => spec
-                        .moved(self.spec.motion, factor)
+                    None => r
+                        .placed(factor)
                         .closest_point(self.slave.qp_position(link.qp_index(), u_local)),
                 };
                 SlipHistory::Spatial {
@@ -81,11 +90,9 @@ impl ContactPair {
                 continue;
             }
             p.origin = Some(match &self.master {
-                MasterSide::Deformable(m) => ([l.xi[0], l.xi[1], 0.0], m.set_index_of(l.facet)),
-                MasterSide::Rigid(spec) => {
-                    let foot = spec
-                        .moved(self.spec.motion, factor)
-                        .closest_point(points[l.qp_index()]);
+                MasterSide::Facets(m) => ([l.xi[0], l.xi[1], 0.0], m.set_index_of(l.facet)),
+                MasterSide::Rigid(r) => {
+                    let foot = r.placed(factor).closest_point(points[l.qp_index()]);
                     (
                         [foot[0] - shift[0], foot[1] - shift[1], foot[2] - shift[2]],
                         0,
@@ -153,7 +160,7 @@ impl ContactPair {
 /// The set index of held facet `facet` (0 for a rigid master).
 fn global_facet(master: &MasterSide, facet: u32) -> u32 {
     match master {
-        MasterSide::Deformable(m) => m.set_index_of(facet),
+        MasterSide::Facets(m) => m.set_index_of(facet),
         MasterSide::Rigid(_) => 0,
     }
 }

@@ -7,7 +7,7 @@ mod friction;
 mod normal;
 
 use super::*;
-use crate::contact::{dual, projection};
+use crate::contact::{autodiff, projection};
 use crate::fem::test_util::{rel_err, Lcg};
 use crate::fem::{FacetType, QuadRule};
 

@@ -1,9 +1,11 @@
 //! What the links add to the Jacobian pattern, the residual and the tangent.
-use super::links::Link;
-use super::{ContactPair, MasterSide};
+use super::kernel::{self, Friction, LinkInput, LinkMaster, LinkState, SlipRate};
+use super::link::Link;
+use super::LinksPair;
 use crate::assembly::{MatrixSink, PatternSink};
-use crate::contact::kernel::{self, Friction, LinkInput, LinkMaster, LinkState, SlipRate};
-use crate::dofs::{DofMap, GlobalDof, DIM};
+use crate::contact::formulation::{self, At};
+use crate::contact::master::MasterSide;
+use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use std::collections::BTreeSet;
 
@@ -20,7 +22,7 @@ const MAX_LINK_NODES: usize = 8;
 
 const MAX_LINK_DOFS: usize = DIM * MAX_LINK_NODES;
 
-impl ContactPair {
+impl LinksPair {
     /// Records every entry the links of this step may couple. A link
     /// couples its slave facet with the one master facet it projects onto,
     /// which may be any facet of its patch, so the pattern is the union of
@@ -29,10 +31,7 @@ impl ContactPair {
     /// slave facet and its whole patch stored 1.3 million zeros beyond the
     /// bulk stiffness's 7.4 million on the Hertz sphere at h = 0.35, each
     /// a multiply in every product and smoother sweep; now 0.7 million.)
-    pub fn add_pattern(&self, dofs: &DofMap, pattern: &mut dyn PatternSink) -> Result<()> {
-        if let Some(m) = &self.mortar {
-            return m.add_pattern(dofs, pattern);
-        }
+    pub(super) fn pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
         let facets: BTreeSet<usize> = self
             .links
             .iter()
@@ -41,7 +40,7 @@ impl ContactPair {
         for &facet in &facets {
             pattern.add_square(&self.slave.facets[facet].dofs)?;
         }
-        let MasterSide::Deformable(m) = &self.master else {
+        let MasterSide::Facets(m) = &self.master else {
             return Ok(());
         };
         let pairs: BTreeSet<(usize, u32)> = self
@@ -66,13 +65,11 @@ impl ContactPair {
     /// residual block and (when `with_tangent`) tangent block to `sink`.
     fn for_each_link(
         &mut self,
-        u_local: &[f64],
-        factor: f64,
+        at: &At,
         with_tangent: bool,
         mut sink: impl FnMut(&[u32], &[GlobalDof], &[f64], Option<&[f64]>, &LinkState) -> Result<()>,
-        _dofs: &DofMap,
     ) -> Result<()> {
-        self.follow(u_local);
+        self.follow(at.u);
         let mut buf = LinkBuffers::default();
         let mut r = [0.0; MAX_LINK_DOFS];
         let mut k = vec![0.0; MAX_LINK_DOFS * MAX_LINK_DOFS];
@@ -85,12 +82,12 @@ impl ContactPair {
             link_dofs.clear();
             nodes.extend(self.slave.facets[sf].nodes.iter().map(|l| l.to_u32()));
             link_dofs.extend_from_slice(&self.slave.facets[sf].dofs);
-            if let MasterSide::Deformable(m) = &self.master {
+            if let MasterSide::Facets(m) = &self.master {
                 let fnodes = m.facet_nodes(link.facet);
                 nodes.extend(fnodes.iter().map(|&n| m.extended_slot(n)));
                 m.facet_dofs(link.facet, &mut link_dofs);
             }
-            let input = self.link_input(link, u_local, factor, &mut buf);
+            let input = self.link_input(link, at, &mut buf);
             let n = link_dofs.len();
             let state = if with_tangent {
                 kernel::residual_tangent(&input, &mut r[..n], Some(&mut k[..n * n]))
@@ -116,17 +113,17 @@ impl ContactPair {
     pub(super) fn link_input<'b>(
         &'b self,
         link: &Link,
-        u_local: &[f64],
-        factor: f64,
+        at: &At,
         buf: &'b mut LinkBuffers,
     ) -> LinkInput<'b> {
+        let (u_local, factor) = (at.u, at.factor);
         let LinkBuffers { xs, xm, vs, vm } = buf;
         let qp = link.qp_index();
         let sf = qp / self.slave.nqp;
         let ns = self.slave.facet_type.nodes();
         self.slave.facet_positions(sf, u_local, &mut xs[..ns]);
         let (master, master_nodes): (LinkMaster, &[u32]) = match &self.master {
-            MasterSide::Deformable(m) => {
+            MasterSide::Facets(m) => {
                 let fnodes = m.facet_nodes(link.facet);
                 for (x, &n) in xm.iter_mut().zip(fnodes) {
                     *x = self.positions[n as usize];
@@ -140,15 +137,11 @@ impl ContactPair {
                     fnodes,
                 )
             }
-            MasterSide::Rigid(spec) => (
-                spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor))
-                    .as_master(),
-                &[],
-            ),
+            MasterSide::Rigid(r) => (r.placed(factor).as_master(), &[]),
         };
         let friction = match (&self.friction, &self.multipliers.tangential) {
             (Some(pf), Some(t)) => {
-                let rate = self.rate.as_ref().map(|rate| {
+                let rate = at.rate.map(|rate: &formulation::SlipRate| {
                     let velocity = |local: u32| {
                         let d = DIM * local as usize;
                         [0, 1, 2].map(|c| rate.dv_du * u_local[d + c] + rate.offset[d + c])
@@ -157,7 +150,7 @@ impl ContactPair {
                         *v = velocity(n.to_u32());
                     }
                     let nm = match &self.master {
-                        MasterSide::Deformable(m) => {
+                        MasterSide::Facets(m) => {
                             for (v, &n) in vm.iter_mut().zip(master_nodes) {
                                 *v = velocity(m.extended_slot(n));
                             }
@@ -199,90 +192,44 @@ impl ContactPair {
     }
 
     /// Adds the links' residual r_c = −∫ pN δgN into the local-form array.
-    pub fn add_residual(
-        &mut self,
-        dofs: &DofMap,
-        u_local: &[f64],
-        factor: f64,
-        r_local: &mut [f64],
-    ) -> Result<()> {
-        if let Some(m) = &self.mortar {
-            m.add_residual(u_local, self.mortar_rate().as_ref(), factor, r_local);
-            return Ok(());
-        }
-        self.for_each_link(
-            u_local,
-            factor,
-            false,
-            |nodes, _, r, _, _| {
-                for (a, &l) in nodes.iter().enumerate() {
-                    for c in 0..DIM {
-                        r_local[DIM * l as usize + c] += r[DIM * a + c];
-                    }
+    pub(super) fn residual(&mut self, at: &At, r_local: &mut [f64]) -> Result<()> {
+        self.for_each_link(at, false, |nodes, _, r, _, _| {
+            for (a, &l) in nodes.iter().enumerate() {
+                for c in 0..DIM {
+                    r_local[DIM * l as usize + c] += r[DIM * a + c];
                 }
-                Ok(())
-            },
-            dofs,
-        )
+            }
+            Ok(())
+        })
     }
 
-    /// Adds the links' consistent tangent into `k` (not assembled).
-    pub fn add_tangent(
-        &mut self,
-        dofs: &DofMap,
-        u_local: &[f64],
-        factor: f64,
-        k: &mut dyn MatrixSink,
-    ) -> Result<()> {
-        if let Some(m) = &self.mortar {
-            let rate = self.mortar_rate();
-            self.tangent_signature = m.add_tangent(
-                dofs,
-                u_local,
-                rate.as_ref(),
-                (factor, self.main_part_tangent),
-                k,
-            )?;
-            return Ok(());
-        }
-        // Which links are closed, on which master facets, sticking or
-        // sliding: what the tangent's structure depends on.
+    /// Adds the links' consistent tangent into `k` (not assembled), and
+    /// keeps its signature: which links are closed, on which master facets,
+    /// sticking or sliding (what the tangent's structure depends on).
+    pub(super) fn tangent(&mut self, at: &At, k: &mut dyn MatrixSink) -> Result<()> {
         let mut signature = std::collections::hash_map::DefaultHasher::new();
-        self.for_each_link(
-            u_local,
-            factor,
-            true,
-            |_, d, _, ke, s| match ke {
-                Some(ke) => {
-                    use std::hash::Hash;
-                    d.hash(&mut signature);
-                    s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
-                    k.add_block(d, d, ke)
-                }
-                None => Ok(()),
-            },
-            dofs,
-        )?;
+        self.for_each_link(at, true, |_, d, _, ke, s| match ke {
+            Some(ke) => {
+                use std::hash::Hash;
+                d.hash(&mut signature);
+                s.friction.as_ref().map(|f| f.sliding).hash(&mut signature);
+                k.add_block(d, d, ke)
+            }
+            None => Ok(()),
+        })?;
         self.tangent_signature = std::hash::Hasher::finish(&signature);
         Ok(())
     }
-
-    /// A hash of the active set the last tangent was assembled with (this
-    /// rank's links): equal hashes mean the same closed links on the same
-    /// master facets in the same stick/slip states.
-    pub fn tangent_signature(&self) -> u64 {
-        self.tangent_signature
-    }
 }
 
-impl ContactPair {
-    /// Every link's state at `u_local` after following its sliding partner.
-    pub(super) fn evaluate_links(&mut self, u_local: &[f64], factor: f64) -> Vec<LinkState> {
-        self.follow(u_local);
+impl LinksPair {
+    /// Every link's state at `at` after following its sliding partner.
+    pub(super) fn evaluate_links(&mut self, at: &At) -> Vec<LinkState> {
+        self.follow(at.u);
         let mut buf = LinkBuffers::default();
         self.links
             .iter()
-            .map(|l| kernel::evaluate(&self.link_input(l, u_local, factor, &mut buf)))
+            .map(|l| kernel::evaluate(&self.link_input(l, at, &mut buf)))
             .collect()
     }
 }

@@ -1,5 +1,5 @@
-//! The Uzawa multipliers λN at the slave quadrature points, and their update
-//! rule λN ← ⟨λN − εN gN⟩.
+//! The links' multipliers λN at the slave quadrature points (updated by
+//! the rule λN ← ⟨λN − εN gN⟩ of `contact::penalty`).
 //!
 //! A slave quadrature point belongs to the rank that owns its facet's cell.
 //! The multipliers live in an owned + ghost layout (a [`Halo`] in a
@@ -12,19 +12,12 @@
 //! this step's slip is measured from, stick/slip, traction and slip), in a
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
-use super::kernel::{contact_pressure, reference_weights};
-use super::surfaces::SlaveSurface;
+use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::assembly::{Halo, HaloFactory};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fem::{shape::facet_shape, QuadRule};
-
-/// The Uzawa update of one multiplier: the contact pressure of the converged
-/// Newton solution, pN = ⟨λN − εN gN⟩ (never negative: contact cannot pull).
-pub fn updated_multiplier(lambda: f64, penalty: f64, gap: f64) -> f64 {
-    contact_pressure(lambda, penalty, gap)
-}
 
 /// A quadrature point contribution to a node this rank owns: the point's slot
 /// in the local (owned + ghost) layout and its weight N_a(ζ) w.
@@ -182,9 +175,6 @@ pub struct Multipliers {
     n_ghost: usize,
     /// For the nodal pressure: contributions of owned and ghost points to owned nodes.
     nodal: Vec<NodalWeight>,
-    /// Global number of every slave facet of the set (by set index):
-    /// contiguous per rank, like the DOFs.
-    global_facet: Vec<usize>,
     /// Owned slave nodes: local index and reference position.
     owned_nodes: Vec<(u32, [f64; 3])>,
 }
@@ -198,17 +188,8 @@ impl Multipliers {
         friction: bool,
         halos: &dyn HaloFactory,
     ) -> Result<Self> {
-        let set = &slave.set;
         let nqp = slave.nqp;
-        if piece.owners.len() != slave.global_facets {
-            return Err(Error::Internal(format!(
-                "slave set '{set}' has {} facets but {} facet owners",
-                slave.global_facets,
-                piece.owners.len()
-            )));
-        }
-        let owner: Vec<usize> = piece.owners.iter().map(|&o| o as usize).collect();
-        let global_facet = contiguous_numbering(&owner, dofs.nranks);
+        let global_facet = &slave.global_facet;
         let owned_node = |nat: usize| dofs.local(NaturalNode(nat)).filter(|&l| dofs.is_owned(l));
         // Ghost facets: other ranks' facets with a node this rank owns, as
         // the piece lists them.
@@ -273,7 +254,6 @@ impl Multipliers {
             n_owned,
             n_ghost: ghosts.len(),
             nodal,
-            global_facet,
             owned_nodes,
         })
     }
@@ -380,36 +360,6 @@ impl Multipliers {
         Ok(())
     }
 
-    /// Global number of a slave point of this rank (contiguous per rank),
-    /// for redistribution to output order.
-    pub fn global_point(&self, set_index: usize, q: usize, nqp: usize) -> usize {
-        self.global_facet[set_index] * nqp + q
-    }
-}
-
-/// Numbers items rank by rank (each rank's in their given order), the same
-/// way `DofMap` numbers nodes.
-fn contiguous_numbering(owner: &[usize], nranks: usize) -> Vec<usize> {
-    let mut count = vec![0usize; nranks];
-    for &o in owner {
-        count[o] += 1;
-    }
-    let mut next: Vec<usize> = count
-        .iter()
-        .scan(0, |acc, &c| {
-            let start = *acc;
-            *acc += c;
-            Some(start)
-        })
-        .collect();
-    owner
-        .iter()
-        .map(|&o| {
-            let n = next[o];
-            next[o] += 1;
-            n
-        })
-        .collect()
 }
 
 #[cfg(test)]
@@ -442,18 +392,4 @@ mod tests {
         assert!(PointFriction::from_record(&p.record(), 7.0, p.traction).is_none());
     }
 
-    #[test]
-    fn update_rule_is_the_positive_part() {
-        assert_eq!(updated_multiplier(1.0, 10.0, 0.05), 0.5);
-        assert_eq!(updated_multiplier(1.0, 10.0, -0.1), 2.0);
-        assert_eq!(updated_multiplier(1.0, 10.0, 0.2), 0.0);
-    }
-
-    #[test]
-    fn numbering_is_contiguous_per_rank() {
-        assert_eq!(
-            contiguous_numbering(&[1, 0, 1, 0, 2], 3),
-            vec![2, 0, 3, 1, 4]
-        );
-    }
 }

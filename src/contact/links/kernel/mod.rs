@@ -56,10 +56,10 @@ mod normal;
 mod tests;
 
 pub use input::{
-    check_buffers, check_input, dof_count, reference_weights, Friction, FrictionState, LinkError,
+    check_buffers, check_input, dof_count, Friction, FrictionState, LinkError,
     LinkInput, LinkMaster, LinkState, SlipHistory, SlipRate,
 };
-pub use normal::{contact_pressure, potential, trial_pressure};
+pub use normal::potential;
 
 use forces::{residual_f64, residual_tangent_sized};
 use normal::evaluate_normal;

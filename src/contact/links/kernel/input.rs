@@ -6,8 +6,7 @@
 use thiserror::Error;
 
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
-use crate::fem::shape::facet_shape;
-use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+use crate::fem::{FacetType, MAX_FACET_NODES};
 use crate::model::RigidSurface;
 
 /// The master as one link's kernel sees it: the current nodes of its master
@@ -366,33 +365,6 @@ pub fn check_buffers(
     };
     length("r", n, r_len)?;
     k_len.map_or(Ok(()), |len| length("k", n * n, len))
-}
-
-/// Slave quadrature points and their reference weights: Gauss weight ×
-/// `|∂X/∂ζ₁ × ∂X/∂ζ₂|` on the reference (undeformed) slave facet `x_ref`.
-/// Empty for bad input (wrong node count, non-finite values, malformed rule).
-pub fn reference_weights(
-    facet: FacetType,
-    x_ref: &[[f64; 3]],
-    rule: &QuadRule,
-) -> Vec<([f64; 2], f64)> {
-    if facet_nodes("x_ref", facet, x_ref).is_err() || rule.check().is_err() {
-        return Vec::new();
-    }
-    rule.points
-        .iter()
-        .zip(&rule.weights)
-        .map(|(p, w)| {
-            let zeta = [p[0], p[1]];
-            let s = facet_shape(facet, zeta);
-            let mut t = [[0.0; 3]; 2];
-            for (xa, da) in x_ref.iter().zip(&s.dn) {
-                t[0] = autodiff::axpy(&t[0], da[0], xa);
-                t[1] = autodiff::axpy(&t[1], da[1], xa);
-            }
-            (zeta, w * autodiff::norm(&autodiff::cross(&t[0], &t[1])))
-        })
-        .collect()
 }
 
 pub(super) fn nodes_as<T: Scalar>(x: &[[f64; 3]]) -> [Vec3<T>; MAX_FACET_NODES] {

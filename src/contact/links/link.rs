@@ -1,10 +1,11 @@
 //! The links of a load step: the search that makes them at the start of the
 //! step, and the following of sliding during its Newton iterations.
-use super::{ContactPair, MasterSide};
+use super::LinksPair;
+use crate::contact::master::MasterSide;
 use crate::assembly::RankExchange;
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
-use crate::dofs::{DofMap, GlobalDof};
+use crate::dofs::DofMap;
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 
@@ -28,7 +29,7 @@ impl Link {
     }
 }
 
-impl ContactPair {
+impl LinksPair {
     /// Before the step's search: the box exchange that decides which master
     /// facets this rank holds (`contact::held_master`), at the same state the
     /// search then runs at. Done at every search, because the search's links
@@ -37,21 +38,14 @@ impl ContactPair {
     /// near each rank's slave points. `tail_base` is the first tail slot the
     /// pair may use; returns how many it uses. Collective (every rank calls
     /// it for every pair).
-    pub fn exchange_master(
+    pub(super) fn exchange(
         &mut self,
         u_local: &[f64],
         dofs: &DofMap,
         tail_base: usize,
         ranks: &dyn RankExchange,
     ) -> usize {
-        if let Some(mortar) = &mut self.mortar {
-            let held = match &mut self.master {
-                MasterSide::Deformable(m) => Some(m.as_mut()),
-                MasterSide::Rigid(_) => None,
-            };
-            return mortar.exchange(held, u_local, dofs, tail_base, ranks);
-        }
-        let MasterSide::Deformable(m) = &mut self.master else {
+        let MasterSide::Facets(m) = &mut self.master else {
             return 0;
         };
         let points: Vec<[f64; 3]> = (0..self.slave.num_qps())
@@ -74,84 +68,11 @@ impl ContactPair {
         m.tail_nodes()
     }
 
-    /// Global DOFs of the held master nodes this rank does not see (the
-    /// tail of the extended local array), node-major.
-    /// (A mortar pair's tail also holds the other ranks' slave nodes it
-    /// evaluates.)
-    pub fn master_tail(&self) -> &[crate::dofs::GlobalDof] {
-        match (&self.master, &self.mortar) {
-            (_, Some(m)) => m.tail_dofs(),
-            (MasterSide::Deformable(m), None) => &m.tail_dofs,
-            _ => &[],
-        }
-    }
-
-    /// Master facets this rank holds now, and in the whole master (None:
-    /// rigid master).
-    pub fn held_master_facets(&self) -> Option<(usize, usize)> {
-        match &self.master {
-            MasterSide::Deformable(m) => Some((m.set_index.len(), m.whole)),
-            MasterSide::Rigid(_) => None,
-        }
-    }
-
-    /// Facets received at the last exchange (None: rigid master).
-    pub fn received_master_facets(&self) -> Option<usize> {
-        match &self.master {
-            MasterSide::Deformable(m) => Some(m.received),
-            MasterSide::Rigid(_) => None,
-        }
-    }
-
-    /// Whether the pair measures its slip from the committed state given to
-    /// [`ContactPair::start_slip_from`] (a frictional mortar pair).
-    pub fn starts_slip_from_committed(&self) -> bool {
-        self.mortar.as_ref().is_some_and(|m| m.restarts_friction())
-    }
-
-    /// See [`crate::contact::mortar::pair::MortarPair::committed_origins`].
-    pub fn committed_origins(&self) -> Vec<(u32, [f64; 3])> {
-        self.mortar
-            .as_ref()
-            .map_or_else(Vec::new, |m| m.committed_origins())
-    }
-
-    /// A frictional mortar pair: the step's slip is measured from
-    /// `u_committed` (the last converged state, extended like every local
-    /// array), set at the search once the held nodes are known.
-    pub fn start_slip_from(&mut self, u_committed: &[f64]) {
-        if let Some(m) = &mut self.mortar {
-            m.start_slip_from(u_committed);
-        }
-    }
-
-    /// Whether the step's search still covers the state `u_local` (see
-    /// `MortarPair::covers`); the links' search distance (ten element
-    /// sizes, at least a tenth of the master's extent) is their margin, so
-    /// they are taken as covered.
-    pub fn covers(&self, u_local: &[f64], factor: f64) -> bool {
-        self.mortar
-            .as_ref()
-            .is_none_or(|m| m.covers(u_local, factor))
-    }
-
-    /// DOFs to hold in the contact DOFs beyond the pattern's (a mortar
-    /// pair's nodes within the search distance; none for links, whose
-    /// pattern already spans it).
-    pub fn reserve_dofs(&self) -> Vec<GlobalDof> {
-        self.mortar
-            .as_ref()
-            .map_or_else(Vec::new, |m| m.reserve_dofs())
-    }
-
     /// The search that starts every load step: outer search (closest master
     /// node through the spatial index) and inner search (projection onto the
     /// facets around it) for every slave point. Returns true when the coupling
     /// pattern differs from the previous step's.
-    pub fn search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
-        if let Some(m) = &mut self.mortar {
-            return m.search(u_local, factor, motion);
-        }
+    pub(super) fn search_links(&mut self, u_local: &[f64], factor: f64) -> bool {
         let nq = self.slave.num_qps();
         let points: Vec<[f64; 3]> = (0..nq)
             .map(|q| self.slave.qp_position(q, u_local))
@@ -165,7 +86,7 @@ impl ContactPair {
         };
         self.links.clear();
         match &self.master {
-            MasterSide::Deformable(m) => {
+            MasterSide::Facets(m) => {
                 self.positions = m.positions(u_local);
                 let surface = search::SearchSurface {
                     facet_type: m.facet_type,
@@ -203,8 +124,8 @@ impl ContactPair {
                     }
                 }
             }
-            MasterSide::Rigid(spec) => {
-                let geometry = spec.moved(self.spec.motion, self.spec.motion_amplitude.at(factor));
+            MasterSide::Rigid(r) => {
+                let geometry = r.placed(factor);
                 for (q, x) in points.iter().enumerate() {
                     if geometry.distance(*x) <= self.search_distance {
                         self.links.push(Link {
@@ -228,7 +149,7 @@ impl ContactPair {
         let mut h = DefaultHasher::new();
         // Patches by set index: the held numbering changes between steps.
         let global = |f: &u32| match &self.master {
-            MasterSide::Deformable(m) => m.set_index_of(*f),
+            MasterSide::Facets(m) => m.set_index_of(*f),
             MasterSide::Rigid(_) => *f,
         };
         for l in &self.links {
@@ -245,7 +166,7 @@ impl ContactPair {
     /// Follows sliding: re-selects each link's master facet within its patch
     /// for the current configuration, and caches the master positions.
     pub(super) fn follow(&mut self, u_local: &[f64]) {
-        let MasterSide::Deformable(m) = &self.master else {
+        let MasterSide::Facets(m) = &self.master else {
             return;
         };
         self.positions = m.positions(u_local);

@@ -1,25 +1,12 @@
-//! The normal part: the contact pressure pN = ⟨λN − εN gN⟩ (the one place
-//! it is written; the Uzawa update of λN calls [`contact_pressure`] too),
-//! open/closed, and the frictionless state and potential of a link.
+//! The normal part of a link: gap, open/closed, the contact pressure
+//! pN = ⟨λN − εN gN⟩ (`contact::penalty`'s law), and the frictionless state
+//! and potential.
 
 use super::evaluate;
 use super::input::{check_input, nodes_as, LinkInput, LinkMaster, LinkState};
 use super::kinematics::{rigid_kinematics, slave_point};
-use crate::contact::autodiff::Scalar;
+use crate::contact::penalty::{contact_pressure, trial_pressure};
 use crate::contact::projection;
-
-/// `λN − εN gN`, the augmented normal traction: the link is closed when it
-/// is ≥ 0, and it is then the contact pressure. Generic in the scalar type
-/// so that the dual pass of the tangent differentiates this same expression.
-pub fn trial_pressure<T: Scalar>(lambda_n: f64, penalty: f64, gap: T) -> T {
-    -(gap * penalty) + lambda_n
-}
-
-/// The contact pressure `pN = ⟨λN − εN gN⟩`, never negative (contact cannot
-/// pull). It is also the Uzawa update of the multiplier: λN ← pN.
-pub fn contact_pressure(lambda_n: f64, penalty: f64, gap: f64) -> f64 {
-    trial_pressure(lambda_n, penalty, gap).max(0.0)
-}
 
 /// Gap, normal, pressure and open/closed, without the friction state.
 pub(super) fn evaluate_normal(input: &LinkInput) -> LinkState {
