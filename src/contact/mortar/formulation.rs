@@ -1,7 +1,7 @@
 //! The mortar pair as the solver sees it: its set-up from the shared pair
 //! data and its duties as a [`Formulation`].
 use super::friction::Rate;
-use super::pair::{MortarMaster, MortarPair};
+use super::pair::{Master, MortarPair};
 use crate::assembly::{MatrixSink, PatternSink, RankExchange};
 use crate::contact::fields::{PairOutput, RestartRequest, RestartRows};
 use crate::contact::formulation::{
@@ -14,7 +14,6 @@ use crate::contact::penalty;
 use crate::contact::surfaces::SlaveSurface;
 use crate::dofs::{DofMap, GlobalDof};
 use crate::error::{Error, Result};
-use crate::model::MasterSpec;
 
 /// The slip rate in the mortar pair's terms.
 fn rate(r: &SlipRate) -> Rate<'_> {
@@ -31,30 +30,18 @@ impl MortarPair {
     /// master are exchanged).
     pub fn new(s: &PairSetup, slave: SlaveSurface, master: MasterSide) -> Result<Self> {
         let spec = s.spec;
-        let (mortar_master, held) = match (&spec.master, master) {
-            (MasterSpec::Surface { set }, MasterSide::Facets(held)) => {
-                (MortarMaster::Facets(set), Some(held))
-            }
-            (_, MasterSide::Rigid(r)) => (MortarMaster::Rigid(r.surface), None),
-            (MasterSpec::Rigid(_), MasterSide::Facets(_)) => {
-                return Err(Error::Internal(
-                    "a rigid master specified, master facets built".into(),
-                ))
-            }
-        };
         let h = slave.h;
         MortarPair::build(
             s.mesh,
             s.dofs,
             spec,
-            (mortar_master, s.ranks),
+            (slave, master, s.ranks),
             |h| penalty::default_normal(spec.penalty, s.softest_youngs, h),
             // Candidates are fixed for a step and every one widens the
             // Jacobian pattern: one element size of margin, not the links'
             // search distance, which only reserves contact DOFs.
             (s.search_distance.min(h), s.search_distance),
             spec.active_friction(),
-            (slave, held),
         )
     }
 }
@@ -70,7 +57,7 @@ impl Formulation for MortarPair {
     /// docs/formulation.md §13.5), symmetric to rounding.
     fn traits(&self) -> Traits {
         Traits {
-            symmetric_tangent: self.friction.is_none() && self.is_rigid(),
+            symmetric_tangent: self.friction.is_none() && matches!(self.master, Master::Rigid(_)),
             accurate_linear_solves: true,
             state_change_steps: true,
             unit: "nodes",
@@ -88,10 +75,7 @@ impl Formulation for MortarPair {
         tail_base: usize,
         ranks: &dyn RankExchange,
     ) -> usize {
-        let mut held = self.held.take();
-        let used = self.exchange(held.as_deref_mut(), u_local, dofs, tail_base, ranks);
-        self.held = held;
-        used
+        self.exchange(u_local, dofs, tail_base, ranks)
     }
 
     fn master_tail(&self) -> &[GlobalDof] {
@@ -99,11 +83,14 @@ impl Formulation for MortarPair {
     }
 
     fn held_facets(&self) -> Option<HeldFacets> {
-        self.held.as_ref().map(|m| HeldFacets {
-            held: m.set_index.len(),
-            whole: m.whole,
-            received: m.received,
-        })
+        match &self.master {
+            Master::Facets(m) => Some(HeldFacets {
+                held: m.held.set_index.len(),
+                whole: m.held.whole,
+                received: m.held.received,
+            }),
+            Master::Rigid(_) => None,
+        }
     }
 
     fn search(&mut self, at: &At, motion: f64) -> bool {

@@ -1,51 +1,56 @@
-//! Mortar contact: multipliers at the slave nodes with dual (biorthogonal)
-//! shape functions, integrated segment by segment over the slave–master
-//! overlaps.
+//! The mortar formulation: multipliers at the slave nodes with dual
+//! (biorthogonal) shape functions, integrated segment by segment over the
+//! slave–master overlaps (docs/formulation.md §13).
 //!
+//! The pair at run time:
+//! - `pair`: [`MortarPair`], its master side (`Master`: master facets or a
+//!   rigid surface), the search, and everything per node (the Uzawa
+//!   update, census, multipliers, commit); `formulation`: its duties as a
+//!   `contact::formulation::Formulation`; `setup` builds it on a rank;
+//!   `holding` decides what the rank holds (its slave facets and those
+//!   around their nodes, the master facets near them) and numbers the
+//!   nodes it does not see;
+//! - `facet_side`: the master facets' side (candidate facet pairs, the
+//!   segment evaluation, residual and tangent); `rigid_side`: a rigid
+//!   master's (candidate slave facets, the integrals over them);
+//! - `output`: the pair's point and nodal fields and force; `restart`:
+//!   taking a step over from a result file;
+//! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
+//!   state; `rows`: the tangent as the solver gets it (entries merged into
+//!   matrix rows, active-set signature).
+//!
+//! The integrals:
 //! - `geometry`: auxiliary plane, projection, polygon clipping,
 //!   triangulation, quadrature points mapped back to both facets
 //!   (`bilinear`: a facet's planar map and its inversion in f64);
 //! - `segment`: dual basis of a slave facet and the integrals of one segment
 //!   (weighted gap, mortar matrices `D` and `M`); `coverage`: the slave
 //!   facets the master covers whole, whose `D` is their exact diagonal;
+//! - `system`: nodal weighted gaps and pressures, residual and consistent
+//!   tangent of a set of segments; `main_part`: the tangent without the
+//!   derivatives of `D`, `M`, `ν` (the first Uzawa iteration from no
+//!   contact);
 //! - `friction`: Coulomb friction on the nodal multipliers (weighted slip,
 //!   return map, tangential residual and tangent);
-//! - `pair`: a mortar pair at run time (search, assembly, Uzawa update);
-//!   `pair_setup` builds it on a rank, `halo` decides what the rank holds
-//!   (its slave facets and those around their nodes, the master facets
-//!   near them) and numbers the nodes it does not see;
-//! - `main_part`: the tangent without the derivatives of `D`, `M`, `ν`
-//!   (the first Uzawa iteration from no contact);
-//! - `rows`: the tangent as the solver gets it (entries merged into matrix
-//!   rows, active-set signature);
-//! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
-//!   state at run time;
-//! - `system`: nodal weighted gaps and pressures, residual and consistent
-//!   tangent of a set of segments;
 //! - `rigid`, `rigid_friction`: the same against a rigid analytic master
-//!   (integrals over the slave facets alone), `rigid_master` the surface
-//!   and its motion, `rigid_pair` their run-time side;
-//! - `pair_output`: the pair's nodal fields, force and point values;
-//!   `pair_restart`: taking them over from a result file.
+//!   (integrals over the slave facets alone).
 mod bilinear;
 pub mod coverage;
-mod facet_search;
+mod facet_side;
 mod formulation;
 pub mod friction;
 pub mod geometry;
-mod halo;
 mod holding;
 mod main_part;
+mod output;
 pub mod pair;
-mod pair_output;
-mod pair_restart;
-mod pair_setup;
+mod restart;
 pub mod rigid;
 pub mod rigid_friction;
-mod rigid_master;
-mod rigid_pair;
+mod rigid_side;
 mod rows;
 pub mod segment;
+mod setup;
 pub mod system;
 mod tangential;
 

@@ -9,22 +9,37 @@
 //! that holds node `j` computes the same `g̃_j` and the same update of
 //! `λ_j` bit for bit; the owner of the node is the one that counts it in
 //! the Uzawa statistics and writes it out.
-use super::friction::{self, Increment, NodeFriction, Rate};
+use super::facet_side::FacetSide;
+use super::friction::{NodeFriction, Rate};
 use super::holding::Holding;
-use super::rigid_master::RigidMaster;
-use super::rows::{signature, Rows};
+use super::rigid_side::RigidSide;
 use super::segment::MortarRules;
-use super::system::{self, Interface, NodalData, NodeState, Segment};
+use super::system::{NodalData, NodeState};
 use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
-use crate::contact::autodiff::Dual;
-use crate::contact::held_master::HeldMaster;
-use crate::contact::surfaces::SlaveSurface;
 use crate::contact::outcome::UzawaStats;
+use crate::contact::surfaces::SlaveSurface;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use crate::fem::{FacetType, MAX_FACET_NODES};
-use crate::model::RigidSurface;
+
+/// The master side of a mortar pair at run time.
+pub(super) enum Master {
+    /// Facets of a deformable body, held near this rank's slave nodes.
+    Facets(FacetSide),
+    /// A rigid analytic surface with its prescribed motion.
+    Rigid(RigidSide),
+}
+
+impl Master {
+    /// The master facet `m`'s position in its set (0 for a rigid master).
+    fn set_index(&self, m: u32) -> u32 {
+        match self {
+            Master::Facets(f) => f.set_index[m as usize],
+            Master::Rigid(_) => 0,
+        }
+    }
+}
 
 /// What a cut-back step restores: λ_j and λT_j of the last converged step.
 #[derive(Debug, Clone)]
@@ -33,24 +48,11 @@ pub struct MortarSnapshot {
     lambda_t: Option<Vec<[f64; 3]>>,
 }
 
-/// One evaluation of the pair (values only; the tangent takes its
-/// derivatives segment by segment): segments, node states and (with
-/// friction) the nodes' friction.
-pub(super) struct Evaluation {
-    pub segments: Vec<Segment<f64>>,
-    /// Per slave facet: whether the segments cover it whole (its `D` is
-    /// the exact diagonal, see `coverage`).
-    pub covered: Vec<bool>,
-    pub states: Vec<NodeState>,
-    pub frictions: Vec<NodeFriction>,
-}
-
 pub struct MortarPair {
     pub(super) name: String,
     /// This rank's slave facets and points: the output's point rows.
     pub(super) slave: SlaveSurface,
-    /// A deformable master's facets this rank holds (None: rigid master).
-    pub(super) held: Option<Box<HeldMaster>>,
+    pub(super) master: Master,
     /// See `Formulation::tangent_signature`.
     pub(super) tangent_signature: u64,
     /// See `Formulation::set_main_part_tangent`.
@@ -66,7 +68,6 @@ pub struct MortarPair {
     pub(super) slave_facets: Vec<[u32; MAX_FACET_NODES]>,
     /// Per slave facet: its position in the slave set.
     pub(super) slave_set_index: Vec<u32>,
-    pub(super) master_facets: Vec<[u32; MAX_FACET_NODES]>,
     pub(super) assembled: Vec<bool>,
     /// Slave facets this rank evaluates (ascending): all it holds.
     pub(super) evaluated: Vec<u32>,
@@ -77,7 +78,13 @@ pub struct MortarPair {
     pub(super) owned: Vec<bool>,
     /// Per slot: the node's element size (mean shortest edge of its facets).
     pub(super) h: Vec<f64>,
+    /// The step's candidates: (evaluated slave facet, held master facet)
+    /// pairs whose bounding boxes meet, or against a rigid master
+    /// (evaluated slave facet near the surface, 0); by slave, then master.
     pub(super) candidates: Vec<(u32, u32)>,
+    /// The last search's candidates by set indices (the held master's
+    /// numbering changes with each exchange).
+    pub(super) candidate_key: Vec<(u32, u32)>,
     pub(super) search_distance: f64,
     /// The links' search distance: nodes of facets within it of the other
     /// surface at the last search (`reserve`, node ids) are held in the
@@ -90,26 +97,15 @@ pub struct MortarPair {
     /// Owned nodes on either surface (local index, reference position).
     pub(super) owned_pair_nodes: Vec<(u32, [f64; 3])>,
     pub(super) friction: Option<PairFriction>,
-    /// A rigid analytic master instead of master facets (none then).
-    pub(super) rigid: Option<RigidMaster>,
     /// Every pair node's natural (file) number, for restarts.
     pub(super) natural: Vec<usize>,
-    /// The master facets held and the tail (see `halo`).
+    /// The tail of nodes this rank does not see (see `holding`).
     pub(super) holding: Holding,
     /// The rows of [`MortarPair::restart_nodes`].
     pub(super) restart_rows: Vec<usize>,
     /// A restart's slip origins of the owned pair nodes, until the first
     /// step after it has converged.
     pub(super) pending_origins: Option<Vec<[f64; 3]>>,
-}
-
-/// The master side of a mortar pair.
-#[derive(Debug, Clone, Copy)]
-pub enum MortarMaster<'a> {
-    /// A facet set of a deformable body.
-    Facets(&'a str),
-    /// A rigid analytic surface.
-    Rigid(RigidSurface),
 }
 
 impl MortarPair {
@@ -141,19 +137,6 @@ impl MortarPair {
             .collect()
     }
 
-    fn interface<'a>(&'a self, positions: &'a [[f64; 3]]) -> Interface<'a> {
-        Interface {
-            slave_type: self.facet_type,
-            master_type: self.facet_type,
-            positions,
-            reference: &self.x_ref,
-            slave_facets: &self.slave_facets,
-            master_facets: &self.master_facets,
-            candidates: &self.candidates,
-            assembled: &self.assembled,
-        }
-    }
-
     /// The search of a load step: every (evaluated slave, master) facet pair
     /// whose bounding boxes, grown by the search distance, meet. Returns
     /// whether the candidates changed.
@@ -166,28 +149,40 @@ impl MortarPair {
     /// facets' shortest edge is the thickness) found the outer third of its
     /// contact zone only after Uzawa had converged, and solved again.
     pub(super) fn search_candidates(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
-        if self.rigid.is_some() {
-            return self.rigid_search(u_local, factor, motion);
-        }
         let x = self.positions(u_local);
-        self.reserve = self.nodes_within(&x, self.reach);
         let margin = self.search_distance.max(motion.min(self.reach));
-        let candidates = self.facet_pairs(&x, margin);
-        // Compared by set index: the held master's numbering changes
-        // with each exchange.
+        let (reserve, candidates) = match &self.master {
+            Master::Facets(m) => (
+                self.nodes_within(m, &x, self.reach),
+                self.facet_pairs(m, &x, margin),
+            ),
+            Master::Rigid(r) => {
+                let near = self.facets_near_rigid(r, &x, factor, self.reach);
+                let candidates = self.facets_near_rigid(r, &x, factor, margin);
+                (self.facet_nodes(&near), candidates.into_iter().map(|f| (f, 0)).collect())
+            }
+        };
         let key: Vec<(u32, u32)> = candidates
             .iter()
-            .map(|&(s, m)| {
-                (
-                    self.slave_set_index[s as usize],
-                    self.holding.master_set_index[m as usize],
-                )
-            })
+            .map(|&(s, m)| (self.slave_set_index[s as usize], self.master.set_index(m)))
             .collect();
-        let changed = key != self.holding.candidate_key;
-        self.holding.candidate_key = key;
+        let changed = key != self.candidate_key;
+        self.reserve = reserve;
+        self.candidate_key = key;
         self.candidates = candidates;
         changed
+    }
+
+    /// The nodes (ids, ascending) of slave facets `facets`.
+    fn facet_nodes(&self, facets: &[u32]) -> Vec<u32> {
+        let nf = self.facet_type.nodes();
+        let mut nodes: Vec<u32> = facets
+            .iter()
+            .flat_map(|&f| self.slave_facets[f as usize][..nf].to_vec())
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
     }
 
     /// Whether the step's candidates still hold every pair that may touch
@@ -200,12 +195,17 @@ impl MortarPair {
     /// without segments, unconstrained, and only a search from the solved
     /// state finds them.
     pub(super) fn candidates_cover(&self, u_local: &[f64], factor: f64) -> bool {
-        if self.rigid.is_some() {
-            return self.rigid_covers(u_local, factor);
-        }
+        let x = self.positions(u_local);
         // Both lists are ordered by slave, then master.
-        self.facet_pairs(&self.positions(u_local), 0.0)
-            .iter()
+        let now: Vec<(u32, u32)> = match &self.master {
+            Master::Facets(m) => self.facet_pairs(m, &x, 0.0),
+            Master::Rigid(r) => self
+                .facets_near_rigid(r, &x, factor, 0.0)
+                .into_iter()
+                .map(|f| (f, 0))
+                .collect(),
+        };
+        now.iter()
             .all(|pair| self.candidates.binary_search(pair).is_ok())
     }
 
@@ -230,18 +230,21 @@ impl MortarPair {
     }
 
     /// For each node of an assembled facet: the DOFs its tangent may couple
-    /// (all nodes of its candidate segments), squared into the pattern.
+    /// (all nodes of its candidate segments: the slave facet's and the
+    /// master facet's), squared into the pattern.
     pub(super) fn pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
-        if self.rigid.is_some() {
-            return self.rigid_pattern(pattern);
-        }
         let nf = self.facet_type.nodes();
         let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
         for &(s, m) in &self.candidates {
-            let ids = self.slave_facets[s as usize][..nf]
+            let master: &[u32] = match &self.master {
+                Master::Facets(f) => &f.facets[m as usize][..nf],
+                Master::Rigid(_) => &[],
+            };
+            let ids: Vec<u32> = self.slave_facets[s as usize][..nf]
                 .iter()
-                .chain(&self.master_facets[m as usize][..nf]);
-            let ids: Vec<u32> = ids.copied().collect();
+                .chain(master)
+                .copied()
+                .collect();
             for &n in &self.slave_facets[s as usize][..nf] {
                 if let Some(j) = self.nodal.slot_of(n) {
                     support[j].extend(&ids);
@@ -264,49 +267,6 @@ impl MortarPair {
         Ok(())
     }
 
-    pub(super) fn evaluate(
-        &self,
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        rate: Option<&Rate>,
-    ) -> Evaluation {
-        let interface = self.interface(x);
-        let (segments, facets_covered) = self.nodal.cache.segments(&interface, &self.rules);
-        let (gap, covered) = system::weighted_gaps(&interface, &self.nodal, &segments);
-        let states = system::node_states(&self.nodal, &gap, &covered);
-        let frictions = self.frictions(&interface, &segments, &states, x, u_local, rate);
-        Evaluation {
-            segments,
-            covered: facets_covered,
-            states,
-            frictions,
-        }
-    }
-
-    /// The nodes' friction at these states (none for a frictionless pair).
-    fn frictions(
-        &self,
-        interface: &Interface,
-        segments: &[Segment<f64>],
-        states: &[NodeState],
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        rate: Option<&Rate>,
-    ) -> Vec<NodeFriction> {
-        match &self.friction {
-            Some(f) => {
-                let (value, slope) = f.increments(&self.node_local, x, u_local, rate);
-                let inc = Increment {
-                    value: &value,
-                    slope,
-                };
-                let slips = friction::segment_slips(interface, segments, &inc);
-                friction::node_frictions(interface, &self.nodal, &f.nodal, states, segments, &slips)
-            }
-            None => Vec::new(),
-        }
-    }
-
     pub(super) fn residual(
         &self,
         u_local: &[f64],
@@ -314,18 +274,10 @@ impl MortarPair {
         factor: f64,
         r_local: &mut [f64],
     ) {
-        if self.rigid.is_some() {
-            return self.rigid_residual(u_local, rate, factor, r_local);
-        }
         let x = self.positions(u_local);
-        let e = self.evaluate(&x, u_local, rate);
-        let interface = self.interface(&x);
-        let mut add = |n: u32, c: usize, v: f64| {
-            r_local[self.local_dof(n, c)] += v;
-        };
-        system::residual(&interface, &self.nodal, &e.segments, &e.states, &mut add);
-        if self.friction.is_some() {
-            friction::residual(&interface, &self.nodal, &e.segments, &e.frictions, &mut add);
+        match &self.master {
+            Master::Facets(m) => self.facet_residual(m, (&x, u_local), rate, r_local),
+            Master::Rigid(r) => self.rigid_residual(r, (&x, u_local), (rate, factor), r_local),
         }
     }
 
@@ -333,8 +285,8 @@ impl MortarPair {
     /// the same segments, the same closed nodes and the same sliding nodes
     /// on this rank (what the tangent's structure depends on, so the
     /// solver may keep the preconditioner of an earlier one). With
-    /// `main_part` a frictionless pair adds only the main part (see
-    /// `main_part`).
+    /// `main_part` a frictionless pair on master facets adds only the main
+    /// part (see `main_part`).
     pub(super) fn tangent(
         &self,
         u_local: &[f64],
@@ -342,118 +294,11 @@ impl MortarPair {
         (factor, main_part): (f64, bool),
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
-        if self.rigid.is_some() {
-            return self.rigid_tangent(u_local, rate, factor, k);
-        }
         let x = self.positions(u_local);
-        if main_part && self.friction.is_none() {
-            return self.add_main_part(&x, u_local, k);
+        match &self.master {
+            Master::Facets(m) => self.facet_tangent(m, (&x, u_local), (rate, main_part), k),
+            Master::Rigid(r) => self.rigid_tangent(r, (&x, u_local), (rate, factor), k),
         }
-        let e = self.evaluate(&x, u_local, rate);
-        let interface = self.interface(&x);
-        let mut rows = Rows::new(self.node_local.len());
-        self.stream_tangent(&interface, &e, &x, u_local, rate, &mut rows);
-        rows.add_to(|id, c| self.global_dof(id, c), k)?;
-        Ok(signature(
-            &e.segments,
-            &e.states,
-            &e.frictions,
-            &self.slave_facets,
-            self.facet_type.nodes(),
-            &self.nodal,
-        ))
-    }
-
-    /// The tangent at the node states (and friction) of the f64
-    /// evaluation `e`: the derivatives are taken only on the overlaps of
-    /// slave facets with a closed node (the tangent of an open node is
-    /// zero, and a closed node's facets are all among them, so its terms
-    /// are complete; on a curved slave most overlaps lie away from the
-    /// contact), and the f64 pass found them: the dual pass makes the same
-    /// clipping decisions on the values. Each `Dual` segment goes into the
-    /// normal and tangential tangents as it is integrated.
-    fn stream_tangent(
-        &self,
-        interface: &Interface,
-        e: &Evaluation,
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        rate: Option<&Rate>,
-        rows: &mut Rows,
-    ) {
-        let nf = self.facet_type.nodes();
-        let closed = |f: u32| {
-            self.slave_facets[f as usize][..nf]
-                .iter()
-                .any(|&n| self.nodal.slot_of(n).is_some_and(|j| e.states[j].closed))
-        };
-        let live: Vec<(u32, u32)> = e
-            .segments
-            .iter()
-            .filter(|s| closed(s.slave))
-            .map(|s| (s.slave, s.master))
-            .collect();
-        let live = Interface {
-            candidates: &live,
-            ..*interface
-        };
-        let increments = self
-            .friction
-            .as_ref()
-            .map(|f| f.increments(&self.node_local, x, u_local, rate));
-        type D = Dual<{ system::SEGMENT_DOFS }>;
-        let mut add = |r, c, v| rows.add(r, c, v);
-        match (&self.friction, &increments) {
-            (Some(_), Some((value, slope))) => {
-                let inc = Increment {
-                    value,
-                    slope: *slope,
-                };
-                let mut t = friction::FrictionalTangent::new(
-                    interface,
-                    &self.nodal,
-                    &e.states,
-                    &e.frictions,
-                );
-                system::for_each_segment::<D>(&live, &self.rules, &e.covered, |seg| {
-                    t.add(
-                        &seg,
-                        &friction::segment_slip(interface, &seg, &inc),
-                        &mut add,
-                    );
-                });
-                t.finish(add);
-            }
-            _ => {
-                let mut t = system::FrictionlessTangent::new(interface, &self.nodal, &e.states);
-                system::for_each_segment::<D>(&live, &self.rules, &e.covered, |seg| {
-                    t.add(&seg, &mut add)
-                });
-                t.finish(add);
-            }
-        }
-    }
-
-    fn add_main_part(
-        &self,
-        x: &[[f64; 3]],
-        u_local: &[f64],
-        k: &mut dyn MatrixSink,
-    ) -> Result<u64> {
-        let e = self.evaluate(x, u_local, None);
-        let interface = self.interface(x);
-        let mut rows = Rows::new(self.node_local.len());
-        let add = |r, c, v| rows.add(r, c, v);
-        super::main_part::tangent(&interface, &self.nodal, &e.segments, &e.states, add);
-        rows.add_to(|id, c| self.global_dof(id, c), k)?;
-        Ok(signature(
-            &e.segments,
-            &e.states,
-            &e.frictions,
-            &self.slave_facets,
-            self.facet_type.nodes(),
-            &self.nodal,
-        ))
     }
 
     /// λ_j ← ⟨λ_j − ε_j ḡ_j⟩ (and λT_j ← tT_j) at every node whose
@@ -498,7 +343,7 @@ impl MortarPair {
         if let Some(f) = &mut self.friction {
             f.last = x;
         }
-        if let Some(r) = &mut self.rigid {
+        if let Master::Rigid(r) = &mut self.master {
             r.last_factor = factor;
         }
         stats
@@ -557,12 +402,12 @@ impl MortarPair {
         rate: Option<&Rate>,
         factor: f64,
     ) -> (Vec<NodeState>, Vec<NodeFriction>) {
-        match &self.rigid {
-            Some(_) => self.rigid_outcome(x, u_local, rate, factor),
-            None => {
-                let e = self.evaluate(x, u_local, rate);
+        match &self.master {
+            Master::Facets(m) => {
+                let e = self.facet_evaluate(m, x, u_local, rate);
                 (e.states, e.frictions)
             }
+            Master::Rigid(r) => self.rigid_outcome(r, (x, u_local), rate, factor),
         }
     }
 
@@ -613,7 +458,7 @@ impl MortarPair {
         if let Some(f) = &mut self.friction {
             f.start.clone_from(&f.last);
         }
-        if let Some(r) = &mut self.rigid {
+        if let Master::Rigid(r) = &mut self.master {
             r.start_factor = r.last_factor;
         }
     }

@@ -42,8 +42,9 @@ pub struct RigidInterface<'a> {
     pub positions: &'a [[f64; 3]],
     pub reference: &'a [[f64; 3]],
     pub facets: &'a [[u32; MAX_FACET_NODES]],
-    /// The facets integrated (from the step's search), ascending.
-    pub candidates: &'a [u32],
+    /// The facets integrated (from the step's search), ascending, as
+    /// (slave facet, 0): the pair's candidates, with no master facet.
+    pub candidates: &'a [(u32, u32)],
     /// Per slave facet: whether its forces are assembled on this rank.
     pub assembled: &'a [bool],
     /// The surface at its current placement (unit normal / axis).
@@ -128,7 +129,7 @@ pub fn facets<T: Seed>(interface: &RigidInterface, rules: &MortarRules) -> Vec<R
     let rule = facet_rule(ft, rules);
     let zero = T::from_f64(0.0);
     let mut out = Vec::with_capacity(interface.candidates.len());
-    'facets: for &f in interface.candidates {
+    'facets: for &(f, _) in interface.candidates {
         let nodes = &interface.facets[f as usize][..ns];
         let mut x_ref = [[0.0; 3]; MAX_FACET_NODES];
         let mut xs = [[zero; 3]; MAX_FACET_NODES];

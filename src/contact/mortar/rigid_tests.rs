@@ -15,7 +15,7 @@ struct Case {
     facet_type: FacetType,
     positions: Vec<[f64; 3]>,
     facets: Vec<[u32; 4]>,
-    candidates: Vec<u32>,
+    candidates: Vec<(u32, u32)>,
     assembled: Vec<bool>,
     expected: Vec<u32>,
     nodal: NodalData,
@@ -98,7 +98,7 @@ fn case(seed: u64, facet_type: FacetType, surface: RigidSurface, mu: Option<f64>
     Case {
         facet_type,
         positions,
-        candidates: (0..facets.len() as u32).collect(),
+        candidates: (0..facets.len() as u32).map(|f| (f, 0)).collect(),
         assembled: vec![true; facets.len()],
         facets,
         expected,
@@ -256,7 +256,7 @@ fn flat_patch_on_a_plane_gives_gap_times_area_and_consistent_forces() {
             normal: [0.0, 0.0, 1.0],
         };
         c.positions = positions;
-        c.candidates = (0..facets.len() as u32).collect();
+        c.candidates = (0..facets.len() as u32).map(|f| (f, 0)).collect();
         c.assembled = vec![true; facets.len()];
         c.facets = facets;
         let interface = c.interface(&c.positions);

@@ -2,7 +2,7 @@
 //! multipliers and, with friction, λT and the slip origins (the
 //! `node_lambda`, `node_lambda_t` and `node_slip_origin` datasets, rows by
 //! natural node).
-use super::pair::MortarPair;
+use super::pair::{Master, MortarPair};
 use crate::contact::fields::{self, RestartField, RestartRequest, RestartRows, RowSpace};
 
 impl MortarPair {
@@ -58,7 +58,7 @@ impl MortarPair {
             pending = Some(origins);
         }
         self.nodal.lambda = lambda;
-        if let Some(r) = &mut self.rigid {
+        if let Master::Rigid(r) = &mut self.master {
             r.last_factor = rows.load_factor;
         }
         self.commit_step();

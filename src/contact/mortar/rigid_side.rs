@@ -1,24 +1,54 @@
-//! A mortar pair against a rigid analytic master at run time: the step's
-//! candidate facets, residual, tangent, node states and output rows (the
-//! integrals are `rigid`'s, the friction `rigid_friction`'s; everything
-//! per node, the Uzawa update and the output fields are `pair`'s).
+//! A mortar pair's rigid analytic master at run time: the surface and its
+//! prescribed motion, the step's candidate slave facets (those with a node
+//! near the surface), and the evaluation, residual and tangent over them
+//! (the integrals are `rigid`'s, the friction `rigid_friction`'s). The
+//! other variant of the master side is `facet_side`; everything per node
+//! (the Uzawa update, the output fields) is `pair`'s.
 //!
 //! Parallel layout as for deformable masters: a rank integrates every slave
 //! facet it evaluates (its own and those sharing a node with them) from the
 //! same ghosted positions and the same placed surface, so every rank that
 //! holds node `j` computes the same `g̃_j`, `λ_j` and `λT_j`.
 use super::friction::{Increment, NodeFriction, Rate};
+use super::output::OutputRows;
 use super::pair::MortarPair;
-use super::pair_output::OutputRows;
 use super::rigid::{self, RigidFacet, RigidInterface, RD};
 use super::rigid_friction::{self, RigidSlip};
-use super::rigid_master::RigidMaster;
 use super::rows::Rows;
 use super::system::{self, NodeState};
-use crate::assembly::{MatrixSink, PatternSink};
+use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Seed;
-use crate::dofs::{GlobalDof, DIM};
+use crate::contact::master::RigidMaster;
 use crate::error::Result;
+
+/// The rigid master of a mortar pair.
+#[derive(Debug, Clone)]
+pub(super) struct RigidSide {
+    pub master: RigidMaster,
+    /// Per slot: how many facets this rank evaluates hold the node (all of
+    /// them must be integrated for its weighted gap to be whole).
+    pub expected: Vec<u32>,
+    /// Load factor of the last converged step and of the last Uzawa update:
+    /// the quasi-static slip measures the master's translation from the first.
+    pub start_factor: f64,
+    pub last_factor: f64,
+}
+
+impl RigidSide {
+    /// `slots`: the pair's slave node per slot; `facet_count`: per slave
+    /// node, the evaluated facets that hold it.
+    pub fn new(master: RigidMaster, slots: &[u32], facet_count: &[usize]) -> Self {
+        RigidSide {
+            master,
+            expected: slots
+                .iter()
+                .map(|&n| facet_count[n as usize] as u32)
+                .collect(),
+            start_factor: 0.0,
+            last_factor: 0.0,
+        }
+    }
+}
 
 /// One evaluation against the rigid master.
 struct RigidEvaluation<T> {
@@ -29,71 +59,33 @@ struct RigidEvaluation<T> {
 }
 
 impl MortarPair {
-    /// Whether the master is a rigid analytic surface.
-    pub fn is_rigid(&self) -> bool {
-        self.rigid.is_some()
-    }
-
-    fn rigid_master(&self) -> &RigidMaster {
-        match &self.rigid {
-            Some(r) => r,
-            None => unreachable!("rigid mortar call on a pair with master facets"),
-        }
-    }
-
-    fn rigid_interface<'a>(&'a self, positions: &'a [[f64; 3]], factor: f64) -> RigidInterface<'a> {
-        let r = self.rigid_master();
+    fn rigid_interface<'a>(
+        &'a self,
+        positions: &'a [[f64; 3]],
+        r: &RigidSide,
+        factor: f64,
+    ) -> RigidInterface<'a> {
         RigidInterface {
             facet_type: self.facet_type,
             positions,
             reference: &self.x_ref,
             facets: &self.slave_facets,
-            candidates: &r.candidates,
+            candidates: &self.candidates,
             assembled: &self.assembled,
-            surface: r.placed(factor),
+            surface: r.master.placed(factor),
         }
-    }
-
-    /// The search of a load step: the evaluated facets with a node within
-    /// the margin (as `search`'s: at least the step's prescribed `motion`)
-    /// of the surface placed at `factor`. Returns whether the candidates
-    /// changed.
-    pub(super) fn rigid_search(&mut self, u_local: &[f64], factor: f64, motion: f64) -> bool {
-        let margin = self.search_distance.max(motion.min(self.reach));
-        let candidates = self.facets_near_rigid(u_local, factor, margin);
-        let nf = self.facet_type.nodes();
-        let mut reserve: Vec<u32> = self
-            .facets_near_rigid(u_local, factor, self.reach)
-            .iter()
-            .flat_map(|&f| self.slave_facets[f as usize][..nf].to_vec())
-            .collect();
-        reserve.sort_unstable();
-        reserve.dedup();
-        self.reserve = reserve;
-        match &mut self.rigid {
-            Some(r) => {
-                let changed = candidates != r.candidates;
-                r.candidates = candidates;
-                changed
-            }
-            None => false,
-        }
-    }
-
-    /// Whether the step's candidates hold every evaluated facet with a node
-    /// on or behind the surface placed at `factor` (see `MortarPair::covers`).
-    pub(super) fn rigid_covers(&self, u_local: &[f64], factor: f64) -> bool {
-        let candidates = &self.rigid_master().candidates;
-        self.facets_near_rigid(u_local, factor, 0.0)
-            .iter()
-            .all(|f| candidates.binary_search(f).is_ok())
     }
 
     /// The evaluated facets (ascending) with a node within `distance` of
-    /// the surface placed at `factor`.
-    fn facets_near_rigid(&self, u_local: &[f64], factor: f64, distance: f64) -> Vec<u32> {
-        let x = self.positions(u_local);
-        let surface = self.rigid_master().placed(factor);
+    /// the surface placed at `factor`, at positions `x`.
+    pub(super) fn facets_near_rigid(
+        &self,
+        r: &RigidSide,
+        x: &[[f64; 3]],
+        factor: f64,
+        distance: f64,
+    ) -> Vec<u32> {
+        let surface = r.master.placed(factor);
         let near: Vec<bool> = x
             .iter()
             .map(|p| rigid::distance(&surface, p).is_some_and(|(g, _)| g <= distance))
@@ -110,42 +102,12 @@ impl MortarPair {
             .collect()
     }
 
-    /// For each complete node: the nodes of its candidate facets, squared
-    /// into the pattern (slave–slave couplings only).
-    pub(super) fn rigid_pattern(&self, pattern: &mut dyn PatternSink) -> Result<()> {
-        let nf = self.facet_type.nodes();
-        let mut support: Vec<Vec<u32>> = vec![Vec::new(); self.nodal.nodes.len()];
-        for &f in &self.rigid_master().candidates {
-            let ids = &self.slave_facets[f as usize][..nf];
-            for &n in ids {
-                if let Some(j) = self.nodal.slot_of(n) {
-                    support[j].extend(ids);
-                }
-            }
-        }
-        let mut d: Vec<GlobalDof> = Vec::new();
-        for (j, mut nodes) in support.into_iter().enumerate() {
-            if !self.complete[j] || nodes.is_empty() {
-                continue;
-            }
-            nodes.sort_unstable();
-            nodes.dedup();
-            d.clear();
-            for n in nodes {
-                d.extend((0..DIM).map(|c| self.global_dof(n, c)));
-            }
-            pattern.add_square(&d)?;
-        }
-        Ok(())
-    }
-
     /// The master's increment of the step: its translation since the last
     /// converged step (quasi-static) or `Δt` times its velocity (dynamics).
-    fn master_increment(&self, rate: Option<&Rate>, factor: f64) -> [f64; 3] {
-        let r = self.rigid_master();
+    fn master_increment(r: &RigidSide, rate: Option<&Rate>, factor: f64) -> [f64; 3] {
         match rate {
             None => {
-                let (now, then) = (r.shift(factor), r.shift(r.start_factor));
+                let (now, then) = (r.master.shift(factor), r.master.shift(r.start_factor));
                 [0, 1, 2].map(|i| now[i] - then[i])
             }
             Some(rate) => rate.master_velocity.map(|v| rate.dt * v),
@@ -154,19 +116,14 @@ impl MortarPair {
 
     fn rigid_evaluate<T: Seed>(
         &self,
-        x: &[[f64; 3]],
-        u_local: &[f64],
+        r: &RigidSide,
+        (x, u_local): (&[[f64; 3]], &[f64]),
         rate: Option<&Rate>,
         factor: f64,
     ) -> RigidEvaluation<T> {
-        let interface = self.rigid_interface(x, factor);
+        let interface = self.rigid_interface(x, r, factor);
         let facets = rigid::facets::<T>(&interface, &self.rules);
-        let (gap, covered) = rigid::weighted_gaps(
-            &interface,
-            &self.nodal,
-            &facets,
-            &self.rigid_master().expected,
-        );
+        let (gap, covered) = rigid::weighted_gaps(&interface, &self.nodal, &facets, &r.expected);
         let states = system::node_states(&self.nodal, &gap, &covered);
         let (slips, frictions) = match &self.friction {
             Some(f) => {
@@ -175,7 +132,7 @@ impl MortarPair {
                     value: &value,
                     slope,
                 };
-                let master = self.master_increment(rate, factor);
+                let master = Self::master_increment(r, rate, factor);
                 let slips = rigid_friction::facet_slips(&interface, &facets, &inc, master);
                 let frictions = rigid_friction::node_frictions(
                     &interface,
@@ -199,14 +156,13 @@ impl MortarPair {
 
     pub(super) fn rigid_residual(
         &self,
-        u_local: &[f64],
-        rate: Option<&Rate>,
-        factor: f64,
+        r: &RigidSide,
+        (x, u_local): (&[[f64; 3]], &[f64]),
+        (rate, factor): (Option<&Rate>, f64),
         r_local: &mut [f64],
     ) {
-        let x = self.positions(u_local);
-        let e = self.rigid_evaluate::<f64>(&x, u_local, rate, factor);
-        let interface = self.rigid_interface(&x, factor);
+        let e = self.rigid_evaluate::<f64>(r, (x, u_local), rate, factor);
+        let interface = self.rigid_interface(x, r, factor);
         let mut add = |n: u32, c: usize, v: f64| {
             r_local[self.local_dof(n, c)] += v;
         };
@@ -216,17 +172,16 @@ impl MortarPair {
         }
     }
 
-    /// See [`MortarPair::add_tangent`].
+    /// See `MortarPair::tangent` (the main part is the whole tangent here).
     pub(super) fn rigid_tangent(
         &self,
-        u_local: &[f64],
-        rate: Option<&Rate>,
-        factor: f64,
+        r: &RigidSide,
+        (x, u_local): (&[[f64; 3]], &[f64]),
+        (rate, factor): (Option<&Rate>, f64),
         k: &mut dyn MatrixSink,
     ) -> Result<u64> {
-        let x = self.positions(u_local);
-        let e = self.rigid_evaluate::<RD>(&x, u_local, rate, factor);
-        let interface = self.rigid_interface(&x, factor);
+        let e = self.rigid_evaluate::<RD>(r, (x, u_local), rate, factor);
+        let interface = self.rigid_interface(x, r, factor);
         let mut rows = Rows::new(self.node_local.len());
         let mut add = |r, c, v| rows.add(r, c, v);
         rigid::tangent(&interface, &self.nodal, &e.facets, &e.states, &mut add);
@@ -258,12 +213,12 @@ impl MortarPair {
     /// Node states and frictions for the Uzawa update.
     pub(super) fn rigid_outcome(
         &self,
-        x: &[[f64; 3]],
-        u_local: &[f64],
+        r: &RigidSide,
+        (x, u_local): (&[[f64; 3]], &[f64]),
         rate: Option<&Rate>,
         factor: f64,
     ) -> (Vec<NodeState>, Vec<NodeFriction>) {
-        let e = self.rigid_evaluate::<f64>(x, u_local, rate, factor);
+        let e = self.rigid_evaluate::<f64>(r, (x, u_local), rate, factor);
         (e.states, e.frictions)
     }
 
@@ -271,17 +226,13 @@ impl MortarPair {
     /// (the output's weights and force directions).
     pub(super) fn rigid_output_rows(
         &self,
+        r: &RigidSide,
         x: &[[f64; 3]],
         factor: f64,
     ) -> (Vec<NodeState>, OutputRows) {
-        let interface = self.rigid_interface(x, factor);
+        let interface = self.rigid_interface(x, r, factor);
         let facets = rigid::facets::<f64>(&interface, &self.rules);
-        let (gap, covered) = rigid::weighted_gaps(
-            &interface,
-            &self.nodal,
-            &facets,
-            &self.rigid_master().expected,
-        );
+        let (gap, covered) = rigid::weighted_gaps(&interface, &self.nodal, &facets, &r.expected);
         let states = system::node_states(&self.nodal, &gap, &covered);
         let nf = self.facet_type.nodes();
         let mut rows = Vec::new();

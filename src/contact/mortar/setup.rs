@@ -1,21 +1,21 @@
 //! Building a mortar pair on one rank: the slave facets it evaluates (see
-//! `halo`), the nodal slots with their areas, element sizes and penalties,
+//! `holding`), the nodal slots with their areas, element sizes and penalties,
 //! and which of them this rank completes and owns.
-use super::halo;
-use super::holding::Holding;
-use super::pair::{MortarMaster, MortarPair};
-use super::rigid_master::RigidMaster;
+use super::facet_side::FacetSide;
+use super::holding::{self, Holding};
+use super::pair::{Master, MortarPair};
+use super::rigid_side::RigidSide;
 use super::segment::MortarRules;
 use super::system::NodalData;
 use super::tangential::PairFriction;
 use crate::assembly::RankExchange;
-use crate::contact::held_master::HeldMaster;
+use crate::contact::master::MasterSide;
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
 use crate::fem::{shape::facet_shape, QuadRule, MAX_FACET_NODES};
-use crate::model::{FrictionSpec, PairSpec};
+use crate::model::{FrictionSpec, MasterSpec, PairSpec};
 
 fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
     let mut row = [0; MAX_FACET_NODES];
@@ -33,29 +33,30 @@ fn shortest_edge(x: &[[f64; 3]]) -> f64 {
 }
 
 impl MortarPair {
-    /// `master`: the master facet set or rigid surface, and the ranks its
-    /// set-up exchanges with (collective); `penalty(h)`: the pair's εN for a
-    /// node of element size `h`; `friction`: the pair's Coulomb friction, if
-    /// it computes any (μ > 0); `(margin, reach)`: the candidates' search
-    /// margin and the distance within which nodes are reserved for the
-    /// contact DOFs (see [`MortarPair::reserve_dofs`]).
+    /// `(slave, master)`: the pair's slave surface and master side on this
+    /// rank, and the ranks the set-up exchanges with (collective);
+    /// `penalty(h)`: the pair's εN for a node of element size `h`;
+    /// `friction`: the pair's Coulomb friction, if it computes any (μ > 0);
+    /// `(margin, reach)`: the candidates' search margin and the distance
+    /// within which nodes are reserved for the contact DOFs (see
+    /// [`MortarPair::reserved_dofs`]).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn build(
         mesh: &LocalMesh,
         dofs: &DofMap,
         spec: &PairSpec,
-        (master, ranks): (MortarMaster, &dyn RankExchange),
+        (slave, master, ranks): (SlaveSurface, MasterSide, &dyn RankExchange),
         penalty: impl Fn(f64) -> f64,
         (search_distance, reach): (f64, f64),
         friction: Option<FrictionSpec>,
-        (slave, held): (SlaveSurface, Option<Box<HeldMaster>>),
     ) -> Result<Self> {
         let facet_type = mesh.cell_type.facet_type();
         let nf = facet_type.nodes();
-        let (master_set, rigid) = match master {
-            MortarMaster::Facets(set) => (Some(set), None),
-            MortarMaster::Rigid(r) => (None, Some(r)),
+        let master_set = match &spec.master {
+            MasterSpec::Surface { set } => Some(set.as_str()),
+            MasterSpec::Rigid(_) => None,
         };
-        let share = halo::slave_share(mesh, dofs, &spec.slave, master_set, ranks)?;
+        let share = holding::slave_share(mesh, dofs, &spec.slave, master_set, ranks)?;
         // Slave node ids in natural order.
         let mut nodes: Vec<(u64, [GlobalDof; DIM], [f64; 3])> = share
             .facets
@@ -176,7 +177,14 @@ impl MortarPair {
                 ),
             ));
         }
-        let rigid = rigid.map(|r| RigidMaster::new(r, spec, &slots, &h_count));
+        let master = match master {
+            MasterSide::Facets(held) => Master::Facets(FacetSide {
+                held,
+                facets: Vec::new(),
+                set_index: Vec::new(),
+            }),
+            MasterSide::Rigid(r) => Master::Rigid(RigidSide::new(r, &slots, &h_count)),
+        };
         let natural: Vec<usize> = nodes.iter().map(|v| v.0 as usize).collect();
         let restart_rows = natural
             .iter()
@@ -193,7 +201,7 @@ impl MortarPair {
         Ok(MortarPair {
             name: spec.name.clone(),
             slave,
-            held,
+            master,
             tangent_signature: 0,
             main_part_tangent: false,
             facet_type,
@@ -203,7 +211,6 @@ impl MortarPair {
             x_ref,
             slave_facets,
             slave_set_index,
-            master_facets: Vec::new(),
             assembled,
             evaluated,
             nodal,
@@ -211,6 +218,7 @@ impl MortarPair {
             owned,
             h,
             candidates: Vec::new(),
+            candidate_key: Vec::new(),
             search_distance,
             reach,
             reserve: Vec::new(),
@@ -218,7 +226,6 @@ impl MortarPair {
             owned_mesh_nodes: dofs.num_owned_nodes(),
             owned_pair_nodes: share.owned_pair_nodes,
             friction,
-            rigid,
             natural,
             holding: Holding {
                 slave_tail,

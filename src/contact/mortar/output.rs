@@ -2,7 +2,7 @@
 //! slave nodes, the pair's force, and point values interpolated from the
 //! nodes.
 use super::friction::Rate;
-use super::pair::{Evaluation, MortarPair};
+use super::pair::{Master, MortarPair};
 use super::system::NodeState;
 use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;
@@ -75,27 +75,9 @@ impl MortarPair {
     ) -> (Vec<Field>, PairForce) {
         let x = self.positions(u_local);
         // Per assembled facet row: (slot, Σ_k D_jk, its force direction Σ_k D_jk ν).
-        let (states, rows): (Vec<NodeState>, OutputRows) = match &self.rigid {
-            Some(_) => self.rigid_output_rows(&x, factor),
-            None => {
-                let Evaluation {
-                    segments, states, ..
-                } = self.evaluate(&x, u_local, rate);
-                let nf = self.facet_type.nodes();
-                let mut rows = Vec::new();
-                for seg in segments.iter().filter(|s| self.assembled[s.slave as usize]) {
-                    for (a, &n) in self.slave_facets[seg.slave as usize][..nf]
-                        .iter()
-                        .enumerate()
-                    {
-                        if let Some(j) = self.nodal.slot_of(n) {
-                            let d: f64 = seg.terms.d[a][..nf].iter().sum();
-                            rows.push((j, d, seg.terms.normal.map(|c| d * c)));
-                        }
-                    }
-                }
-                (states, rows)
-            }
+        let (states, rows): (Vec<NodeState>, OutputRows) = match &self.master {
+            Master::Facets(m) => self.facet_output_rows(m, &x, u_local, rate),
+            Master::Rigid(r) => self.rigid_output_rows(r, &x, factor),
         };
         let zero = [0.0; 3];
         let lambda_t = |j: usize| self.friction.as_ref().map_or(&zero, |f| &f.nodal.lambda[j]);
