@@ -103,12 +103,15 @@ fn history(h5: &Path) -> Vec<HashMap<String, f64>> {
 
 /// Largest mean slip of the step at a slave node.
 fn largest_slip(out: &Path, step: usize) -> f64 {
-    read_dataset::<f64>(out, &format!("/steps/{step:06}/contact/interface/node_slip"))
-        .expect("node_slip")
-        .0
-        .chunks_exact(3)
-        .map(|s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt())
-        .fold(0.0, f64::max)
+    read_dataset::<f64>(
+        out,
+        &format!("/steps/{step:06}/contact/interface/node_slip"),
+    )
+    .expect("node_slip")
+    .0
+    .chunks_exact(3)
+    .map(|s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt())
+    .fold(0.0, f64::max)
 }
 
 #[test]

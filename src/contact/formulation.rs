@@ -15,10 +15,26 @@
 use super::fields::{PairOutput, RestartRequest, RestartRows};
 use super::outcome::UzawaStats;
 use super::surfaces::SlaveSurface;
-use crate::assembly::{MatrixSink, PatternSink, RankExchange};
+use crate::assembly::{HaloFactory, MatrixSink, PatternSink, RankExchange};
+use crate::distribution::{LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof};
 use crate::error::Result;
+use crate::model::PairSpec;
 use std::any::Any;
+
+/// What a formulation is built from on one rank.
+pub struct PairSetup<'a> {
+    pub mesh: &'a LocalMesh,
+    pub dofs: &'a DofMap,
+    pub spec: &'a PairSpec,
+    /// The slave set beyond this rank's facets (owners, ghost facets).
+    pub slave_piece: &'a SlaveSetPiece,
+    /// Young's modulus of the softest body (the default penalty's scale).
+    pub softest_youngs: f64,
+    pub search_distance: f64,
+    pub halos: &'a dyn HaloFactory,
+    pub ranks: &'a dyn RankExchange,
+}
 
 /// Dynamics: the time integrator's velocity, affine in the displacement,
 /// `v = dv_du · u + offset` (local form, per DOF), for the slip rate.

@@ -4,7 +4,9 @@
 //! test, the slip rate in dynamics) and hands every duty to its
 //! formulation (see [`super::formulation`]).
 use super::fields::{PairOutput, RestartRequest, RestartRows};
-use super::formulation::{At, Census, Formulation, HeldFacets, PairSnapshot, SlipRate, Traits};
+use super::formulation::{
+    At, Census, Formulation, HeldFacets, PairSetup, PairSnapshot, SlipRate, Traits,
+};
 use super::links::LinksPair;
 use super::master::MasterSide;
 use super::mortar::MortarPair;
@@ -17,20 +19,6 @@ use crate::dofs::{DofMap, GlobalDof};
 use crate::error::{Error, Result};
 use crate::model::{self, PairSpec};
 use crate::verify::{facet_samples, NodalSample};
-
-/// What a formulation is built from on one rank.
-pub struct PairSetup<'a> {
-    pub mesh: &'a LocalMesh,
-    pub dofs: &'a DofMap,
-    pub spec: &'a PairSpec,
-    /// The slave set beyond this rank's facets (owners, ghost facets).
-    pub slave_piece: &'a SlaveSetPiece,
-    /// Young's modulus of the softest body (the default penalty's scale).
-    pub softest_youngs: f64,
-    pub search_distance: f64,
-    pub halos: &'a dyn HaloFactory,
-    pub ranks: &'a dyn RankExchange,
-}
 
 pub struct ContactPair {
     pub spec: PairSpec,
@@ -238,7 +226,12 @@ impl ContactPair {
         self.formulation.add_pattern(pattern)
     }
 
-    pub fn add_residual(&mut self, u_local: &[f64], factor: f64, r_local: &mut [f64]) -> Result<()> {
+    pub fn add_residual(
+        &mut self,
+        u_local: &[f64],
+        factor: f64,
+        r_local: &mut [f64],
+    ) -> Result<()> {
         let at = At {
             u: u_local,
             factor,

@@ -266,7 +266,11 @@ mod tests {
         let first = [progress(1e-2, false), progress(1e-2, true)];
         assert_eq!(s.stalled(&first), [false, false]);
         let second = [progress(9e-3, false), progress(9e-3, true)];
-        assert_eq!(s.stalled(&second), [true, false], "friction keeps its penalty");
+        assert_eq!(
+            s.stalled(&second),
+            [true, false],
+            "friction keeps its penalty"
+        );
         let third = [progress(9e-3, false), progress(8.9e-3, false)];
         assert_eq!(s.stalled(&third), [false, false], "one raise a step");
         let mut off = StepPenalties::new(1, false);

@@ -321,7 +321,7 @@ impl LoadSteps<'_> {
     fn search_contact(&mut self, target: f64) -> Result<()> {
         if !self.mech.contact.is_empty() {
             let mark = PhaseMark::new(&self.mech.times, self.mech.contact);
-            // The step's prescribed motion: a mortar pair's search margin.
+            // The step's prescribed motion: the pairs' search margin.
             let step = self.mech.dirichlet.largest_increment(self.done, target);
             let [motion] = parallel::max(&self.world, [step]);
             let (mech, x, x_prev) = (&mut self.mech, &self.x, &self.x_prev);
@@ -329,7 +329,11 @@ impl LoadSteps<'_> {
             let searched = self.stages.scope(Phase::ContactSearch, || {
                 mech.exchange_masters(x)?;
                 // The pairs are the same on every rank: so is this choice.
-                if mech.contact.iter().any(|p| p.measures_slip_from_committed()) {
+                if mech
+                    .contact
+                    .iter()
+                    .any(|p| p.measures_slip_from_committed())
+                {
                     // `x_prev`: the last converged state, with a restart's
                     // slip origins at the owned nodes until its first step
                     // has converged.
@@ -686,11 +690,7 @@ impl LoadSteps<'_> {
             halo_displacements: parallel::sum_usize(&world, [dofs.ghost_dofs().len()])[0],
             halo_multipliers: parallel::sum_usize(
                 &world,
-                [mech
-                    .contact
-                    .iter()
-                    .map(|p| p.multiplier_halo().1)
-                    .sum()],
+                [mech.contact.iter().map(|p| p.multiplier_halo().1).sum()],
             )[0],
         })
     }

@@ -129,7 +129,7 @@ impl TimeStepper {
     }
 
     /// The velocity map `v = v_u u + offset` in local (owned + ghost) form,
-    /// for frictional links; `rigid_velocity` is a rigid master's velocity.
+    /// for frictional pairs; `rigid_velocity` is a rigid master's velocity.
     pub fn slip_rate(
         &mut self,
         c: &Coefficients,

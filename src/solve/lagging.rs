@@ -3,8 +3,8 @@
 //! build, or when the kept one has stopped working.
 //!
 //! With linear-elastic bodies the tangent is K plus the penalty stiffness of
-//! the closed links (and small geometric terms ∝ pN). While the same links
-//! are closed on the same master facets, consecutive tangents differ only in
+//! the closed contacts (and small geometric terms ∝ pN). While the same
+//! contacts are closed on the same master facets, consecutive tangents differ only in
 //! those small terms, so the factors of an earlier one precondition GMRES to
 //! convergence in a few iterations. After an active-set change they do not
 //! (lagging across such changes cost hundreds of GMRES iterations on
@@ -58,7 +58,7 @@ impl Default for PreconditionerLag {
 
 impl PreconditionerLag {
     /// The watch for an iterative solve (GMRES + AMG). The hierarchy is only
-    /// an approximate inverse anyway, and the penalty terms of a few links
+    /// an approximate inverse anyway, and the penalty terms of a few contacts
     /// more or less change it little, so it is kept across active-set
     /// changes until the linear iterations say it has worn out.
     pub fn iterative() -> Self {

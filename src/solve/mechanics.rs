@@ -47,9 +47,9 @@ pub struct Mechanics<'a> {
     /// tangent: K is in the preconditioner's factor, and nothing else
     /// reads the operator (the linear solve is the preconditioner alone).
     pub always_rebuild: bool,
-    /// End backtracking steps where the last mortar node changes between
-    /// open and closed (`state_change`): with hyperelastic bodies, or on
-    /// the Krylov path.
+    /// End backtracking steps where the last contact constraint changes
+    /// between open and closed (`state_change`): with hyperelastic bodies,
+    /// or on the Krylov path.
     pub state_change_steps: bool,
     /// Newton on the condensed contact system (the Schur paths'; see
     /// `petsc::condensed` and `petsc::low_rank`): while its step is active
@@ -668,7 +668,9 @@ impl NonlinearProblem for Mechanics<'_> {
         // The same on every rank: the pairs are the scene's, the condensed
         // state is switched collectively.
         let condensed = self.condensed.as_ref().is_some_and(|c| c.is_active());
-        if condensed || !self.state_change_steps || !self.contact.iter().any(|p| p.traits().state_change_steps)
+        if condensed
+            || !self.state_change_steps
+            || !self.contact.iter().any(|p| p.traits().state_change_steps)
         {
             return Ok(None);
         }

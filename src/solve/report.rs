@@ -22,14 +22,15 @@ pub struct ContactReport {
     pub normal_force: f64,
     pub tangential_force: f64,
     pub max_penetration: f64,
-    /// Active points (links) or active slave nodes (mortar).
+    /// Active constraints (what the pair's formulation counts).
     pub active_points: usize,
-    /// What `active_points` counts: "points" or "nodes".
+    /// What `active_points` counts (`contact::Traits::unit`): "points" or
+    /// "nodes".
     pub active_what: &'static str,
     /// Active points that slide (friction).
     pub sliding_points: usize,
     pub penalty: f64,
-    /// Links pair with a deformable master: facets held per rank (min, max
+    /// A pair with a deformable master: facets held per rank (min, max
     /// over ranks), facets received per rank (max) and the whole master.
     pub master_held: Option<[usize; 4]>,
 }

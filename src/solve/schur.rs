@@ -191,7 +191,7 @@ pub(super) fn contact_dofs(pairs: &[ContactPair], _dofs: &DofMap) -> Result<Vec<
     Ok(whole_nodes(&t.0))
 }
 
-/// The DOFs the pairs reserve for C beyond their pattern (a mortar pair's
+/// The DOFs the pairs reserve for C beyond their pattern (a pair's
 /// nodes within the search distance), whole nodes.
 fn reserved_dofs(pairs: &[ContactPair]) -> Vec<PetscInt> {
     let r: Vec<PetscInt> = pairs

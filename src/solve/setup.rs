@@ -159,7 +159,11 @@ pub(super) fn set_solver_defaults(
     // fixed 1e-4 instead of Eisenstat–Walker (a loose solve makes its
     // Newton crawl); the others
     // keep Eisenstat–Walker, which suits them (below).
-    let rtol = if accurate_linear_solves { "1e-4" } else { "1e-10" };
+    let rtol = if accurate_linear_solves {
+        "1e-4"
+    } else {
+        "1e-10"
+    };
     petsc::options::set_default("-ksp_rtol", rtol)?;
     if constant && settings.reuse.linear_stiffness {
         // The Jacobian is set once, so GAMG's set-up runs once: free the

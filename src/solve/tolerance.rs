@@ -196,7 +196,6 @@ mod tests {
         }
     }
 
-
     #[test]
     fn a_loose_pass_is_confirmed_before_the_step_ends() {
         assert_eq!(round_end(true, true), RoundEnd::Converged);

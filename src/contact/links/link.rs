@@ -1,8 +1,8 @@
 //! The links of a load step: the search that makes them at the start of the
 //! step, and the following of sliding during its Newton iterations.
 use super::LinksPair;
-use crate::contact::master::MasterSide;
 use crate::assembly::RankExchange;
+use crate::contact::master::MasterSide;
 use crate::contact::projection::{self, Projection};
 use crate::contact::search::{self, SearchIndex};
 use crate::dofs::DofMap;

@@ -24,12 +24,9 @@ mod uzawa;
 pub use link::Link;
 
 use super::fields::{PairOutput, RestartRequest, RestartRows};
-use super::formulation::{
-    At, Census, Formulation, HeldFacets, PairSnapshot, Traits,
-};
+use super::formulation::{At, Census, Formulation, HeldFacets, PairSetup, PairSnapshot, Traits};
 use super::master::MasterSide;
 use super::outcome::UzawaStats;
-use super::pair::PairSetup;
 use super::penalty;
 use super::surfaces::SlaveSurface;
 use crate::assembly::{MatrixSink, PatternSink, RankExchange};

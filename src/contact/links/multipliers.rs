@@ -12,8 +12,8 @@
 //! this step's slip is measured from, stick/slip, traction and slip), in a
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
-use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::assembly::{Halo, HaloFactory};
+use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::Result;
@@ -359,7 +359,6 @@ impl Multipliers {
         }
         Ok(())
     }
-
 }
 
 #[cfg(test)]
@@ -391,5 +390,4 @@ mod tests {
         assert!(PointFriction::from_record(&bad, 2.0, p.traction).is_none());
         assert!(PointFriction::from_record(&p.record(), 7.0, p.traction).is_none());
     }
-
 }

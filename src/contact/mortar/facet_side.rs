@@ -5,27 +5,16 @@
 //! `system`'s, the friction `friction`'s). A rigid master is the other
 //! variant of the master side (`rigid_side`).
 use super::friction::{self, Increment, NodeFriction, Rate};
+use super::master::FacetSide;
 use super::output::OutputRows;
 use super::pair::MortarPair;
 use super::rows::{signature, Rows};
 use super::system::{self, Interface, NodeState, Segment};
 use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Dual;
-use crate::contact::held_master::HeldMaster;
 use crate::error::Result;
 use crate::fem::surface::facet_normal_at_centre;
 use crate::fem::MAX_FACET_NODES;
-
-/// The master facets this rank holds, as pair node ids.
-pub(super) struct FacetSide {
-    /// The held facets of the master set (see `contact::held_master`).
-    pub held: Box<HeldMaster>,
-    /// Held facets as pair node ids (after the slave nodes).
-    pub facets: Vec<[u32; MAX_FACET_NODES]>,
-    /// Each held facet's position in the master set (the numbering of
-    /// held facets changes with each exchange, this one does not).
-    pub set_index: Vec<u32>,
-}
 
 /// One evaluation of the pair (values only; the tangent takes its
 /// derivatives segment by segment): segments, node states and (with
@@ -59,7 +48,12 @@ impl MortarPair {
     /// body), so that a slave facet pushed through the master surface
     /// further than its own thickness still pairs with the facets it
     /// crossed.
-    pub(super) fn facet_pairs(&self, m: &FacetSide, x: &[[f64; 3]], margin: f64) -> Vec<(u32, u32)> {
+    pub(super) fn facet_pairs(
+        &self,
+        m: &FacetSide,
+        x: &[[f64; 3]],
+        margin: f64,
+    ) -> Vec<(u32, u32)> {
         let nf = self.facet_type.nodes();
         let bbox = |f: &[u32; MAX_FACET_NODES]| bounding_box(&f[..nf], x);
         let masters: Vec<_> = m
@@ -124,11 +118,7 @@ impl MortarPair {
                 nodes.extend(&self.slave_facets[s as usize][..nf]);
             }
         }
-        for (f, near) in m
-            .facets
-            .iter()
-            .zip(meeting_any(&masters, &slaves, reach))
-        {
+        for (f, near) in m.facets.iter().zip(meeting_any(&masters, &slaves, reach)) {
             if near {
                 nodes.extend(&f[..nf]);
             }

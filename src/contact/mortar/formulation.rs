@@ -1,15 +1,16 @@
 //! The mortar pair as the solver sees it: its set-up from the shared pair
 //! data and its duties as a [`Formulation`].
 use super::friction::Rate;
-use super::pair::{Master, MortarPair};
+use super::master::Master;
+use super::pair::MortarPair;
 use crate::assembly::{MatrixSink, PatternSink, RankExchange};
 use crate::contact::fields::{PairOutput, RestartRequest, RestartRows};
 use crate::contact::formulation::{
-    foreign_snapshot, At, Census, Formulation, HeldFacets, PairSnapshot, SlipRate, Traits,
+    foreign_snapshot, At, Census, Formulation, HeldFacets, PairSetup, PairSnapshot, SlipRate,
+    Traits,
 };
 use crate::contact::master::MasterSide;
 use crate::contact::outcome::UzawaStats;
-use crate::contact::pair::PairSetup;
 use crate::contact::penalty;
 use crate::contact::surfaces::SlaveSurface;
 use crate::dofs::{DofMap, GlobalDof};

@@ -3,16 +3,17 @@
 //! slave–master overlaps (docs/formulation.md §13).
 //!
 //! The pair at run time:
-//! - `pair`: [`MortarPair`], its master side (`Master`: master facets or a
-//!   rigid surface), the search, and everything per node (the Uzawa
-//!   update, census, multipliers, commit); `formulation`: its duties as a
-//!   `contact::formulation::Formulation`; `setup` builds it on a rank;
-//!   `holding` decides what the rank holds (its slave facets and those
+//! - `pair`: [`MortarPair`], the search, and everything per node (the
+//!   Uzawa update, census, multipliers, commit); `formulation`: its duties
+//!   as a `contact::formulation::Formulation`; `setup` builds it on a
+//!   rank; `share` decides what the rank holds (its slave facets and those
 //!   around their nodes, the master facets near them) and numbers the
-//!   nodes it does not see;
-//! - `facet_side`: the master facets' side (candidate facet pairs, the
-//!   segment evaluation, residual and tangent); `rigid_side`: a rigid
-//!   master's (candidate slave facets, the integrals over them);
+//!   nodes it does not see (the tail, `holding`);
+//! - `master`: the master side (`Master`: master facets or a rigid
+//!   surface), each variant's run-time duties in its own module:
+//!   `facet_side` (candidate facet pairs, the segment evaluation, residual
+//!   and tangent), `rigid_side` (candidate slave facets, the integrals
+//!   over them);
 //! - `output`: the pair's point and nodal fields and force; `restart`:
 //!   taking a step over from a result file;
 //! - `tangential`: a frictional pair's nodal λT, slip origin and stick/slip
@@ -42,6 +43,7 @@ pub mod friction;
 pub mod geometry;
 mod holding;
 mod main_part;
+mod master;
 mod output;
 pub mod pair;
 mod restart;
@@ -51,6 +53,7 @@ mod rigid_side;
 mod rows;
 pub mod segment;
 mod setup;
+mod share;
 pub mod system;
 mod tangential;
 

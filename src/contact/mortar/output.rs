@@ -2,7 +2,8 @@
 //! slave nodes, the pair's force, and point values interpolated from the
 //! nodes.
 use super::friction::Rate;
-use super::pair::{Master, MortarPair};
+use super::master::Master;
+use super::pair::MortarPair;
 use super::system::NodeState;
 use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;

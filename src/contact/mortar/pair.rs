@@ -1,7 +1,7 @@
 //! A mortar contact pair at run time: candidate segments per load step,
 //! residual and tangent contributions, the nodal Uzawa update.
 //!
-//! Parallel layout: see `halo`. A rank holds the slave facets of its own
+//! Parallel layout: see `share`. A rank holds the slave facets of its own
 //! cells (assembled here) and the other ranks' facets around their nodes
 //! (evaluated only, so each node's weighted gap is complete), and the
 //! master facets near its slave nodes. Segments are integrated in a fixed
@@ -9,10 +9,9 @@
 //! that holds node `j` computes the same `g̃_j` and the same update of
 //! `λ_j` bit for bit; the owner of the node is the one that counts it in
 //! the Uzawa statistics and writes it out.
-use super::facet_side::FacetSide;
 use super::friction::{NodeFriction, Rate};
 use super::holding::Holding;
-use super::rigid_side::RigidSide;
+use super::master::Master;
 use super::segment::MortarRules;
 use super::system::{NodalData, NodeState};
 use super::tangential::PairFriction;
@@ -22,24 +21,6 @@ use crate::contact::surfaces::SlaveSurface;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use crate::fem::{FacetType, MAX_FACET_NODES};
-
-/// The master side of a mortar pair at run time.
-pub(super) enum Master {
-    /// Facets of a deformable body, held near this rank's slave nodes.
-    Facets(FacetSide),
-    /// A rigid analytic surface with its prescribed motion.
-    Rigid(RigidSide),
-}
-
-impl Master {
-    /// The master facet `m`'s position in its set (0 for a rigid master).
-    fn set_index(&self, m: u32) -> u32 {
-        match self {
-            Master::Facets(f) => f.set_index[m as usize],
-            Master::Rigid(_) => 0,
-        }
-    }
-}
 
 /// What a cut-back step restores: λ_j and λT_j of the last converged step.
 #[derive(Debug, Clone)]
@@ -159,7 +140,10 @@ impl MortarPair {
             Master::Rigid(r) => {
                 let near = self.facets_near_rigid(r, &x, factor, self.reach);
                 let candidates = self.facets_near_rigid(r, &x, factor, margin);
-                (self.facet_nodes(&near), candidates.into_iter().map(|f| (f, 0)).collect())
+                (
+                    self.facet_nodes(&near),
+                    candidates.into_iter().map(|f| (f, 0)).collect(),
+                )
             }
         };
         let key: Vec<(u32, u32)> = candidates
@@ -352,7 +336,12 @@ impl MortarPair {
     /// The nodes' states at `u_local` as the Uzawa update would find
     /// them, nothing changed: its statistics without the multiplier
     /// changes (a failed Newton solve's report).
-    pub(super) fn node_census(&self, u_local: &[f64], rate: Option<&Rate>, factor: f64) -> UzawaStats {
+    pub(super) fn node_census(
+        &self,
+        u_local: &[f64],
+        rate: Option<&Rate>,
+        factor: f64,
+    ) -> UzawaStats {
         let x = self.positions(u_local);
         let (states, frictions) = self.trial(&x, u_local, rate, factor);
         self.census_of(&states, &frictions)

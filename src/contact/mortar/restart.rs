@@ -2,7 +2,8 @@
 //! multipliers and, with friction, λT and the slip origins (the
 //! `node_lambda`, `node_lambda_t` and `node_slip_origin` datasets, rows by
 //! natural node).
-use super::pair::{Master, MortarPair};
+use super::master::Master;
+use super::pair::MortarPair;
 use crate::contact::fields::{self, RestartField, RestartRequest, RestartRows, RowSpace};
 
 impl MortarPair {

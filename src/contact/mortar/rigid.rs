@@ -91,7 +91,10 @@ pub fn distance<T: Scalar>(surface: &RigidSurface, x: &Vec3<T>) -> Option<(T, Ve
     match *surface {
         RigidSurface::Plane { point, normal } => {
             let n = autodiff::constant3::<T>(normal);
-            Some((autodiff::dot(&autodiff::sub(x, &autodiff::constant3(point)), &n), n))
+            Some((
+                autodiff::dot(&autodiff::sub(x, &autodiff::constant3(point)), &n),
+                n,
+            ))
         }
         RigidSurface::Sphere { centre, radius } => {
             radial(autodiff::sub(x, &autodiff::constant3(centre)), radius)
@@ -165,9 +168,11 @@ pub fn facets<T: Seed>(interface: &RigidInterface, rules: &MortarRules) -> Vec<R
                 for k in 0..ns {
                     let c = pw * s.n[k];
                     terms.d[j][k] += c;
-                    terms.force[j][k] = autodiff::sub(&terms.force[j][k], &autodiff::scale_f64(&n, c));
+                    terms.force[j][k] =
+                        autodiff::sub(&terms.force[j][k], &autodiff::scale_f64(&n, c));
                 }
-                terms.normal[j] = autodiff::add(&terms.normal[j], &autodiff::scale_f64(&n, s.n[j] * w0));
+                terms.normal[j] =
+                    autodiff::add(&terms.normal[j], &autodiff::scale_f64(&n, s.n[j] * w0));
             }
         }
         out.push(terms);

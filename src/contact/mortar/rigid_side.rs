@@ -10,6 +10,7 @@
 //! same ghosted positions and the same placed surface, so every rank that
 //! holds node `j` computes the same `g̃_j`, `λ_j` and `λT_j`.
 use super::friction::{Increment, NodeFriction, Rate};
+use super::master::RigidSide;
 use super::output::OutputRows;
 use super::pair::MortarPair;
 use super::rigid::{self, RigidFacet, RigidInterface, RD};
@@ -18,37 +19,7 @@ use super::rows::Rows;
 use super::system::{self, NodeState};
 use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Seed;
-use crate::contact::master::RigidMaster;
 use crate::error::Result;
-
-/// The rigid master of a mortar pair.
-#[derive(Debug, Clone)]
-pub(super) struct RigidSide {
-    pub master: RigidMaster,
-    /// Per slot: how many facets this rank evaluates hold the node (all of
-    /// them must be integrated for its weighted gap to be whole).
-    pub expected: Vec<u32>,
-    /// Load factor of the last converged step and of the last Uzawa update:
-    /// the quasi-static slip measures the master's translation from the first.
-    pub start_factor: f64,
-    pub last_factor: f64,
-}
-
-impl RigidSide {
-    /// `slots`: the pair's slave node per slot; `facet_count`: per slave
-    /// node, the evaluated facets that hold it.
-    pub fn new(master: RigidMaster, slots: &[u32], facet_count: &[usize]) -> Self {
-        RigidSide {
-            master,
-            expected: slots
-                .iter()
-                .map(|&n| facet_count[n as usize] as u32)
-                .collect(),
-            start_factor: 0.0,
-            last_factor: 0.0,
-        }
-    }
-}
 
 /// One evaluation against the rigid master.
 struct RigidEvaluation<T> {

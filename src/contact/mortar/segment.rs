@@ -367,7 +367,10 @@ pub(super) fn reference_distortion(facet: FacetType, x: &[[f64; 3]]) -> f64 {
             let a1 = combine([-1.0, 1.0, 1.0, -1.0]);
             let a2 = combine([-1.0, -1.0, 1.0, 1.0]);
             let b = combine([1.0, -1.0, 1.0, -1.0]);
-            super::bilinear::distortion(autodiff::norm(&b), autodiff::norm(&autodiff::cross(&a1, &a2)))
+            super::bilinear::distortion(
+                autodiff::norm(&b),
+                autodiff::norm(&autodiff::cross(&a1, &a2)),
+            )
         }
     }
 }

@@ -1,11 +1,11 @@
 //! Building a mortar pair on one rank: the slave facets it evaluates (see
-//! `holding`), the nodal slots with their areas, element sizes and penalties,
+//! `share`), the nodal slots with their areas, element sizes and penalties,
 //! and which of them this rank completes and owns.
-use super::facet_side::FacetSide;
-use super::holding::{self, Holding};
-use super::pair::{Master, MortarPair};
-use super::rigid_side::RigidSide;
+use super::holding::Holding;
+use super::master::{FacetSide, Master, RigidSide};
+use super::pair::MortarPair;
 use super::segment::MortarRules;
+use super::share;
 use super::system::NodalData;
 use super::tangential::PairFriction;
 use crate::assembly::RankExchange;
@@ -27,7 +27,10 @@ fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
 fn shortest_edge(x: &[[f64; 3]]) -> f64 {
     (0..x.len())
         .map(|i| {
-            crate::contact::autodiff::norm(&crate::contact::autodiff::sub(&x[i], &x[(i + 1) % x.len()]))
+            crate::contact::autodiff::norm(&crate::contact::autodiff::sub(
+                &x[i],
+                &x[(i + 1) % x.len()],
+            ))
         })
         .fold(f64::INFINITY, f64::min)
 }
@@ -56,7 +59,7 @@ impl MortarPair {
             MasterSpec::Surface { set } => Some(set.as_str()),
             MasterSpec::Rigid(_) => None,
         };
-        let share = holding::slave_share(mesh, dofs, &spec.slave, master_set, ranks)?;
+        let share = share::slave_share(mesh, dofs, &spec.slave, master_set, ranks)?;
         // Slave node ids in natural order.
         let mut nodes: Vec<(u64, [GlobalDof; DIM], [f64; 3])> = share
             .facets

@@ -215,7 +215,8 @@ fn dual_basis_is_biorthogonal_and_sums_to_one() {
             let t = |c: usize| -> [f64; 3] {
                 [0, 1, 2].map(|i| (0..n).map(|k| s.dn[k][c] * x[k][i]).sum())
             };
-            let jw = crate::contact::autodiff::norm(&crate::contact::autodiff::cross(&t(0), &t(1))) * w;
+            let jw =
+                crate::contact::autodiff::norm(&crate::contact::autodiff::cross(&t(0), &t(1))) * w;
             let phi = dual_values(&a, &s.n, n);
             assert!((phi[..n].iter().sum::<f64>() - 1.0).abs() < 1e-13);
             for j in 0..n {

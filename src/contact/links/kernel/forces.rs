@@ -4,8 +4,8 @@
 use super::friction::{friction_traction, slip_increment};
 use super::input::{dof_count, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory};
 use super::kinematics::{kinematics, tangential, Frame, Kinematics};
-use crate::contact::penalty::trial_pressure;
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
+use crate::contact::penalty::trial_pressure;
 use crate::fem::shape::facet_shape;
 use crate::fem::MAX_FACET_NODES;
 
@@ -30,7 +30,10 @@ pub(super) fn link_forces<T: Scalar>(
     // carries derivatives (in the f64 pass this changes nothing).
     let main_part = input.main_part_tangent && input.friction.is_none();
     let mut common = if main_part {
-        autodiff::scale(&autodiff::constant3::<T>(autodiff::re3(&kin.normal)), -pressure)
+        autodiff::scale(
+            &autodiff::constant3::<T>(autodiff::re3(&kin.normal)),
+            -pressure,
+        )
     } else {
         autodiff::scale(&kin.normal, -pressure)
     };

@@ -66,7 +66,11 @@ fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Ve
             SlipHistory::Convected { lambda, .. },
         ) => {
             // Contravariant basis m^α = M^{αβ} τ_β, so that λT·τ_α = λ_α.
-            let (m11, m12, m22) = (autodiff::dot(t1, t1), autodiff::dot(t1, t2), autodiff::dot(t2, t2));
+            let (m11, m12, m22) = (
+                autodiff::dot(t1, t1),
+                autodiff::dot(t1, t2),
+                autodiff::dot(t2, t2),
+            );
             let det = m11 * m22 - m12 * m12;
             let c1 = (m22 * lambda[0] - m12 * lambda[1]) / det;
             let c2 = (m11 * lambda[1] - m12 * lambda[0]) / det;

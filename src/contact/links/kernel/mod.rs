@@ -56,8 +56,8 @@ mod normal;
 mod tests;
 
 pub use input::{
-    check_buffers, check_input, dof_count, Friction, FrictionState, LinkError,
-    LinkInput, LinkMaster, LinkState, SlipHistory, SlipRate,
+    check_buffers, check_input, dof_count, Friction, FrictionState, LinkError, LinkInput,
+    LinkMaster, LinkState, SlipHistory, SlipRate,
 };
 pub use normal::potential;
 
