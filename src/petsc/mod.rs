@@ -1,10 +1,10 @@
 //! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers the
-//! rest of the program uses. This is the only place with `unsafe` besides MPI
-//! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
+//! rest of the program uses. With `runtime/` (process signals and malloc) the
+//! only place with `unsafe`; every PETSc error code becomes a [`PetscError`]
+//! naming the call.
 pub mod condensed;
 pub mod condensed_state;
 pub mod dense;
-pub mod heap;
 mod linear_floor;
 pub mod log;
 pub mod low_rank;
@@ -16,7 +16,6 @@ pub mod scatter;
 pub mod schur;
 mod schur_preconditioner;
 mod shell;
-pub mod signals;
 mod slope;
 pub mod snes;
 pub mod sys;

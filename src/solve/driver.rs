@@ -510,11 +510,12 @@ impl LoadSteps<'_> {
     /// SIGINT, every rank ends the run here (the signal reaches the ranks at
     /// different moments, so each asks all the others).
     fn stop_if_signalled(&self) -> Result<()> {
-        let local = crate::petsc::signals::received().unwrap_or(0);
+        let local = crate::runtime::signals::received().unwrap_or(0);
         let [signal] = parallel::max(&self.world, [f64::from(local)]);
         if signal > 0.0 {
             return Err(Error::Stopped {
                 signal: signal as i32,
+                name: crate::runtime::signals::name(signal as i32),
                 step: self.first_step + self.reports.len(),
                 load_factor: self.done,
             });

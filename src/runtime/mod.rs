@@ -1,5 +1,13 @@
-//! Process start-up and shut-down: MPI first, then PETSc on the same
-//! communicator; PETSc finalised before MPI.
+//! The process around a run: start-up and shut-down (MPI first, then
+//! PETSc on the same communicator; PETSc finalised before MPI), the C heap's
+//! settings (`heap`) and the termination signals (`signals`).
+//!
+//! `runtime/` (process signals and malloc, through libc) and `petsc/`
+//! (the PETSc and LAPACK bindings) are the only places with `unsafe` code;
+//! each block says why it holds.
+pub mod heap;
+pub mod signals;
+
 use crate::error::{Error, Result};
 use crate::petsc::PetscGuard;
 use mpi::topology::{Communicator, SimpleCommunicator};
@@ -18,8 +26,8 @@ impl Runtime {
     /// included), e.g. `["-ksp_type", "cg"]`.
     pub fn start(petsc_args: &[String]) -> Result<Self> {
         run_alone_without_a_daemon();
-        // Before MPI and PETSc allocate (see `petsc::heap`).
-        crate::petsc::heap::restore_malloc_defaults();
+        // Before MPI and PETSc allocate (see `heap`).
+        heap::restore_malloc_defaults();
         let universe =
             mpi::initialize().ok_or_else(|| Error::Mpi("MPI was already initialised".into()))?;
         let world = universe.world();
@@ -28,7 +36,7 @@ impl Runtime {
         let petsc = PetscGuard::initialize(&world, &args)?;
         // After PETSc's start-up, which installs its own handlers: a
         // termination signal then ends the run at a step boundary.
-        crate::petsc::signals::defer_termination(world.rank() == 0).map_err(|e| {
+        signals::defer_termination(world.rank() == 0).map_err(|e| {
             let why = format!("cannot install the SIGTERM/SIGINT handler: {e}");
             Error::Io(std::io::Error::new(e.kind(), why))
         })?;
