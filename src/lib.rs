@@ -25,7 +25,8 @@ pub mod dofs;
 pub mod error;
 pub mod exchange;
 pub mod fem;
-pub mod footprint;
+pub mod hertz;
+pub mod memory;
 pub mod mesh;
 pub mod model;
 pub mod output;
@@ -40,6 +41,5 @@ pub mod scene;
 pub mod setup_only;
 pub mod solve;
 pub mod vec3;
-pub mod verify;
 
 pub use error::{Error, Result};

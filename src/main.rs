@@ -1,6 +1,6 @@
 //! The `contactlink` command line: run a scene, list the built-in scenes,
 //! check a scene without solving, summarise or plot a result file.
-use contactlink::footprint::Footprint;
+use contactlink::memory::Footprint;
 use contactlink::pipeline::{self, RunOptions};
 use contactlink::runtime::Runtime;
 use contactlink::scene::BUILTIN;
@@ -193,7 +193,7 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
             // One process, no partition or matrix: what the model alone costs.
             println!(
                 "memory: peak resident {:.1} MiB (this process, model only); scene and mesh built in {seconds:.2} s",
-                contactlink::footprint::peak_mib().unwrap_or(0.0)
+                contactlink::memory::peak_mib().unwrap_or(0.0)
             );
             ExitCode::SUCCESS
         }
@@ -219,7 +219,7 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     let result = pipeline::run_scene(&rt, scene, &cli.run);
     // Collective, on every rank whatever the outcome (failures are agreed).
     let footprint = Footprint::over_ranks(&rt.world());
-    contactlink::footprint::checkpoint("the run");
+    contactlink::memory::checkpoint("the run");
     // One error line under MPI: failures are agreed (every failing rank
     // holds the same text), so the lowest rank that has it prints it.
     let printer = contactlink::parallel::lowest_rank(&rt.world(), result.is_err());

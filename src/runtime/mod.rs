@@ -42,8 +42,8 @@ impl Runtime {
         })?;
         // Set-up time counts from here: the scene, the mesh, the partition
         // and the matrix, not MPI's and PETSc's own start-up.
-        crate::footprint::setup_started();
-        crate::footprint::checkpoint("MPI and PETSc start-up");
+        crate::memory::setup_started();
+        crate::memory::checkpoint("MPI and PETSc start-up");
         Ok(Runtime {
             _petsc: petsc,
             universe,

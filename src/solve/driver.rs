@@ -601,7 +601,7 @@ impl LoadSteps<'_> {
         if self.echo {
             print_step(&report);
         }
-        crate::footprint::checkpoint("load step (solver and preconditioner alive)");
+        crate::memory::checkpoint("load step (solver and preconditioner alive)");
         let pair_fields: Vec<PairFields> = self
             .mech
             .contact
@@ -623,7 +623,7 @@ impl LoadSteps<'_> {
             )
         })?;
         drop(pair_fields);
-        crate::footprint::checkpoint("step output");
+        crate::memory::checkpoint("step output");
         output_mark.book(
             Phase::Output,
             &mut self.times,

@@ -164,7 +164,7 @@ impl<'a> Mechanics<'a> {
     /// scatter for the facets now held. Collective.
     pub fn exchange_masters(&mut self, x: &Vector) -> Result<()> {
         let dofs = self.dofs;
-        let ranks = super::halo::MpiRanks(SimpleCommunicator::world());
+        let ranks = crate::assembly::MpiRanks(SimpleCommunicator::world());
         self.with_state(x, |u, pairs| {
             let u = &u[..DIM * dofs.num_local_nodes()];
             let mut base = 0;
@@ -654,7 +654,7 @@ impl NonlinearProblem for Mechanics<'_> {
         let local = self.jacobian_impl(x, j);
         if self.jacobian_evaluations == 1 {
             // Before the first preconditioner set-up, which comes next.
-            crate::footprint::checkpoint("first Jacobian");
+            crate::memory::checkpoint("first Jacobian");
         }
         self.agree(local)
     }

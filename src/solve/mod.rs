@@ -13,7 +13,6 @@ pub mod boundary;
 mod driver;
 pub mod dynamics;
 mod failure;
-pub mod halo;
 pub mod lagging;
 mod master_tail;
 pub mod mechanics;

@@ -5,7 +5,7 @@ use crate::contact::dual::norm;
 use crate::contact::multipliers::{FrictionRecord, PointFriction};
 use crate::contact::outcome::PairForce;
 use crate::error::Result;
-use crate::verify::{facet_samples, NodalSample};
+use crate::hertz::{facet_samples, NodalSample};
 
 /// Point values for output, for this rank's slave points.
 pub struct PointValues {
@@ -71,7 +71,7 @@ impl ContactPair {
     /// every facet of this rank that has one of them as a corner (reference
     /// configuration), so that a reader can form ∫N_j p dA / ∫N_j dA of a
     /// closed-form pressure p: what the nodal pressure of
-    /// [`Self::node_values`] approximates (verify::fit_nodal_averages). Each
+    /// [`Self::node_values`] approximates (hertz::fit_nodal_averages). Each
     /// facet is on one rank only, so the samples of all ranks together
     /// cover each node's support once. (The facets were checked when the
     /// surface was built, so none fails here.)
