@@ -1,12 +1,16 @@
 //! The process around a run: start-up and shut-down (MPI first, then
 //! PETSc on the same communicator; PETSc finalised before MPI), the C heap's
-//! settings (`heap`) and the termination signals (`signals`).
+//! settings (`heap`), the termination signals (`signals`) and the CPU clock
+//! (`clock`).
 //!
-//! `runtime/` (process signals and malloc, through libc) and `petsc/`
-//! (the PETSc and LAPACK bindings) are the only places with `unsafe` code;
-//! each block says why it holds.
+//! `runtime/` (process signals, malloc and the clock, through libc) and
+//! `petsc/` (the PETSc and LAPACK bindings) are the only places with
+//! `unsafe` code; each block says why it holds.
+mod clock;
 pub mod heap;
 pub mod signals;
+
+pub use clock::cpu_seconds;
 
 use crate::error::{Error, Result};
 use crate::petsc::PetscGuard;

@@ -12,8 +12,8 @@ use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
+use crate::linsolve::Condensed;
 use crate::parallel::{self, fault, fault::FaultPhase};
-use crate::petsc::condensed_state::Condensed;
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Vector};
 use mpi::topology::SimpleCommunicator;
@@ -52,7 +52,7 @@ pub struct Mechanics<'a> {
     /// the Krylov path.
     pub state_change_steps: bool,
     /// Newton on the condensed contact system (the Schur paths'; see
-    /// `petsc::condensed` and `petsc::low_rank`): while its step is active
+    /// `linsolve`): while its step is active
     /// the SNES vector is the condensed one and so is the residual.
     pub condensed: Option<Condensed>,
     stages: Stages,

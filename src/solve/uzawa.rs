@@ -11,10 +11,10 @@ use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
 use super::penalty::{Progress, PENALTY_RAISE, PENALTY_RAISES, RATE_RAISE, RATE_RAISES};
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
-use super::schur;
 use super::tolerance;
 use crate::contact::{ContactPair, UzawaStats};
 use crate::error::Result;
+use crate::linsolve;
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::{Matrix, Snes, SnesOutcome, Vector};
 use mpi::traits::*;
@@ -84,9 +84,9 @@ pub(super) fn uzawa_loop(
         ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
     // The condensed Newton iterates are the whole vector's only with no
     // step-length test (stol compares norms of the whole x and step).
-    let condensed = stol == 0.0 && schur::condenses(ctx.snes);
+    let condensed = stol == 0.0 && linsolve::condenses(ctx.snes);
     if condensed {
-        schur::arm(ctx.snes, ctx.x)?;
+        linsolve::arm(ctx.snes, ctx.x)?;
     }
     let mut result = uzawa_rounds(
         world,
@@ -97,17 +97,17 @@ pub(super) fn uzawa_loop(
         (stol, max_it, condensed),
         (&mut softened, &mut main_part),
     );
-    if schur::condenses(ctx.snes) {
+    if linsolve::condenses(ctx.snes) {
         // The converged step's interior, formed once (a failed one is
         // dropped: the step starts again from the last converged state; an
         // uncovered one goes on from this state).
         if matches!(result, Ok(Ok(_) | Err(StepFailure::Uncovered { .. }))) {
-            let expanded = schur::expand(ctx.snes, ctx.x);
+            let expanded = linsolve::expand(ctx.snes, ctx.x);
             if let Err(e) = expanded {
                 result = Err(e);
             }
         }
-        schur::disarm(ctx.snes);
+        linsolve::disarm(ctx.snes);
     }
     if condensed {
         // The condensed iterates hold the true state on the contact DOFs
@@ -194,7 +194,7 @@ fn uzawa_rounds(
         snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
         if linear_floor > 0.0 {
             let contact = !mech.contact.is_empty();
-            snes.set_linear_floor(if contact { linear_floor } else { 0.0 })?;
+            linsolve::set_linear_floor(snes, if contact { linear_floor } else { 0.0 })?;
         }
         // Between Uzawa iterations only λ changes, so the tangent barely
         // does: keep the preconditioner (the LU factors) of the first solve.
