@@ -54,6 +54,31 @@ impl Runtime {
         })
     }
 
+    /// The options given to this run (command line, PETSC_OPTIONS, a
+    /// scene's `petsc_options`) that neither this program nor PETSc read on
+    /// any rank (`petsc::options::unread`), as (name, value): rank 0's
+    /// list, each kept if no rank read it. Collective; at the end of a run.
+    pub fn unread_options(&self) -> Result<Vec<(String, String)>> {
+        let world = self.world();
+        let local = crate::petsc::options::unread().map_err(Error::from);
+        let rank0 = crate::parallel::agree(&world, local)?;
+        let text: String = rank0
+            .iter()
+            .map(|(k, v)| format!("{k}{FIELD}{v}{RECORD}"))
+            .collect();
+        let text = crate::parallel::broadcast_text(&world, 0, &text);
+        let mut unread = Vec::new();
+        for entry in text.split(RECORD).filter(|e| !e.is_empty()) {
+            let (key, value) = entry.split_once(FIELD).unwrap_or((entry, ""));
+            let here = crate::petsc::options::was_read(key).map_err(Error::from);
+            let read_here = crate::parallel::agree(&world, here)?;
+            if !crate::parallel::any_rank(&world, read_here) {
+                unread.push((key.to_owned(), value.to_owned()));
+            }
+        }
+        Ok(unread)
+    }
+
     pub fn world(&self) -> SimpleCommunicator {
         self.universe.world()
     }
@@ -66,6 +91,11 @@ impl Runtime {
         self.universe.world().size() as usize
     }
 }
+
+/// The separators of [`Runtime::unread_options`]'s broadcast: between an
+/// option's name and value, and after each option (no option holds them).
+const FIELD: char = '\u{1f}';
+const RECORD: char = '\u{1e}';
 
 /// A process started without a launcher (`contactlink run scene.toml`) is an
 /// MPI singleton. Open MPI then forks a daemon (`orted`) for it, and its
