@@ -92,7 +92,7 @@ pub struct LowRankPreconditioner {
     m: Option<DenseMatrix>,
     m_rhs: Option<Vector>,
     m_sol: Option<Vector>,
-    /// Newton on the condensed system (`condensed`), shared with the
+    /// Newton on the condensed system (`newton`), shared with the
     /// residual; None: every solve is a whole one.
     reduced: Option<Rc<RefCell<Reduced>>>,
     /// `-log_view` stages of G's columns and of the dense set-ups.
