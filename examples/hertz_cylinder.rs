@@ -17,13 +17,13 @@
 //! second; the built-in `hertz-cylinder` scene uses 0.1). With OUT.h5 the
 //! result file is written (`examples/plot_pressure.py` plots it).
 use contactlink::fem::Material;
+use contactlink::hertz::{effective_modulus, HertzCheck, HertzKind};
 use contactlink::mesh::generate::{hertz_cylinder, HertzCylinderSpec};
 use contactlink::mesh::Mesh;
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
 use contactlink::model::{MasterSpec, PairSpec};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
-use contactlink::verify::{effective_modulus, HertzCheck, HertzKind};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

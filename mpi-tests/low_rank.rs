@@ -1,7 +1,7 @@
 //! The contact Schur path on several ranks (`[solver] contact_schur`): K
 //! factored once in parallel and each Jacobian solved through the low-rank
-//! update on the contact DOFs (`petsc::low_rank`; by default Newton on the
-//! condensed contact system, `petsc::low_rank::condensed`), against the old path
+//! update on the contact DOFs (`linsolve::low_rank`; by default Newton on the
+//! condensed contact system, `linsolve::low_rank::newton`), against the old path
 //! (K + Kc factored whole at each rebuild). On one rank the same comparison
 //! runs the one-rank Schur path.
 use contactlink::pipeline;

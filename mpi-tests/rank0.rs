@@ -36,9 +36,9 @@ pub fn only_rank_0_holds_the_mesh(rt: &Runtime) -> Result<(), String> {
         } else {
             &[]
         };
-        let before = contactlink::footprint::resident_mib();
+        let before = contactlink::memory::resident_mib();
         let loaded = load::on_root(&rt.world(), scene, over).map_err(|e| e.to_string())?;
-        let after = contactlink::footprint::resident_mib();
+        let after = contactlink::memory::resident_mib();
         let (nodes, cells, bytes) = match &loaded.mesh {
             Some(m) => (
                 m.num_nodes(),

@@ -55,11 +55,12 @@ pub enum Error {
     /// SIGTERM or SIGINT reached a rank; all ranks stopped together at the
     /// end of a load step (every converged step is written).
     #[error(
-        "stopped by {} after load step {step} (load factor {load_factor:.6}); every converged step is written",
-        crate::petsc::signals::name(*signal)
+        "stopped by {name} after load step {step} (load factor {load_factor:.6}); every converged step is written"
     )]
     Stopped {
         signal: i32,
+        /// The signal's conventional name (`runtime::signals::name`).
+        name: &'static str,
         step: usize,
         load_factor: f64,
     },

@@ -14,6 +14,8 @@
 //! `model` is the problem as plain data between `scene` and `solve` (a program
 //! may build it in code instead of reading a scene).
 //! `parallel` is where rank-local outcomes become one decision of all ranks.
+//! `linsolve` holds the linear solves `solve` adds to PETSc's own (the
+//! contact Schur path, condensed Newton).
 //! `pipeline` strings these together for one run; `petsc` and `runtime` are
 //! the only places that touch C libraries directly.
 pub mod amplitude;
@@ -25,7 +27,9 @@ pub mod dofs;
 pub mod error;
 pub mod exchange;
 pub mod fem;
-pub mod footprint;
+pub mod hertz;
+pub mod linsolve;
+pub mod memory;
 pub mod mesh;
 pub mod model;
 pub mod output;
@@ -40,6 +44,5 @@ pub mod scene;
 pub mod setup_only;
 pub mod solve;
 pub mod vec3;
-pub mod verify;
 
 pub use error::{Error, Result};

@@ -1,6 +1,6 @@
 //! The `contactlink` command line: run a scene, list the built-in scenes,
 //! check a scene without solving, summarise or plot a result file.
-use contactlink::footprint::Footprint;
+use contactlink::memory::Footprint;
 use contactlink::pipeline::{self, RunOptions};
 use contactlink::runtime::Runtime;
 use contactlink::scene::BUILTIN;
@@ -27,7 +27,8 @@ FROM.h5 (multipliers and friction history included) and writes the remaining ste
 OUT.h5 (which must be another file), numbered on from there.
 Any other option starting with '-' goes to PETSc (e.g. -ksp_type gmres -snes_monitor);
 PETSC_OPTIONS in the environment is read too. Options given here override the scene's
-[solver] petsc_options and the program's defaults.
+[solver] petsc_options and the program's defaults; a run that ends names the ones
+nobody read in one warning line.
 
 run prints one line per load step when its output goes to a terminal (under mpirun:
 when mpirun's does) or with -v (--verbose),
@@ -193,7 +194,7 @@ fn check(scene: &str, overrides: &[String]) -> ExitCode {
             // One process, no partition or matrix: what the model alone costs.
             println!(
                 "memory: peak resident {:.1} MiB (this process, model only); scene and mesh built in {seconds:.2} s",
-                contactlink::footprint::peak_mib().unwrap_or(0.0)
+                contactlink::memory::peak_mib().unwrap_or(0.0)
             );
             ExitCode::SUCCESS
         }
@@ -219,14 +220,29 @@ fn run(scene: &str, cli: &Cli) -> ExitCode {
     let result = pipeline::run_scene(&rt, scene, &cli.run);
     // Collective, on every rank whatever the outcome (failures are agreed).
     let footprint = Footprint::over_ranks(&rt.world());
-    contactlink::footprint::checkpoint("the run");
+    contactlink::memory::checkpoint("the run");
     // One error line under MPI: failures are agreed (every failing rank
     // holds the same text), so the lowest rank that has it prints it.
     let printer = contactlink::parallel::lowest_rank(&rt.world(), result.is_err());
+    // Collective, whatever the outcome.
+    let unread = rt.unread_options();
     let code = match result {
         Ok(summary) => {
             if let (0, Some(p)) = (rank, &summary.output) {
                 record_footprint(p, &footprint);
+            }
+            // A run that failed may have stopped before it read them: only
+            // a whole run's are reported.
+            match &unread {
+                Ok(unread) => {
+                    if let (0, Some(line)) = (rank, unread_warning(unread)) {
+                        eprintln!("{line}");
+                    }
+                }
+                Err(e) if rank == 0 => {
+                    eprintln!("contactlink: warning: the unread options: {e}")
+                }
+                Err(_) => {}
             }
             // The summary prints unless -q (scripts parse its `done:` and
             // `Hertz:` lines); the per-step lines were decided in parse_args.
@@ -358,6 +374,50 @@ fn failure_code(e: &contactlink::Error) -> ExitCode {
     }
 }
 
+/// The flags of `contactlink run` that take a value, and what the value is:
+/// an option nobody read that starts with one of them and '=' or a space
+/// is the flag glued to its value (`'--set output.path=x.h5'` as one word,
+/// which starts with '-' and so went to PETSc).
+const VALUE_FLAGS: [(&str, &str); 5] = [
+    ("--set", "key=value"),
+    ("--output", "the file name"),
+    ("--restart", "the file name"),
+    ("--step", "the step number"),
+    ("-o", "the file name"),
+];
+
+/// The one warning line naming the options nobody read (name, value),
+/// with what was meant where one is a flag of ours glued to its value.
+fn unread_warning(unread: &[(String, String)]) -> Option<String> {
+    if unread.is_empty() {
+        return None;
+    }
+    let named: Vec<String> = unread
+        .iter()
+        .map(|(key, value)| {
+            let word = if value.is_empty() {
+                key.clone()
+            } else {
+                format!("{key} {value}")
+            };
+            let glued = VALUE_FLAGS.iter().find(|(flag, _)| {
+                key.strip_prefix(flag)
+                    .is_some_and(|rest| rest.starts_with(['=', ' ']))
+            });
+            match glued {
+                Some((flag, what)) => {
+                    format!("'{word}' (pass {flag} and {what} as two words)")
+                }
+                None => word,
+            }
+        })
+        .collect();
+    Some(format!(
+        "contactlink: warning: PETSc options nobody read: {}",
+        named.join(", ")
+    ))
+}
+
 /// `/footprint` in the closed result file; a failure only warns (the
 /// results are written; the other ranks have moved on).
 fn record_footprint(path: &std::path::Path, footprint: &Footprint) {
@@ -479,5 +539,44 @@ fn plot(file: &str, cli: &Cli) -> ExitCode {
             eprintln!("contactlink: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unread_warning;
+
+    fn pairs(p: &[(&str, &str)]) -> Vec<(String, String)> {
+        p.iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn the_unread_options_make_one_line() {
+        assert_eq!(unread_warning(&[]), None);
+        assert_eq!(
+            unread_warning(&pairs(&[("-ksp_tpye", "gmres"), ("-snes_monitr", "")])).unwrap(),
+            "contactlink: warning: PETSc options nobody read: -ksp_tpye gmres, -snes_monitr"
+        );
+    }
+
+    #[test]
+    fn a_flag_glued_to_its_value_is_told_apart() {
+        let line = unread_warning(&pairs(&[
+            ("--set output.path=x.h5", ""),
+            ("-o=out.h5", ""),
+            ("-options_file", "x"),
+        ]))
+        .unwrap();
+        assert!(
+            line.contains("'--set output.path=x.h5' (pass --set and key=value as two words)"),
+            "{line}"
+        );
+        assert!(
+            line.contains("'-o=out.h5' (pass -o and the file name as two words)"),
+            "{line}"
+        );
+        assert!(line.ends_with(", -options_file x"), "{line}");
     }
 }

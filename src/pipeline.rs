@@ -4,6 +4,7 @@
 pub mod load;
 
 use crate::error::Result;
+use crate::hertz::{HertzCheck, HertzComparison, NodalSample};
 use crate::model::Model;
 use crate::output::paths::{check_not_input, Input};
 use crate::output::{create_result_file, Hdf5Sink, HistoryCsv, Provenance, Tee};
@@ -12,7 +13,6 @@ use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::scene::{self, SceneSource};
 use crate::solve::{PairFields, RunReport, Simulation, StepReport, StepSink};
-use crate::verify::{HertzCheck, HertzComparison, NodalSample};
 use mpi::traits::CommunicatorCollectives;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -321,7 +321,7 @@ impl StepSink for HertzObserver {
         let points: Vec<[f64; 3]> = points.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let samples = self.loaded_node_samples(fields.pair, &points, &pressure);
         let force = report.contact.get(i).map_or([0.0; 3], |c| c.force);
-        self.last = crate::verify::compare(check, &points, &pressure, &samples, force);
+        self.last = crate::hertz::compare(check, &points, &pressure, &samples, force);
         Ok(())
     }
 }

@@ -3,8 +3,8 @@
 //! it says so) and reads the HDF5 file it wrote.
 mod common;
 use common::*;
+use contactlink::hertz::{self, HertzCheck, HertzKind};
 use contactlink::output::{layout, list_steps, read_dataset, read_nodal};
-use contactlink::verify::{self, HertzCheck, HertzKind};
 use std::path::Path;
 
 fn last_step(path: &Path) -> usize {
@@ -171,7 +171,7 @@ fn patch_test_pressure_is_uniform_up_to_the_measured_deviation() {
 // Measured when written: 0.68 % (nodal), 36 % (individual Gauss-point multipliers).
 const NODAL_PATCH_BOUND: f64 = 0.02;
 
-fn hertz_line(out: &Path) -> verify::HertzComparison {
+fn hertz_line(out: &Path) -> hertz::HertzComparison {
     let step = last_step(out);
     let nodal: Vec<([f64; 3], f64)> = nodal_pressure_on(out, step, "cylinder.curved")
         .into_iter()
@@ -188,9 +188,9 @@ fn hertz_line(out: &Path) -> verify::HertzComparison {
         kind: HertzKind::Line { thickness: 1.0 },
         pair: "hertz".into(),
         radius: 10.0,
-        effective_modulus: verify::effective_modulus(1000.0, 0.3, 1000.0, 0.3),
+        effective_modulus: hertz::effective_modulus(1000.0, 0.3, 1000.0, 0.3),
     };
-    verify::compare(&check, &pts, &p, &[], [f[0], f[1], f[2]]).expect("a pressure profile")
+    hertz::compare(&check, &pts, &p, &[], [f[0], f[1], f[2]]).expect("a pressure profile")
 }
 
 #[test]
@@ -362,9 +362,9 @@ fn hertz_sphere_on_a_coarse_mesh_is_close_to_closed_form() {
         kind: HertzKind::Point,
         pair: "hertz".into(),
         radius: 10.0,
-        effective_modulus: verify::effective_modulus(1000.0, 0.3, 1000.0, 0.3),
+        effective_modulus: hertz::effective_modulus(1000.0, 0.3, 1000.0, 0.3),
     };
-    let c = verify::compare(&check, &pts, &p, &[], [f[0], f[1], f[2]]).expect("a pressure profile");
+    let c = hertz::compare(&check, &pts, &p, &[], [f[0], f[1], f[2]]).expect("a pressure profile");
     println!(
         "sphere: F = {:.5}, p0 {:.5} vs {:.5} ({:+.3} %), a {:.5} vs {:.5} ({:+.3} %)",
         c.load,

@@ -386,7 +386,7 @@ fn mortar_answers_agree_on_one_two_and_three_ranks() {
 }
 
 /// On 2 ranks a mortar pair takes the several-rank contact Schur path (K's
-/// factor with a low-rank update, `petsc::low_rank`) and answers as the
+/// factor with a low-rank update, `linsolve::low_rank`) and answers as the
 /// full factorisation and the 1-rank run do, to 1e-10. In these cases the
 /// upper block is held by the contact alone, so K is singular: the path's
 /// shifted factor is what makes it work (its first solve diverged before).

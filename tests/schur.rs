@@ -6,7 +6,7 @@
 //! and whole runs of hertz-cylinder, frictionless (LDLᵀ), with Coulomb
 //! friction over two steps and with a mortar pair (both non-symmetric:
 //! the dense LU path), with and without the Schur path.
-use contactlink::petsc::schur::SchurPreconditioner;
+use contactlink::linsolve::SchurPreconditioner;
 use contactlink::petsc::{Matrix, PatternBuilder, PetscInt, Vector};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
@@ -311,7 +311,7 @@ fn schur_path() {
     );
     // A frictional mortar pair, whose second step's line search cuts the
     // Newton step: the same step lengths as on the full factorisation
-    // (the line search's slope from the whole system, `petsc::slope`).
+    // (the line search's slope from the whole system, `linsolve::slope`).
     let frictional = [
         "mesh.fine_size=0.4",
         "contact.friction=0.2",

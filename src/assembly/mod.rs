@@ -12,7 +12,7 @@ pub mod loads;
 pub mod sink;
 
 pub use bulk::BulkAssembler;
-pub use halo::{Halo, HaloFactory, RankExchange, SingleRank};
+pub use halo::{Halo, HaloFactory, MpiRanks, PetscHalos, RankExchange, SingleRank};
 pub use loads::SurfaceLoads;
 pub use sink::{MatrixSink, PatternSink};
 

@@ -17,8 +17,8 @@ use crate::assembly::{HaloFactory, MatrixSink, PatternSink, RankExchange};
 use crate::distribution::{LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof};
 use crate::error::{Error, Result};
+use crate::hertz::{facet_samples, NodalSample};
 use crate::model::{self, PairSpec};
-use crate::verify::{facet_samples, NodalSample};
 
 pub struct ContactPair {
     pub spec: PairSpec,
@@ -344,7 +344,7 @@ impl ContactPair {
     /// every facet of this rank that has one of them as a corner (reference
     /// configuration), so that a reader can form ∫N_j p dA / ∫N_j dA of a
     /// closed-form pressure p: what the nodal pressure of the output
-    /// approximates (verify::fit_nodal_averages). Each facet is on one rank
+    /// approximates (hertz::fit_nodal_averages). Each facet is on one rank
     /// only, so the samples of all ranks together cover each node's support
     /// once. (The facets were checked when the surface was built, so none
     /// fails here.)

@@ -84,7 +84,7 @@ pub fn distribute(world: &impl Communicator, mesh: &Mesh, wanted: &Wanted) -> Re
     let part = if rank == 0 {
         // Contact slave facets are balanced over the ranks with the cells.
         let part = crate::partition::partition_cells(mesh, size, wanted.slave_sets);
-        if let (Ok(p), true) = (&part, crate::footprint::checkpoints_enabled()) {
+        if let (Ok(p), true) = (&part, crate::memory::checkpoints_enabled()) {
             let balance = crate::partition::Balance::of(mesh, p, size, wanted.slave_sets);
             eprintln!("{}", balance.line());
         }
@@ -93,7 +93,7 @@ pub fn distribute(world: &impl Communicator, mesh: &Mesh, wanted: &Wanted) -> Re
         Ok(Vec::new())
     };
     let part = parallel::agree(world, part)?;
-    crate::footprint::checkpoint("partition");
+    crate::memory::checkpoint("partition");
     if size == 1 {
         return Ok(Numbering::new(mesh, &part, 1).piece(mesh, &part, 0, wanted));
     }

@@ -21,8 +21,8 @@ pub use solver::{Reuse, SolverSettings, DEFAULT_ACCELERATION, DEFAULT_FORCING, M
 
 use crate::amplitude::Amplitude;
 use crate::fem::Material;
+use crate::hertz::HertzCheck;
 use crate::mesh::Mesh;
-use crate::verify::HertzCheck;
 
 /// A vector field of the reference position, b(X).
 pub type VectorField = Box<dyn Fn([f64; 3]) -> [f64; 3]>;

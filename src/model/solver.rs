@@ -50,11 +50,11 @@ pub struct SolverSettings {
     pub first_contact_main_tangent: bool,
     /// On the direct path with linear bodies on one rank, factor the bulk
     /// stiffness once with a Schur complement on the contact DOFs and solve
-    /// each contact Jacobian through it (see `solve::schur`).
+    /// each contact Jacobian through it (see `linsolve`).
     pub contact_schur: bool,
     /// On the contact Schur path, Newton on the condensed contact system
     /// (the same iterates; the interior formed once per step, see
-    /// `petsc::condensed` on one rank, `petsc::low_rank::condensed` on
+    /// `linsolve::schur::newton` on one rank, `linsolve::low_rank::newton` on
     /// several).
     pub condensed_newton: bool,
     /// Depth of the Anderson acceleration of the frictionless pairs'

@@ -13,8 +13,8 @@ use super::{
 use crate::amplitude::Amplitude;
 use crate::error::{Error, Result};
 use crate::fem::{CellType, Material};
+use crate::hertz::{HertzCheck, HertzKind};
 use crate::mesh::Mesh;
-use crate::verify::{HertzCheck, HertzKind};
 
 /// Words in, in the order [`Reader`] takes them out.
 #[derive(Debug, Default)]

@@ -8,10 +8,10 @@ use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
 use crate::distribution::LocalMesh;
 use crate::dofs::even_block;
 use crate::error::Result;
+use crate::hertz::{HertzCheck, HertzKind};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
 use crate::solve::{NaturalOrder, PairFields, Simulation, StepReport, StepSink};
-use crate::verify::{HertzCheck, HertzKind};
 
 /// Where a run came from, stored in the result file (`/scene`,
 /// `/scene_overrides`) so a result can be traced to its input.

@@ -1,6 +1,6 @@
 //! Distributed sparse matrices (MPIAIJ); `pattern` creates them exactly
 //! preallocated.
-use super::{petsc_call, sys, PetscInt, Result, Vector};
+use super::{comm_world, petsc_call, sys, PetscError, PetscInt, Result, Vector};
 
 pub struct Matrix {
     raw: sys::Mat,
@@ -200,6 +200,146 @@ impl Matrix {
     }
 }
 
+impl Matrix {
+    /// A square AIJ matrix with `local` rows and columns on this rank of
+    /// `global`, and `per_row[i]` non-zeros in local row i's diagonal block
+    /// (none in the off-diagonal ones; None: no preallocation). Collective.
+    pub fn new_aij(
+        local: PetscInt,
+        global: PetscInt,
+        per_row: Option<&[PetscInt]>,
+    ) -> Result<Self> {
+        if per_row.is_some_and(|p| p.len() < local.max(0) as usize) {
+            return Err(PetscError::new(
+                "MatCreateAIJ",
+                format!("fewer row lengths than the {local} local rows"),
+            ));
+        }
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: `per_row` holds an entry per local row (checked above) or
+        // is null; PETSc copies it; the matrix goes to an owning value.
+        unsafe {
+            petsc_call!(MatCreateAIJ(
+                comm_world(),
+                local,
+                local,
+                global,
+                global,
+                0,
+                per_row.map_or(std::ptr::null(), <[PetscInt]>::as_ptr),
+                0,
+                std::ptr::null(),
+                &mut raw
+            ))?
+        };
+        Ok(Matrix::owned(raw))
+    }
+
+    /// Sets a dense row-major block at global (rows, cols), replacing what
+    /// is there (off-rank rows allowed; assemble afterwards).
+    pub fn set_block(
+        &mut self,
+        rows: &[PetscInt],
+        cols: &[PetscInt],
+        values: &[f64],
+    ) -> Result<()> {
+        set_values(self.raw, rows, cols, values, sys::InsertMode_INSERT_VALUES)
+    }
+
+    /// Global (rows, columns).
+    pub fn size(&self) -> Result<(PetscInt, PetscInt)> {
+        let (mut m, mut n) = (0, 0);
+        // SAFETY: valid mat and out-pointers.
+        unsafe { petsc_call!(MatGetSize(self.raw, &mut m, &mut n))? };
+        Ok((m, n))
+    }
+
+    /// This rank's (rows, columns).
+    pub fn local_size(&self) -> Result<(PetscInt, PetscInt)> {
+        let (mut m, mut n) = (0, 0);
+        // SAFETY: valid mat and out-pointers.
+        unsafe { petsc_call!(MatGetLocalSize(self.raw, &mut m, &mut n))? };
+        Ok((m, n))
+    }
+
+    /// [first, end) of the rows this rank owns.
+    pub fn ownership_range(&self) -> Result<(PetscInt, PetscInt)> {
+        let (mut lo, mut hi) = (0, 0);
+        // SAFETY: valid mat and out-pointers.
+        unsafe { petsc_call!(MatGetOwnershipRange(self.raw, &mut lo, &mut hi))? };
+        Ok((lo, hi))
+    }
+
+    /// Vectors of the column and the row layout (x and b of A x = b).
+    /// Collective.
+    pub fn create_vecs(&self) -> Result<(Vector, Vector)> {
+        let (mut right, mut left): (sys::Vec, sys::Vec) =
+            (std::ptr::null_mut(), std::ptr::null_mut());
+        // SAFETY: valid mat; the vectors go to owning wrappers at once.
+        unsafe {
+            petsc_call!(MatCreateVecs(self.raw, &mut right, &mut left))?;
+            Ok((Vector::owned_from_raw(right), Vector::owned_from_raw(left)))
+        }
+    }
+
+    /// The diagonal into `d` (of the row layout).
+    pub fn diagonal(&self, d: &mut Vector) -> Result<()> {
+        // SAFETY: valid mat and vector (PETSc checks the layout).
+        unsafe { petsc_call!(MatGetDiagonal(self.raw, d.raw())) }
+    }
+
+    /// Adds `d` to the diagonal. Collective.
+    pub fn add_diagonal(&mut self, d: &Vector) -> Result<()> {
+        // SAFETY: valid mat and vector (PETSc checks the layout).
+        unsafe {
+            petsc_call!(MatDiagonalSet(
+                self.raw,
+                d.raw(),
+                sys::InsertMode_ADD_VALUES
+            ))
+        }
+    }
+
+    /// y = Aᵀ x
+    pub fn mult_transpose(&self, x: &Vector, y: &mut Vector) -> Result<()> {
+        // SAFETY: all valid; PETSc checks layouts.
+        unsafe { petsc_call!(MatMultTranspose(self.raw, x.raw(), y.raw())) }
+    }
+
+    /// Calls `f(row, columns, values)` for each row in `rows` of the
+    /// assembled matrix (rows this process holds: any of a sequential
+    /// matrix, the owned ones of a parallel one); an empty row comes with
+    /// empty slices. An error of `f` ends the walk (after the row's
+    /// restore) and is returned.
+    pub fn for_rows(
+        &self,
+        rows: impl Iterator<Item = PetscInt>,
+        mut f: impl FnMut(PetscInt, &[PetscInt], &[f64]) -> Result<()>,
+    ) -> Result<()> {
+        for row in rows {
+            let mut nz: PetscInt = 0;
+            let mut cols: *const PetscInt = std::ptr::null();
+            let mut vals: *const f64 = std::ptr::null();
+            // SAFETY: a valid assembled matrix holding `row` on this process;
+            // the row's pointers are read only between MatGetRow and the
+            // paired MatRestoreRow, and hold `nz` entries each.
+            unsafe {
+                petsc_call!(MatGetRow(self.raw, row, &mut nz, &mut cols, &mut vals))?;
+                let read = if nz > 0 && !cols.is_null() && !vals.is_null() {
+                    let cs = std::slice::from_raw_parts(cols, nz as usize);
+                    let vs = std::slice::from_raw_parts(vals, nz as usize);
+                    f(row, cs, vs)
+                } else {
+                    f(row, &[], &[])
+                };
+                petsc_call!(MatRestoreRow(self.raw, row, &mut nz, &mut cols, &mut vals))?;
+                read?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A dense row-major block's values match its rows and columns.
 pub(super) fn check_block(rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
     if rows.len() * cols.len() != values.len() {
@@ -218,7 +358,7 @@ pub(super) fn check_block(rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) 
 }
 
 /// MatSetValues for a dense row-major block.
-fn set_values(
+pub(super) fn set_values(
     raw: sys::Mat,
     rows: &[PetscInt],
     cols: &[PetscInt],

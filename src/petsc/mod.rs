@@ -1,32 +1,40 @@
-//! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers the
-//! rest of the program uses. This is the only place with `unsafe` besides MPI
-//! start-up; every PETSc error code becomes a [`PetscError`] naming the call.
-pub mod condensed;
-pub mod condensed_state;
+//! The PETSc binding layer: raw bindings (`sys`) and the safe RAII wrappers
+//! the rest of the program uses, over PETSc and the few LAPACK routines it
+//! calls (`lapack`): vectors, sparse and dense matrices, MUMPS factors with
+//! their Schur complement and selected inverse entries (`factor`),
+//! scatters, index sets, Newton (SNES) with Rust callbacks and the shells
+//! and hooks that put Rust state into its linear solves (`shell`,
+//! `linear_test`), options and log stages. Algorithms built on them live
+//! outside (`linsolve`, `solve`).
+//!
+//! With `runtime/` (process signals and malloc) the only place with
+//! `unsafe`; every PETSc error code becomes a [`PetscError`] naming the
+//! call.
 pub mod dense;
-pub mod heap;
-mod linear_floor;
+pub mod factor;
+pub mod index_set;
+pub mod lapack;
+pub mod linear_test;
 pub mod log;
-pub mod low_rank;
 pub mod matrix;
 pub mod options;
 mod pattern;
 pub mod reason;
 pub mod scatter;
-pub mod schur;
-mod schur_preconditioner;
-mod shell;
-pub mod signals;
-mod slope;
+pub mod shell;
 pub mod snes;
 pub mod sys;
 pub mod vector;
 
+pub use dense::DenseMatrix;
+pub use factor::Factor;
+pub use linear_test::{LinearTest, Newton, NewtonProgress};
 pub use log::LogStage;
 pub use matrix::Matrix;
 pub use pattern::PatternBuilder;
 pub use reason::{KspReason, SnesReason};
 pub use scatter::Scatter;
+pub use shell::{ShellOperator, ShellPreconditioner};
 pub use snes::{NonlinearProblem, Snes, SnesOutcome};
 pub use vector::{GhostedVector, Vector};
 
@@ -42,6 +50,17 @@ pub struct PetscError {
     pub call: &'static str,
     pub code: i32,
     pub message: String,
+}
+
+impl PetscError {
+    /// An error of the Rust side around `call` (no PETSc code).
+    pub fn new(call: &'static str, message: String) -> Self {
+        PetscError {
+            call,
+            code: -1,
+            message,
+        }
+    }
 }
 
 pub type Result<T> = std::result::Result<T, PetscError>;
@@ -168,4 +187,15 @@ impl Drop for PetscGuard {
 pub(crate) fn comm_world() -> sys::MPI_Comm {
     // SAFETY: PETSC_COMM_WORLD is written once before PetscInitialize and only read after.
     unsafe { sys::PETSC_COMM_WORLD }
+}
+
+/// This process's rank in PETSc's world communicator.
+pub fn world_rank() -> Result<i32> {
+    let mut r = 0;
+    // SAFETY: valid communicator; out-pointer is a local.
+    let code = unsafe { sys::MPI_Comm_rank(comm_world(), &mut r) };
+    if code != 0 {
+        return Err(PetscError::new("MPI_Comm_rank", format!("error {code}")));
+    }
+    Ok(r)
 }

@@ -147,6 +147,78 @@ pub fn insert_string_defaults(opts: &str) -> Result<()> {
     Ok(())
 }
 
+/// Options PETSc reads only inside PetscFinalize, after any list of unread
+/// options can be taken: they are read, just later. (`-log_view`,
+/// `-malloc_dump` and their kind are read at start-up as well.)
+const READ_AT_FINALIZE: [&str; 3] = ["-citations", "-options_left", "-options_view"];
+
+/// The options given to this run that nothing has read so far (PETSc keeps
+/// the count): from the command line, PETSC_OPTIONS or a scene's
+/// `petsc_options`, never the program's own defaults, and not those PETSc
+/// reads at finalize. As (name with its leading dash, value; "" for none),
+/// in the database's order. Rank-local: PETSc counts the reads of this
+/// process.
+pub fn unread() -> Result<Vec<(String, String)>> {
+    let mut n: super::PetscInt = 0;
+    let mut names: *mut *mut std::os::raw::c_char = std::ptr::null_mut();
+    let mut values: *mut *mut std::os::raw::c_char = std::ptr::null_mut();
+    let text = |p: *mut std::os::raw::c_char| {
+        // SAFETY: PETSc's entries are null or NUL-terminated strings of
+        // the database, alive until the restore below.
+        (!p.is_null()).then(|| {
+            unsafe { std::ffi::CStr::from_ptr(p) }
+                .to_string_lossy()
+                .into_owned()
+        })
+    };
+    let mut left = Vec::new();
+    // SAFETY: out-pointers are locals; PETSc fills two arrays of `n`
+    // entries, read only before the paired restore frees them.
+    unsafe {
+        petsc_call!(PetscOptionsLeftGet(
+            std::ptr::null_mut(),
+            &mut n,
+            &mut names,
+            &mut values
+        ))?;
+        if n > 0 && !names.is_null() && !values.is_null() {
+            let names = std::slice::from_raw_parts(names, n as usize);
+            let values = std::slice::from_raw_parts(values, n as usize);
+            for (&k, &v) in names.iter().zip(values) {
+                if let Some(k) = text(k) {
+                    left.push((format!("-{k}"), text(v).unwrap_or_default()));
+                }
+            }
+        }
+        petsc_call!(PetscOptionsLeftRestore(
+            std::ptr::null_mut(),
+            &mut n,
+            &mut names,
+            &mut values
+        ))?;
+    }
+    let ours = PROGRAM_SET.lock().unwrap_or_else(|e| e.into_inner());
+    let by_program = |k: &str| ours.iter().any(|(n, s)| n == k && *s == Source::Program);
+    left.retain(|(k, _)| !by_program(k) && !READ_AT_FINALIZE.contains(&k.as_str()));
+    Ok(left)
+}
+
+/// Whether something has read the option `name` (with its leading dash)
+/// in this process; false when it is not in the database.
+pub fn was_read(name: &str) -> Result<bool> {
+    let n = c_string(name.strip_prefix('-').unwrap_or(name))?;
+    let mut used = sys::PetscBool_PETSC_FALSE;
+    // SAFETY: valid C string, `used` is a valid out-pointer.
+    unsafe {
+        petsc_call!(PetscOptionsUsed(
+            std::ptr::null_mut(),
+            n.as_ptr(),
+            &mut used
+        ))?
+    };
+    Ok(used == sys::PetscBool_PETSC_TRUE)
+}
+
 /// The message PETSc gave where its last error started (the innermost
 /// call, e.g. "Unable to find requested KSP type nonsense") and its code.
 /// PETSc passes it only to the error handler; the code alone names a class

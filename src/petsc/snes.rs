@@ -1,11 +1,10 @@
 //! Newton's method through PETSc SNES, with residual and Jacobian computed by
 //! Rust code behind the [`NonlinearProblem`] trait.
-use super::linear_floor::{floor_test, LinearFloor};
-use super::low_rank::LowRankPreconditioner;
+use super::linear_test::{self, Hook, LinearTest};
 use super::reason::{KspReason, SnesReason};
-use super::schur::SchurPreconditioner;
-use super::slope::LastSolve;
+use super::shell::{self, OperatorShell, ShellOperator, ShellPreconditioner};
 use super::{comm_world, petsc_call, sys, Matrix, PetscError, Result, Vector};
+use std::any::Any;
 use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -81,19 +80,18 @@ struct Context<'a> {
 
 pub struct Snes {
     raw: sys::SNES,
-    /// The shell preconditioner's state, when there is one: boxed so that
-    /// its address, which the PC holds, stays fixed; dropped after the SNES
-    /// (fields go after `Drop::drop`).
-    schur: Option<Box<SchurPreconditioner>>,
-    /// The several-rank counterpart of `schur` (same rules).
-    low_rank: Option<Box<LowRankPreconditioner>>,
-    /// The linear solves' floor (`set_linear_floor`), boxed for the same
-    /// reason and dropped after the SNES too.
-    floor: Option<Box<LinearFloor>>,
-    /// On the Schur and low-rank paths, the operator the line search's
-    /// slope is taken with (`super::slope`); boxed and dropped after the
-    /// SNES, as above.
-    slope: Option<Box<LastSolve>>,
+    /// The linear solves' own convergence test (`add_linear_test`, a
+    /// `linear_test::Hook`): boxed so that its address, which the KSP
+    /// holds, stays fixed; dropped after the SNES (fields go after
+    /// `Drop::drop`), which its drop needs.
+    linear_test: Option<Box<dyn Any>>,
+    /// The shell preconditioner's state, when there is one
+    /// (`install_shell_preconditioner`): boxed and dropped after the SNES,
+    /// as above.
+    preconditioner: Option<Box<dyn Any>>,
+    /// The shell Jacobian operator, when there is one (`set_operator`):
+    /// boxed and dropped after the SNES, as above.
+    operator: Option<Box<OperatorShell>>,
     /// The line search is PETSc's backtracking one (read after the options
     /// are applied): the problem's `step_fraction` is asked before it.
     backtracking: bool,
@@ -117,10 +115,9 @@ impl Snes {
         unsafe { petsc_call!(SNESCreate(comm_world(), &mut raw))? };
         let snes = Snes {
             raw,
-            schur: None,
-            low_rank: None,
-            floor: None,
-            slope: None,
+            linear_test: None,
+            preconditioner: None,
+            operator: None,
             backtracking: false,
         };
         Ok(snes)
@@ -187,124 +184,103 @@ impl Snes {
         }
     }
 
-    /// Makes the linear solver's preconditioner the Schur-complement shell
+    /// Makes the linear solver's preconditioner a shell backed by `state`
     /// (after [`Self::set_from_options`], which would reset it).
-    pub fn install_schur(&mut self, state: SchurPreconditioner) -> Result<()> {
+    pub fn install_shell_preconditioner<T: ShellPreconditioner>(&mut self, state: T) -> Result<()> {
         let mut ksp: sys::KSP = std::ptr::null_mut();
         let mut pc: sys::PC = std::ptr::null_mut();
         let mut boxed = Box::new(state);
-        let ptr: *mut SchurPreconditioner = &mut *boxed;
-        self.schur = Some(boxed);
+        let ptr: *mut T = &mut *boxed;
+        self.preconditioner = Some(boxed);
         // SAFETY: valid snes; the KSP and PC are borrowed from it; the box
         // is kept in `self` until after the SNES (and so the PC) is destroyed,
         // and never moved out while the SNES lives.
         unsafe {
             petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
             petsc_call!(KSPGetPC(ksp, &mut pc))?;
-            super::schur::install(pc, ptr)?;
-            self.watch_solves(ksp)?;
-            // A fresh exact solve needs no Krylov iterations around it
-            // (GMRES took one each, at twice the solves); a user's
-            // -ksp_type stands.
-            if !super::options::user_set("-ksp_type")? {
-                petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
-            }
-            Ok(())
+            shell::install(pc, ptr)
         }
     }
 
-    /// Stops each linear solve of a Newton iteration once its residual has
-    /// fallen to `fraction` of what that Newton solve still has to remove,
-    /// i.e. below `fraction` · max(atol, rtol·|R0|) / |R_k| of its start,
-    /// whatever looser or tighter tolerance the linear solver had: the last
-    /// Newton iteration of a solve needs only the reduction left, not the
-    /// one the forcing sequence asks for. Keeps the KSP's own test (and the
-    /// Eisenstat–Walker tolerances it is given). 0: no floor. Collective;
-    /// after [`Self::set_from_options`].
-    pub fn set_linear_floor(&mut self, fraction: f64) -> Result<()> {
-        if let Some(f) = self.floor.as_mut() {
-            f.fraction = fraction;
-            return Ok(());
-        }
+    /// The shell preconditioner's state, if one of type `T` is installed.
+    pub fn preconditioner<T: ShellPreconditioner>(&self) -> Option<&T> {
+        self.preconditioner.as_ref()?.downcast_ref()
+    }
+
+    pub fn preconditioner_mut<T: ShellPreconditioner>(&mut self) -> Option<&mut T> {
+        self.preconditioner.as_mut()?.downcast_mut()
+    }
+
+    /// Makes the Jacobian operator of every later solve a shell backed by
+    /// `state` (over the Jacobian matrix, which stays the preconditioning
+    /// matrix), and reports each linear solve of this SNES to it.
+    pub fn set_operator(&mut self, state: impl ShellOperator) -> Result<()> {
         let mut ksp: sys::KSP = std::ptr::null_mut();
-        let mut floor = Box::new(LinearFloor {
+        let operator = self
+            .operator
+            .insert(Box::new(OperatorShell::new(Box::new(state))));
+        // SAFETY: valid snes; the KSP is borrowed from it; the box lives in
+        // `self` until after the SNES is destroyed and is never moved out
+        // while it lives.
+        unsafe { petsc_call!(SNESGetKSP(self.raw, &mut ksp))? };
+        operator.watch(ksp)
+    }
+
+    /// The linear solver applies its preconditioner once (KSP "preonly"),
+    /// unless the user chose a `-ksp_type`: for a preconditioner that
+    /// solves exactly.
+    pub fn apply_preconditioner_only(&mut self) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        // SAFETY: valid snes; the KSP is borrowed from it.
+        unsafe {
+            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
+            if !super::options::user_set("-ksp_type")? {
+                petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds `test` after the KSP's own convergence test (which it keeps,
+    /// with the Eisenstat–Walker tolerances it is given) for every linear
+    /// solve of this SNES. Collective; after [`Self::set_from_options`].
+    pub fn add_linear_test<T: LinearTest>(&mut self, test: T) -> Result<()> {
+        let mut ksp: sys::KSP = std::ptr::null_mut();
+        let mut hook = Box::new(Hook {
             snes: self.raw,
-            fraction,
             inner: None,
             inner_ctx: std::ptr::null_mut(),
             inner_destroy: None,
-            rnorm0: 0.0,
+            test,
         });
-        let ptr: *mut LinearFloor = &mut *floor;
+        let ptr: *mut Hook<T> = &mut *hook;
         // SAFETY: valid snes; the KSP is borrowed from it. The KSP's own
-        // test is taken over (not destroyed) and called from `floor_test`;
-        // the box lives in `self` until after the SNES is destroyed and is
-        // never moved out while it lives; its inner context is destroyed
-        // in `Drop`, after the SNES.
+        // test is taken over (not destroyed) and called from the hook's
+        // trampoline; the box lives in `self` until after the SNES is
+        // destroyed and is never moved out while it lives; its drop then
+        // destroys the inner context.
         unsafe {
             petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
             petsc_call!(KSPGetAndClearConvergenceTest(
                 ksp,
-                &mut floor.inner,
-                &mut floor.inner_ctx,
-                &mut floor.inner_destroy
+                &mut hook.inner,
+                &mut hook.inner_ctx,
+                &mut hook.inner_destroy
             ))?;
-            self.floor = Some(floor);
+            self.linear_test = Some(hook);
             petsc_call!(KSPSetConvergenceTest(
                 ksp,
-                Some(floor_test),
+                Some(linear_test::trampoline::<T>),
                 ptr as *mut c_void,
                 None
             ))
         }
     }
 
-    /// Makes the linear solver's preconditioner the low-rank contact
-    /// update of K's factor (several ranks; as [`Self::install_schur`]).
-    pub fn install_low_rank(&mut self, state: LowRankPreconditioner) -> Result<()> {
-        let mut ksp: sys::KSP = std::ptr::null_mut();
-        let mut pc: sys::PC = std::ptr::null_mut();
-        let mut boxed = Box::new(state);
-        let ptr: *mut LowRankPreconditioner = &mut *boxed;
-        self.low_rank = Some(boxed);
-        // SAFETY: as in `install_schur`: the box lives in `self` until after
-        // the SNES is destroyed and is never moved out while it lives.
-        unsafe {
-            petsc_call!(SNESGetKSP(self.raw, &mut ksp))?;
-            petsc_call!(KSPGetPC(ksp, &mut pc))?;
-            super::low_rank::install(pc, ptr)?;
-            self.watch_solves(ksp)?;
-            // An exact solve, as on the Schur path.
-            if !super::options::user_set("-ksp_type")? {
-                petsc_call!(KSPSetType(ksp, c"preonly".as_ptr()))?;
-            }
-            Ok(())
-        }
-    }
-
-    /// The linear solves of `ksp` (this SNES's) recorded for the line
-    /// search's slope (see `super::slope`).
-    fn watch_solves(&mut self, ksp: sys::KSP) -> Result<()> {
-        let slope = self.slope.get_or_insert_with(|| Box::new(LastSolve::new()));
-        slope.watch(ksp)
-    }
-
-    /// The low-rank preconditioner's state, if installed.
-    pub fn low_rank(&self) -> Option<&LowRankPreconditioner> {
-        self.low_rank.as_deref()
-    }
-
-    pub fn low_rank_mut(&mut self) -> Option<&mut LowRankPreconditioner> {
-        self.low_rank.as_deref_mut()
-    }
-
-    /// The Schur preconditioner's state, if installed.
-    pub fn schur(&self) -> Option<&SchurPreconditioner> {
-        self.schur.as_deref()
-    }
-
-    pub fn schur_mut(&mut self) -> Option<&mut SchurPreconditioner> {
-        self.schur.as_deref_mut()
+    /// The linear test added, if it is of type `T`.
+    pub fn linear_test_mut<T: LinearTest>(&mut self) -> Option<&mut T> {
+        let hook = self.linear_test.as_mut()?.downcast_mut::<Hook<T>>()?;
+        Some(&mut hook.test)
     }
 
     /// Applies the options database (after the program's defaults are set).
@@ -342,10 +318,9 @@ impl Snes {
             jacobian_stopped: false,
         };
         let ctx_ptr = &mut ctx as *mut Context as *mut c_void;
-        // The operator is the Jacobian matrix itself, or on the contact
-        // paths whose matrix holds the contact tangent alone a shell for
-        // the line search's slope.
-        let operator = match self.slope.as_mut() {
+        // The operator is the Jacobian matrix itself, or the shell of
+        // `set_operator` over it.
+        let operator = match self.operator.as_mut() {
             Some(s) => s.operator(j.raw())?,
             None => j.raw(),
         };
@@ -463,15 +438,8 @@ impl Drop for Snes {
         unsafe {
             sys::SNESDestroy(&mut self.raw);
         }
-        if let Some(f) = self.floor.as_mut() {
-            if let Some(destroy) = f.inner_destroy {
-                // SAFETY: the context `set_linear_floor` took over from the
-                // KSP, destroyed once, by the function it came with.
-                unsafe {
-                    destroy(f.inner_ctx);
-                }
-            }
-        }
+        // The boxed hooks drop after this, the linear test's first: it
+        // destroys the KSP test context it took over.
     }
 }
 
@@ -583,7 +551,7 @@ unsafe extern "C" fn jacobian_trampoline(
     ctx: *mut c_void,
 ) -> sys::PetscErrorCode {
     // SAFETY: PETSc passes valid objects for the call's duration; P is the
-    // Jacobian matrix set in `solve` (A is P or the slope's shell).
+    // Jacobian matrix set in `solve` (A is P or the shell over it).
     let (xv, mut am) = unsafe { (Vector::borrowed(x), Matrix::borrowed(p)) };
     let code = run_callback(ctx, snes, Kind::Jacobian, |p| p.jacobian(&xv, &mut am));
     // SNES reads its preconditioner lag after this callback returns, so a

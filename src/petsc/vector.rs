@@ -24,6 +24,14 @@ impl Vector {
         Ok(Vector { raw, owned: true })
     }
 
+    /// A vector of `n` entries on this process alone.
+    pub fn new_seq(n: usize) -> Result<Self> {
+        let mut raw: sys::Vec = std::ptr::null_mut();
+        // SAFETY: PETSc is initialised; `raw` is a valid out-pointer.
+        unsafe { petsc_call!(VecCreateSeq(self_comm(), to_petsc_int(n)?, &mut raw))? };
+        Ok(Vector { raw, owned: true })
+    }
+
     /// Wraps a vector PETSc owns (e.g. inside a SNES callback); not destroyed on drop.
     ///
     /// # Safety
@@ -116,6 +124,14 @@ impl Vector {
         Ok(n)
     }
 
+    /// Whether both hold the same entries (collective).
+    pub fn equals(&self, other: &Vector) -> Result<bool> {
+        let mut same = sys::PetscBool_PETSC_FALSE;
+        // SAFETY: both valid vecs of the same layout (PETSc checks); out-pointer valid.
+        unsafe { petsc_call!(VecEqual(self.raw, other.raw, &mut same))? };
+        Ok(same == sys::PetscBool_PETSC_TRUE)
+    }
+
     pub fn copy_from(&mut self, other: &Vector) -> Result<()> {
         // SAFETY: both valid with the same layout (caller's contract, PETSc checks).
         unsafe { petsc_call!(VecCopy(other.raw, self.raw)) }
@@ -189,6 +205,12 @@ impl Drop for Vector {
             }
         }
     }
+}
+
+/// MPI's communicator of this process alone.
+pub(super) fn self_comm() -> sys::MPI_Comm {
+    // SAFETY: MPI is initialised while PETSc is; the handle is a constant.
+    unsafe { sys::RSMPI_COMM_SELF }
 }
 
 /// A vector with owned entries followed by ghost copies of off-rank entries.

@@ -5,7 +5,7 @@
 //! Written by rank 0 alone once the run has closed the file (the peak is
 //! known only then), read back by `contactlink summary`.
 use super::ResultsError;
-use crate::footprint::Footprint;
+use crate::memory::Footprint;
 use crate::output::read_f64_attr;
 use std::path::Path;
 

@@ -219,7 +219,7 @@ pub fn nodal_samples(
     path: &Path,
     pair: &str,
     wanted: &dyn Fn(&[f64; 3]) -> bool,
-) -> Result<Option<Vec<crate::verify::NodalSample>>, ResultsError> {
+) -> Result<Option<Vec<crate::hertz::NodalSample>>, ResultsError> {
     use crate::fem::FacetType;
     let Some(set) = crate::output::read_string_attr(path, layout::CONTACT_PAIRS, pair)? else {
         return Ok(None);
@@ -258,7 +258,7 @@ pub fn nodal_samples(
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let out = crate::verify::facet_samples(facet_type, facets.iter().map(Vec::as_slice), wanted)
+    let out = crate::hertz::facet_samples(facet_type, facets.iter().map(Vec::as_slice), wanted)
         .map_err(|(f, e)| ResultsError::file(path, format!("{object}: facet {f}: {e}")))?;
     Ok(Some(out))
 }

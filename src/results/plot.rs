@@ -4,8 +4,8 @@
 //! [hertz] check), the load from the step's total contact force.
 use super::{open_steps, slave_nodes, PairPoints, ResultsError};
 use crate::dofs::NaturalNode;
+use crate::hertz::{self, HertzCheck, HertzKind};
 use crate::output::{layout, read_dataset, read_f64_attr, read_nodal, read_string_attr};
-use crate::verify::{self, HertzCheck, HertzKind};
 use plotters::prelude::*;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -21,7 +21,7 @@ pub struct PlotReport {
     pub output: PathBuf,
     /// Computed and closed-form peak pressure and half-width (line) or
     /// radius (point).
-    pub comparison: Option<verify::HertzComparison>,
+    pub comparison: Option<hertz::HertzComparison>,
     /// False when no font was found: the plot has no text.
     pub with_text: bool,
 }
@@ -55,7 +55,7 @@ pub fn plot(path: &Path, output: &Path, step: Option<usize>) -> Result<PlotRepor
         loaded.contains(&x.map(f64::to_bits))
     })?
     .unwrap_or_default();
-    let comparison = verify::compare(&check, &nodal.points, &nodal.pressure, &samples, pair.force);
+    let comparison = hertz::compare(&check, &nodal.points, &nodal.pressure, &samples, pair.force);
     let font = load_font();
     let with_text = match &font {
         Ok(()) => true,
@@ -160,9 +160,9 @@ impl Profile {
         let total = pair.force.iter().map(|f| f * f).sum::<f64>().sqrt();
         let (width, p0) = match check.kind {
             HertzKind::Line { thickness } => {
-                verify::hertz_line(total / thickness, check.radius, check.effective_modulus)
+                hertz::hertz_line(total / thickness, check.radius, check.effective_modulus)
             }
-            HertzKind::Point => verify::hertz_point(total, check.radius, check.effective_modulus),
+            HertzKind::Point => hertz::hertz_point(total, check.radius, check.effective_modulus),
         };
         let signed = matches!(check.kind, HertzKind::Line { .. });
         let centre = active_centroid(pair);
@@ -292,7 +292,7 @@ fn load_font() -> Result<(), String> {
         .map_err(|_| format!("{} is not a usable TrueType font", path.display()))
 }
 
-fn title(check: &HertzCheck, profile: &Profile, cmp: Option<&verify::HertzComparison>) -> String {
+fn title(check: &HertzCheck, profile: &Profile, cmp: Option<&hertz::HertzComparison>) -> String {
     let w = if profile.signed { "b" } else { "a" };
     let kind = if profile.signed { "line" } else { "point" };
     match cmp {
@@ -315,7 +315,7 @@ fn draw(
     output: &Path,
     check: &HertzCheck,
     profile: &Profile,
-    cmp: Option<&verify::HertzComparison>,
+    cmp: Option<&hertz::HertzComparison>,
     with_text: bool,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new(output, (1000, 650)).into_drawing_area();

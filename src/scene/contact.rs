@@ -7,11 +7,11 @@ use super::lines::Seg;
 use super::parse::{Bad, Checked};
 use super::sections::{ContactSection, HertzSection};
 use crate::fem::Material;
+use crate::hertz::{HertzCheck, HertzKind};
 use crate::mesh::Mesh;
 use crate::model::{
     Formulation, FrictionSpec, MasterSpec, PairSpec, RigidSurface, SlaveQuadrature,
 };
-use crate::verify::{HertzCheck, HertzKind};
 
 /// Gauss points on quadrilateral slave facets (docs/formulation.md §2.4); on
 /// triangles, the slave nodes. Three Gauss points per triangle put about six

@@ -18,7 +18,6 @@ use super::reactions::support_reactions;
 use super::report::{
     contact_reports, nodal_pressure, print_step, PairFields, RunReport, StepReport, StepSink,
 };
-use super::schur;
 use super::setup::{self, build_jacobian, newton_solver, set_solver_defaults, StepTolerance};
 use super::start::{initial_state, mechanics, prepare_time_step, time_stepper, Parts};
 use super::uzawa::{chain, uzawa_loop, StepContext, StepResult};
@@ -30,6 +29,7 @@ use crate::contact::{ContactPair, PairForce, UzawaStats};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
+use crate::linsolve;
 use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::parallel::{self, fault, fault::FaultPhase};
@@ -163,12 +163,14 @@ impl<'m> Simulation<'m> {
         let reaction = x.duplicate()?;
         let (mut snes, tolerance) = newton_solver(model, local)?;
         let global_dofs = DIM * mech.dofs.num_global_nodes();
-        if schur::applies(model, tangent, mech.loads, global_dofs) {
+        let linear_contact = tangent.contact && tangent.linear_bulk;
+        if linsolve::applies(model, linear_contact, mech.loads, global_dofs) {
             if let Some(k) = mech.separate_stiffness() {
-                schur::install(&mut snes, k, mech.dirichlet, tangent, rt.size())?;
+                let rows = mech.dirichlet.global_rows();
+                linsolve::install(&mut snes, k, rows, tangent.symmetric, rt.size())?;
                 mech.always_rebuild = true;
                 if model.solver.condensed_newton {
-                    mech.condensed = schur::condensed_state(&mut snes);
+                    mech.condensed = linsolve::condensed_state(&mut snes);
                 }
             }
         }
@@ -384,7 +386,7 @@ impl LoadSteps<'_> {
                 // tangent alone (K is in the factor): its pattern is the
                 // contact couplings', not the bulk's (b/40: 13.6 million
                 // entries zeroed per Jacobian, and a matrix of K's size).
-                let bulk = (!(mech.always_rebuild && self.snes.schur().is_some()))
+                let bulk = (!(mech.always_rebuild && linsolve::schur_installed(&self.snes)))
                     .then_some((mech.bulk, mech.loads));
                 *self.jac = self
                     .stages
@@ -392,7 +394,7 @@ impl LoadSteps<'_> {
                         build_jacobian(mech.dofs, bulk, mech.contact, mesh)
                     })?;
                 self.pattern_builds += 1;
-                schur::want(
+                linsolve::want(
                     &mut self.snes,
                     self.mech.contact,
                     self.mech.dofs,
@@ -515,11 +517,12 @@ impl LoadSteps<'_> {
     /// SIGINT, every rank ends the run here (the signal reaches the ranks at
     /// different moments, so each asks all the others).
     fn stop_if_signalled(&self) -> Result<()> {
-        let local = crate::petsc::signals::received().unwrap_or(0);
+        let local = crate::runtime::signals::received().unwrap_or(0);
         let [signal] = parallel::max(&self.world, [f64::from(local)]);
         if signal > 0.0 {
             return Err(Error::Stopped {
                 signal: signal as i32,
+                name: crate::runtime::signals::name(signal as i32),
                 step: self.first_step + self.reports.len(),
                 load_factor: self.done,
             });
@@ -606,7 +609,7 @@ impl LoadSteps<'_> {
         if self.echo {
             print_step(&report);
         }
-        crate::footprint::checkpoint("load step (solver and preconditioner alive)");
+        crate::memory::checkpoint("load step (solver and preconditioner alive)");
         let pair_fields: Vec<PairFields> = self
             .mech
             .contact
@@ -628,7 +631,7 @@ impl LoadSteps<'_> {
             )
         })?;
         drop(pair_fields);
-        crate::footprint::checkpoint("step output");
+        crate::memory::checkpoint("step output");
         output_mark.book(
             Phase::Output,
             &mut self.times,
@@ -673,7 +676,7 @@ impl LoadSteps<'_> {
         } = self;
         let dofs = mech.dofs;
         // Freed before the gather's scatter is built: the two never add up.
-        let schur = schur::summary(&snes);
+        let schur = linsolve::summary(&snes);
         drop(snes);
         let displacement = NaturalOrder::nodal(dofs)?.gather_root(&x)?;
         Ok(RunReport {

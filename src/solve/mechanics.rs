@@ -12,8 +12,8 @@ use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
+use crate::linsolve::Condensed;
 use crate::parallel::{self, fault, fault::FaultPhase};
-use crate::petsc::condensed_state::Condensed;
 use crate::petsc::snes::CallbackError;
 use crate::petsc::{GhostedVector, Matrix, NonlinearProblem, Vector};
 use mpi::topology::SimpleCommunicator;
@@ -52,7 +52,7 @@ pub struct Mechanics<'a> {
     /// or on the Krylov path.
     pub state_change_steps: bool,
     /// Newton on the condensed contact system (the Schur paths'; see
-    /// `petsc::condensed` and `petsc::low_rank`): while its step is active
+    /// `linsolve`): while its step is active
     /// the SNES vector is the condensed one and so is the residual.
     pub condensed: Option<Condensed>,
     stages: Stages,
@@ -164,7 +164,7 @@ impl<'a> Mechanics<'a> {
     /// scatter for the facets now held. Collective.
     pub fn exchange_masters(&mut self, x: &Vector) -> Result<()> {
         let dofs = self.dofs;
-        let ranks = super::halo::MpiRanks(SimpleCommunicator::world());
+        let ranks = crate::assembly::MpiRanks(SimpleCommunicator::world());
         self.with_state(x, |u, pairs| {
             let u = &u[..DIM * dofs.num_local_nodes()];
             let mut base = 0;
@@ -654,7 +654,7 @@ impl NonlinearProblem for Mechanics<'_> {
         let local = self.jacobian_impl(x, j);
         if self.jacobian_evaluations == 1 {
             // Before the first preconditioner set-up, which comes next.
-            crate::footprint::checkpoint("first Jacobian");
+            crate::memory::checkpoint("first Jacobian");
         }
         self.agree(local)
     }

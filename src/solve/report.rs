@@ -74,7 +74,7 @@ pub struct RunReport {
     pub preconditioner_builds: usize,
     pub preconditioner_reuses: usize,
     /// The contact Schur path's figures (None: not taken).
-    pub schur: Option<super::schur::SchurSummary>,
+    pub schur: Option<crate::linsolve::SchurSummary>,
     /// Seconds per phase over the run, the largest over the ranks.
     pub phases: PhaseTimes,
     /// Halo volume, summed over ranks: ghost displacement values refreshed

@@ -233,7 +233,7 @@ pub(super) struct SetUp {
 /// so that it is freed once the pieces are cut).
 pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<SetUp> {
     let world = rt.world();
-    crate::footprint::checkpoint("model build");
+    crate::memory::checkpoint("model build");
     // Contact pairs hold the master facets near their slave side,
     // exchanged at the searches (`contact::held_master`): no node is
     // ghosted beyond the cells' own.
@@ -248,16 +248,16 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
     let owned = matches!(mesh, Cow::Owned(_));
     drop(mesh);
     if owned {
-        crate::footprint::checkpoint("pieces cut, global mesh freed");
+        crate::memory::checkpoint("pieces cut, global mesh freed");
     }
     let partition_block = std::mem::take(&mut piece.block_partition);
     let (dofs, mut local) = DofMap::from_piece(piece);
-    crate::footprint::checkpoint("DOF map");
+    crate::memory::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
         BulkAssembler::new(&local, &dofs, model.materials.clone()),
     )?;
-    crate::footprint::checkpoint("bulk assembler (element data)");
+    crate::memory::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();
     for (set, load, amplitude) in &model.facet_loads {
         let facets = local.facet_set(set).ok_or_else(|| {
@@ -288,20 +288,20 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
                     slave,
                     p,
                     softest,
-                    &super::halo::PetscHalos,
-                    &super::halo::MpiRanks(rt.world()),
+                    &crate::assembly::PetscHalos,
+                    &crate::assembly::MpiRanks(rt.world()),
                 )
             })
             .collect::<Result<Vec<_>>>(),
     )?;
-    crate::footprint::checkpoint("loads, Dirichlet sets, contact pairs");
+    crate::memory::checkpoint("loads, Dirichlet sets, contact pairs");
     // The contact pairs hold what they need of the slave sets; the rest of
     // the local mesh stays for the near-null space, the dynamics and the
     // output.
     local.slaves = Vec::new();
     let jac = build_jacobian(&dofs, Some((&bulk, &loads)), &[], &local)?;
-    crate::footprint::checkpoint("Jacobian allocation");
-    crate::footprint::setup_finished();
+    crate::memory::checkpoint("Jacobian allocation");
+    crate::memory::setup_finished();
     Ok(SetUp {
         partition_block,
         local,

@@ -62,7 +62,7 @@ pub fn inner_acceleration(setting: Option<usize>, krylov: bool) -> usize {
 
 /// On the Krylov path with contact, a Newton iteration's GMRES stops once
 /// its residual is below this fraction of what the Newton solve still has
-/// to remove (`Snes::set_linear_floor`), however tight the Eisenstat–Walker
+/// to remove (`linsolve::set_linear_floor`), however tight the Eisenstat–Walker
 /// tolerance. That tolerance follows Newton's last rate and asks the last
 /// iteration of a solve for far more than is left (hertz-sphere h = 0.35:
 /// a non-final solve that had to reach 5e-4 went from 1.9e-3 to 4.1e-5 in

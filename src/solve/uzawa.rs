@@ -8,11 +8,11 @@ use super::anderson::Anderson;
 use super::failure::{newton_failure, StepFailure};
 use super::mechanics::Mechanics;
 use super::phases::{Phase, PhaseMark, PhaseTimes, Stages};
-use super::schur;
 use super::tolerance;
 use crate::contact::penalty::{PairProgress, StepPenalties, RATE_RAISE, ROUND_RAISE};
 use crate::contact::{ContactPair, UzawaStats};
 use crate::error::Result;
+use crate::linsolve;
 use crate::parallel::{self, fault, fault::FaultPhase};
 use crate::petsc::{Matrix, Snes, SnesOutcome, Vector};
 use mpi::traits::*;
@@ -86,9 +86,9 @@ pub(super) fn uzawa_loop(
         ctx.main_part_tangent && !frictional && main_part_tangent(world, mech.contact, true);
     // The condensed Newton iterates are the whole vector's only with no
     // step-length test (stol compares norms of the whole x and step).
-    let condensed = stol == 0.0 && schur::condenses(ctx.snes);
+    let condensed = stol == 0.0 && linsolve::condenses(ctx.snes);
     if condensed {
-        schur::arm(ctx.snes, ctx.x)?;
+        linsolve::arm(ctx.snes, ctx.x)?;
     }
     let mut result = uzawa_rounds(
         world,
@@ -99,17 +99,17 @@ pub(super) fn uzawa_loop(
         (stol, max_it, condensed),
         (&mut penalties, &mut main_part),
     );
-    if schur::condenses(ctx.snes) {
+    if linsolve::condenses(ctx.snes) {
         // The converged step's interior, formed once (a failed one is
         // dropped: the step starts again from the last converged state; an
         // uncovered one goes on from this state).
         if matches!(result, Ok(Ok(_) | Err(StepFailure::Uncovered { .. }))) {
-            let expanded = schur::expand(ctx.snes, ctx.x);
+            let expanded = linsolve::expand(ctx.snes, ctx.x);
             if let Err(e) = expanded {
                 result = Err(e);
             }
         }
-        schur::disarm(ctx.snes);
+        linsolve::disarm(ctx.snes);
     }
     if condensed {
         // The condensed iterates hold the true state on the contact DOFs
@@ -315,7 +315,7 @@ fn newton(
     snes.set_tolerances(tol.atol, tol.rtol, stol, max_it)?;
     if *linear_floor > 0.0 {
         let contact = !mech.contact.is_empty();
-        snes.set_linear_floor(if contact { *linear_floor } else { 0.0 })?;
+        linsolve::set_linear_floor(snes, if contact { *linear_floor } else { 0.0 })?;
     }
     snes.set_lag_preconditioner(if fresh { 1 } else { -1 })?;
     let mark = PhaseMark::new(&mech.times, mech.contact);

@@ -26,17 +26,17 @@
 //! failed, a non-finite update) goes through the caller's agreement hook
 //! before any rank acts on it, so no rank leaves a collective call the
 //! others are still in.
-pub(super) use super::shell::install;
 mod bulk;
-mod condensed;
-mod gather;
 mod inverse;
+mod newton;
 mod sparse;
 mod update;
-use super::shell::{error, ShellState};
-use super::{comm_world, petsc_call, sys, LogStage, Matrix, PetscInt, Result, Vector};
-pub use condensed::Reduced;
-use gather::gather_sorted;
+
+pub use newton::Reduced;
+
+use crate::petsc::{index_set, world_rank, Factor, LogStage, Matrix, PetscError, PetscInt};
+use crate::petsc::{DenseMatrix, Result, Scatter, ShellPreconditioner, Vector};
+use crate::runtime::cpu_seconds;
 use sparse::Sparse;
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -45,63 +45,13 @@ use std::rc::Rc;
 /// parallel module provides it).
 pub type AnyRank = Box<dyn Fn(bool) -> bool>;
 
-fn self_comm() -> sys::MPI_Comm {
-    // SAFETY: MPI is initialised while PETSc is; the handle is a constant.
-    unsafe { sys::RSMPI_COMM_SELF }
-}
-
-fn world_rank() -> Result<i32> {
-    let mut r = 0;
-    // SAFETY: valid communicator; out-pointer is a local.
-    let code = unsafe { sys::MPI_Comm_rank(comm_world(), &mut r) };
-    if code != 0 {
-        return Err(error("MPI_Comm_rank", format!("error {code}")));
-    }
-    Ok(r)
-}
-
-/// A matrix destroyed when it goes out of scope.
-struct OwnedMat(sys::Mat);
-
-impl Drop for OwnedMat {
-    fn drop(&mut self) {
-        // SAFETY: owned and destroyed once (null is skipped by PETSc).
-        unsafe {
-            sys::MatDestroy(&mut self.0);
-        }
-    }
-}
-
-/// A scatter released when it goes out of scope.
-struct OwnedScatter(sys::VecScatter);
-
-impl OwnedScatter {
-    /// Another reference to `s` (released by this one's drop).
-    fn reference(s: sys::VecScatter) -> Result<Self> {
-        // SAFETY: a valid scatter; the reference taken here is released
-        // once, in `drop`.
-        unsafe { petsc_call!(PetscObjectReference(s as sys::PetscObject))? };
-        Ok(OwnedScatter(s))
-    }
-}
-
-impl Drop for OwnedScatter {
-    fn drop(&mut self) {
-        // SAFETY: this handle's reference, released once.
-        unsafe {
-            sys::VecScatterDestroy(&mut self.0);
-        }
-    }
-}
-
-/// A sequential vector of `n` entries on this rank.
-fn seq_vector(n: usize) -> Result<Vector> {
-    let mut v: sys::Vec = std::ptr::null_mut();
-    // SAFETY: the new vector goes to an owning wrapper at once.
-    unsafe {
-        petsc_call!(VecCreateSeq(self_comm(), super::to_petsc_int(n)?, &mut v))?;
-        Ok(Vector::owned_from_raw(v))
-    }
+/// Every rank's `local` indices on every rank, sorted and distinct.
+/// Collective.
+fn gather_sorted(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
+    let mut out = index_set::all_gather(local)?;
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
 }
 
 /// The shell preconditioner's state (see the module's comment).
@@ -112,14 +62,14 @@ pub struct LowRankPreconditioner {
     constrained: Vec<PetscInt>,
     any_rank: AnyRank,
     root: bool,
-    /// K's MUMPS factor (null before the first set-up).
-    factor: sys::Mat,
+    /// K's MUMPS factor (None before the first set-up).
+    factor: Option<Factor>,
     /// C, the same on every rank.
     c: Vec<PetscInt>,
     fixed: Vec<bool>,
     wanted: Vec<PetscInt>,
     /// Full vector → its C entries on rank 0 (none elsewhere).
-    pick: sys::VecScatter,
+    pick: Option<Scatter>,
     /// Sequential, |C| entries on rank 0 and none elsewhere.
     small: Option<Vector>,
     /// A, the diagonal shift of K's factor (K' = K + A; see `bulk`), in
@@ -137,12 +87,12 @@ pub struct LowRankPreconditioner {
     /// touches (sorted).
     d: Sparse,
     u: Vec<usize>,
-    /// Rank 0: the LU factors of M_UU = I + D_UU G_UU (null when U is
+    /// Rank 0: the LU factors of M_UU = I + D_UU G_UU (None when U is
     /// empty), and sequential work vectors of |U| entries.
-    m: OwnedMat,
+    m: Option<DenseMatrix>,
     m_rhs: Option<Vector>,
     m_sol: Option<Vector>,
-    /// Newton on the condensed system (`condensed`), shared with the
+    /// Newton on the condensed system (`newton`), shared with the
     /// residual; None: every solve is a whole one.
     reduced: Option<Rc<RefCell<Reduced>>>,
     /// `-log_view` stages of G's columns and of the dense set-ups.
@@ -183,21 +133,6 @@ pub struct LowRankPreconditioner {
     pub last_error: Option<String>,
 }
 
-/// This process's CPU seconds so far (user + system).
-fn cpu_seconds() -> f64 {
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: a valid clock id and out-pointer.
-    let ok = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) } == 0;
-    if ok {
-        t.tv_sec as f64 + 1e-9 * t.tv_nsec as f64
-    } else {
-        0.0
-    }
-}
-
 impl LowRankPreconditioner {
     /// `k`: the linear bulk stiffness; `constrained`: this rank's rows and
     /// columns the Jacobian replaces by the identity (gathered here: K is
@@ -209,11 +144,11 @@ impl LowRankPreconditioner {
             constrained: gather_sorted(constrained)?,
             any_rank,
             root: world_rank()? == 0,
-            factor: std::ptr::null_mut(),
+            factor: None,
             c: Vec::new(),
             fixed: Vec::new(),
             wanted: Vec::new(),
-            pick: std::ptr::null_mut(),
+            pick: None,
             small: None,
             shift: None,
             shift_c: Vec::new(),
@@ -223,7 +158,7 @@ impl LowRankPreconditioner {
             known: Vec::new(),
             d: Sparse::default(),
             u: Vec::new(),
-            m: OwnedMat(std::ptr::null_mut()),
+            m: None,
             m_rhs: None,
             m_sol: None,
             reduced: None,
@@ -292,7 +227,7 @@ impl LowRankPreconditioner {
         let Some(d) = self.agreed(read)? else {
             return Ok(());
         };
-        if self.factor.is_null() {
+        if self.factor.is_none() {
             // K' is shifted where the first tangent acts (see `bulk`).
             self.factor_bulk(&d.touched())?;
             if self.failed.is_some() {
@@ -361,47 +296,21 @@ impl LowRankPreconditioner {
         self.g = vec![0.0; if self.root { n * n } else { 0 }];
         self.known = vec![false; here];
         if let Some(r) = &self.reduced {
-            r.borrow_mut().window = condensed::Window::default();
+            r.borrow_mut().window = newton::Window::default();
         }
         self.ensure_work_vectors()?;
         let z = self
             .z
             .as_ref()
-            .ok_or_else(|| error("set_c", "no work vector".into()))?;
-        let mut small: sys::Vec = std::ptr::null_mut();
-        let mut from: sys::IS = std::ptr::null_mut();
-        let mut to: sys::IS = std::ptr::null_mut();
+            .ok_or_else(|| PetscError::new("set_c", "no work vector".into()))?;
         let positions: Vec<PetscInt> = (0..here as PetscInt).collect();
-        // SAFETY: valid matrices and vectors; the sequential vector goes to
-        // an owning wrapper at once; the index slices are copied and their
-        // sets destroyed on every path; the old scatter is destroyed once
-        // and replaced.
-        unsafe {
-            let len = super::to_petsc_int(here)?;
-            petsc_call!(VecCreateSeq(self_comm(), len, &mut small))?;
-            self.small = Some(Vector::owned_from_raw(small));
-            sys::VecScatterDestroy(&mut self.pick);
-            petsc_call!(ISCreateGeneral(
-                self_comm(),
-                len,
-                self.c.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut from
-            ))?;
-            let made = petsc_call!(ISCreateGeneral(
-                self_comm(),
-                len,
-                positions.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut to
-            ))
-            .and_then(|()| petsc_call!(VecScatterCreate(z.raw(), from, small, to, &mut self.pick)));
-            sys::ISDestroy(&mut from);
-            sys::ISDestroy(&mut to);
-            made?;
-        }
-        self.shift_c = match (&self.shift, &mut self.small) {
-            (Some(v), Some(small)) => at_c(self.pick, v, small)?,
+        let small = Vector::new_seq(here)?;
+        self.pick = None;
+        let pick = Scatter::new_local(z, &self.c[..here], &small, &positions)?;
+        self.small = Some(small);
+        self.pick = Some(pick);
+        self.shift_c = match (&self.shift, &mut self.small, &self.pick) {
+            (Some(v), Some(small), Some(pick)) => at_c(pick, v, small)?,
             _ => Vec::new(),
         };
         Ok(())
@@ -412,15 +321,9 @@ impl LowRankPreconditioner {
         if self.z.is_some() {
             return Ok(());
         }
-        let mut right: sys::Vec = std::ptr::null_mut();
-        let mut left: sys::Vec = std::ptr::null_mut();
-        // SAFETY: `k` is a valid matrix; the vectors go to owning wrappers
-        // at once.
-        unsafe {
-            petsc_call!(MatCreateVecs(self.k.raw(), &mut right, &mut left))?;
-            self.z = Some(Vector::owned_from_raw(right));
-            self.t = Some(Vector::owned_from_raw(left));
-        }
+        let (right, left) = self.k.create_vecs()?;
+        self.z = Some(right);
+        self.t = Some(left);
         Ok(())
     }
 
@@ -439,20 +342,25 @@ impl LowRankPreconditioner {
                 return self.condensed_apply(&r, b, x);
             }
         }
-        let (Some(z), Some(t), Some(small)) = (&mut self.z, &mut self.t, &mut self.small) else {
-            return Err(error(
+        let (Some(z), Some(t), Some(small), Some(pick), Some(factor)) = (
+            &mut self.z,
+            &mut self.t,
+            &mut self.small,
+            &self.pick,
+            &self.factor,
+        ) else {
+            return Err(PetscError::new(
                 "LowRankPreconditioner::apply",
                 "applied before its set-up".into(),
             ));
         };
-        // SAFETY: valid factor and vectors of its size (PETSc checks).
-        unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
+        factor.solve(b, z)?;
         self.sparse_solves += 1;
-        scatter(self.pick, z.raw(), small.raw(), false)?;
+        pick.forward(z, small)?;
         let update = update::Update {
             d: &self.d,
             u: &self.u,
-            m: self.m.0,
+            m: self.m.as_ref(),
             rhs: self.m_rhs.as_mut(),
             sol: self.m_sol.as_mut(),
         };
@@ -470,37 +378,17 @@ impl LowRankPreconditioner {
         // t = b − P y, then x = K⁻¹ t.
         small.scale(-1.0)?;
         t.copy_from(b)?;
-        scatter(self.pick, small.raw(), t.raw(), true)?;
+        pick.reverse_add(small, t)?;
         self.sparse_solves += 1;
-        // SAFETY: as above.
-        unsafe { petsc_call!(MatSolve(self.factor, t.raw(), x.raw())) }
+        factor.solve(t, x)
     }
 }
 
 /// `v` (K's layout) at C's positions on rank 0 (empty elsewhere), through
 /// `small`. Collective.
-fn at_c(pick: sys::VecScatter, v: &Vector, small: &mut Vector) -> Result<Vec<f64>> {
-    scatter(pick, v.raw(), small.raw(), false)?;
+fn at_c(pick: &Scatter, v: &Vector, small: &mut Vector) -> Result<Vec<f64>> {
+    pick.forward(v, small)?;
     small.with_array(|a| a.to_vec())
-}
-
-/// The forward scatter (full → C entries, inserting) or the reverse one
-/// (C entries added into the full vector). Collective.
-fn scatter(s: sys::VecScatter, from: sys::Vec, to: sys::Vec, reverse: bool) -> Result<()> {
-    let (mode, add) = if reverse {
-        (sys::ScatterMode_SCATTER_REVERSE, sys::InsertMode_ADD_VALUES)
-    } else {
-        (
-            sys::ScatterMode_SCATTER_FORWARD,
-            sys::InsertMode_INSERT_VALUES,
-        )
-    };
-    // SAFETY: the caller passes the scatter's own layouts (PETSc checks);
-    // begin and end are paired.
-    unsafe {
-        petsc_call!(VecScatterBegin(s, from, to, add, mode))?;
-        petsc_call!(VecScatterEnd(s, from, to, add, mode))
-    }
 }
 
 /// Both sorted: every entry of `a` is in `b`.
@@ -508,17 +396,7 @@ fn is_subset(a: &[PetscInt], b: &[PetscInt]) -> bool {
     a.iter().all(|x| b.binary_search(x).is_ok())
 }
 
-impl Drop for LowRankPreconditioner {
-    fn drop(&mut self) {
-        // SAFETY: owned and destroyed once (null handles are skipped).
-        unsafe {
-            sys::MatDestroy(&mut self.factor);
-            sys::VecScatterDestroy(&mut self.pick);
-        }
-    }
-}
-
-impl ShellState for LowRankPreconditioner {
+impl ShellPreconditioner for LowRankPreconditioner {
     const NAME: &'static std::ffi::CStr =
         c"MUMPS factor of the bulk stiffness with a low-rank contact update";
     fn set_up(&mut self, kc: &Matrix) -> Result<()> {

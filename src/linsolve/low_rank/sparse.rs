@@ -1,7 +1,5 @@
 //! The contact tangent D on C, on rank 0, as compressed rows.
-use super::super::schur::for_rows;
-use super::super::shell::error;
-use super::super::{petsc_call, sys, PetscInt, Result};
+use crate::petsc::{Matrix, PetscError, PetscInt, Result};
 
 /// D on rank 0 in compressed rows: D[i, col[k]] = val[k] for k in
 /// start[i]..start[i + 1] (positions in C; constrained rows and columns
@@ -77,11 +75,11 @@ impl Sparse {
 /// of it the zeros of open links). `c` sorted. Collective: a rank whose
 /// reading failed still takes part in the gather, with no entries, and
 /// returns its error after it.
-pub(super) fn gather_sparse(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Sparse> {
+pub(super) fn gather_sparse(m: &Matrix, c: &[PetscInt], fixed: &[bool]) -> Result<Sparse> {
     use mpi::traits::{Communicator, Root};
     let local = own_rows(m, c, fixed).and_then(|t| match i32::try_from(t.len()) {
         Ok(_) => Ok(t),
-        Err(_) => Err(error(
+        Err(_) => Err(PetscError::new(
             "gather_sparse",
             format!(
                 "{} values of the contact tangent exceed one gather",
@@ -118,18 +116,16 @@ pub(super) fn gather_sparse(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Resu
 
 /// This rank's triplets (row, column, value; positions in C stored as f64,
 /// exact below 2⁵³) of `m`'s owned rows of C.
-fn own_rows(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Vec<f64>> {
-    let (mut lo, mut hi): (PetscInt, PetscInt) = (0, 0);
-    // SAFETY: a valid matrix and out-pointers.
-    unsafe { petsc_call!(MatGetOwnershipRange(m, &mut lo, &mut hi))? };
+fn own_rows(m: &Matrix, c: &[PetscInt], fixed: &[bool]) -> Result<Vec<f64>> {
+    let (lo, hi) = m.ownership_range()?;
     let from = c.partition_point(|&d| d < lo);
     let to = c.partition_point(|&d| d < hi);
     let mut out = Vec::new();
     let rows = (from..to).filter(|&i| !fixed[i]).map(|i| c[i]);
-    for_rows(m, rows, |row, cols, vals| {
+    m.for_rows(rows, |row, cols, vals| {
         // C is sorted: a row's position in it is found again.
         let Ok(i) = c.binary_search(&row) else {
-            return;
+            return Ok(());
         };
         for (&col, &v) in cols.iter().zip(vals) {
             if let Ok(k) = c.binary_search(&col) {
@@ -138,6 +134,7 @@ fn own_rows(m: sys::Mat, c: &[PetscInt], fixed: &[bool]) -> Result<Vec<f64>> {
                 }
             }
         }
+        Ok(())
     })?;
     Ok(out)
 }

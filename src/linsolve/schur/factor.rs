@@ -1,6 +1,6 @@
 //! The bulk stiffness factored once with a MUMPS Schur complement on the
-//! contact DOFs, and the PETSc shell preconditioner that solves
-//! (K + Kc) x = b exactly with it when Kc is non-zero only on those DOFs.
+//! contact DOFs, which solves (K + Kc) x = b exactly when Kc is non-zero
+//! only on those DOFs.
 //!
 //! With C the contact candidate DOFs and I the rest, MUMPS factors K_II
 //! and returns S0 = K_CC − K_CI K_II⁻¹ K_IC (dense). A Jacobian J = K + Kc
@@ -17,7 +17,7 @@
 //! ordered by a key the caller gives (decreasing; the solve layer's is the
 //! distance to the other body, so the contact zone comes last), S0's
 //! leading block up to a little before the first DOF a tangent touches is
-//! factored once ([`PartialCholesky`]), and each later tangent factors the
+//! factored once ([`PartialCholesky`], `partial.rs`), and each later tangent factors the
 //! trailing block alone, in place in the Schur matrix PETSc solves with. A
 //! tangent that makes S indefinite falls back to LDLᵀ of the whole S
 //! (LAPACK's dsytrf, as every factorisation did before; the first one too).
@@ -40,16 +40,14 @@
 //! default made D x_C carry x_C's roundoff times |D|/σ into the soft
 //! J_ref⁻¹ (the mortar patch test's force 4 % off). S_ref is positive
 //! definite where S0 is only semi-definite (a body held by contact alone).
-use super::condensed::Layout;
-use super::dense::{PartialCholesky, PartialLu};
-use super::shell::error;
-use super::{petsc_call, sys, Matrix, PetscInt, Result, Vector};
+use super::layout::Layout;
+use super::partial::{PartialCholesky, PartialLu};
+use crate::petsc::{Factor, Matrix, PetscError, PetscInt, Result, Vector};
 use std::rc::Rc;
 
 /// K factored with a dense Schur complement on the DOFs `c`.
 pub struct SchurFactor {
-    factor: sys::Mat,
-    is: sys::IS,
+    factor: Factor,
     /// C, its Schur order and S0 (shared with the condensed Newton state).
     layout: Rc<Layout>,
     /// The contact tangent is symmetric (else the LU path, see the module).
@@ -68,9 +66,6 @@ pub struct SchurFactor {
     /// The split whose leading columns the factor matrix's Schur array
     /// holds now (so a new tangent writes the trailing block only).
     in_array: Option<usize>,
-    /// PETSc has factored the Schur matrix once (its solve operations are
-    /// installed) and nothing has marked it unfactored since.
-    factored_once: bool,
     pub counts: DenseCounts,
 }
 
@@ -91,40 +86,12 @@ pub struct DenseCounts {
 }
 
 impl DenseCounts {
-    pub(super) fn add(&mut self, o: DenseCounts) {
+    pub fn add(&mut self, o: DenseCounts) {
         self.trailing += o.trailing;
         self.largest_trailing = self.largest_trailing.max(o.largest_trailing);
         self.leading += o.leading;
         self.whole += o.whole;
     }
-}
-
-/// Calls `f(row, columns, values)` for each row in `rows` of the assembled
-/// matrix `m` (rows this process holds: any of a sequential matrix, the
-/// owned ones of a parallel one).
-pub(super) fn for_rows(
-    m: sys::Mat,
-    rows: impl Iterator<Item = PetscInt>,
-    mut f: impl FnMut(PetscInt, &[PetscInt], &[f64]),
-) -> Result<()> {
-    for row in rows {
-        let mut nz: PetscInt = 0;
-        let mut cols: *const PetscInt = std::ptr::null();
-        let mut vals: *const f64 = std::ptr::null();
-        // SAFETY: `m` is a valid assembled matrix holding `row` on this
-        // process; the row's pointers are read only between MatGetRow and
-        // the paired MatRestoreRow, and hold `nz` entries each.
-        unsafe {
-            petsc_call!(MatGetRow(m, row, &mut nz, &mut cols, &mut vals))?;
-            if nz > 0 && !cols.is_null() && !vals.is_null() {
-                let cs = std::slice::from_raw_parts(cols, nz as usize);
-                let vs = std::slice::from_raw_parts(vals, nz as usize);
-                f(row, cs, vs);
-            }
-            petsc_call!(MatRestoreRow(m, row, &mut nz, &mut cols, &mut vals))?;
-        }
-    }
-    Ok(())
 }
 
 /// The Schur order of the sorted DOFs `c` by decreasing `key` (DOFs
@@ -154,7 +121,7 @@ impl SchurFactor {
         key: &[(PetscInt, f64)],
     ) -> Result<Self> {
         if c.is_empty() || c.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(error(
+            return Err(PetscError::new(
                 "SchurFactor::new",
                 "the Schur DOFs must be sorted, distinct and not empty".into(),
             ));
@@ -168,16 +135,15 @@ impl SchurFactor {
         let mut pos = vec![0; n];
         let mut fixed = vec![false; n];
         for (p, d) in order.iter().enumerate() {
-            let i = c
-                .binary_search(d)
-                .map_err(|_| error("SchurFactor::new", "the Schur order lost a DOF".into()))?;
+            let i = c.binary_search(d).map_err(|_| {
+                PetscError::new("SchurFactor::new", "the Schur order lost a DOF".into())
+            })?;
             pos[i] = p;
             fixed[p] = fixed_sorted[i];
         }
-        let mut base = vec![0.0; n * n];
+        let factor = Factor::cholesky_with_schur(k, &order)?;
         let mut me = SchurFactor {
-            factor: std::ptr::null_mut(),
-            is: std::ptr::null_mut(),
+            factor,
             layout: Rc::new(Layout {
                 c,
                 pos,
@@ -191,58 +157,12 @@ impl SchurFactor {
             reference: None,
             partial_refused: false,
             in_array: None,
-            factored_once: false,
             counts: DenseCounts::default(),
         };
-        let kind = sys::MatFactorType_MAT_FACTOR_CHOLESKY;
-        let mut s0: sys::Mat = std::ptr::null_mut();
-        // SAFETY: `k` is a valid assembled matrix; the factor and the index
-        // set are owned by `me` (destroyed in Drop, also on an early error);
-        // `order` outlives the IS (PETSC_COPY_VALUES copies it anyway). The
-        // Schur copy `s0` is destroyed below on every path; its array is
-        // read only while it lives.
-        unsafe {
-            petsc_call!(ISCreateGeneral(
-                super::comm_world(),
-                super::to_petsc_int(n)?,
-                order.as_ptr(),
-                sys::PetscCopyMode_PETSC_COPY_VALUES,
-                &mut me.is
-            ))?;
-            petsc_call!(MatGetFactor(
-                k.raw(),
-                c"mumps".as_ptr(),
-                kind,
-                &mut me.factor
-            ))?;
-            petsc_call!(MatFactorSetSchurIS(me.factor, me.is))?;
-            let mut info = sys::MatFactorInfo::default();
-            petsc_call!(MatFactorInfoInitialize(&mut info))?;
-            petsc_call!(MatCholeskyFactorSymbolic(
-                me.factor,
-                k.raw(),
-                std::ptr::null_mut(),
-                &info
-            ))?;
-            petsc_call!(MatCholeskyFactorNumeric(me.factor, k.raw(), &info))?;
-            me.check_factor_error()?;
-            let mut status: sys::MatFactorSchurStatus = 0;
-            petsc_call!(MatFactorCreateSchurComplement(
-                me.factor,
-                &mut s0,
-                &mut status
-            ))?;
-            let read = (|| -> Result<()> {
-                let mut arr: *const f64 = std::ptr::null();
-                petsc_call!(MatDenseGetArrayRead(s0, &mut arr))?;
-                base.copy_from_slice(std::slice::from_raw_parts(arr, n * n));
-                petsc_call!(MatDenseRestoreArrayRead(s0, &mut arr))?;
-                symmetrise(&mut base, n);
-                Ok(())
-            })();
-            sys::MatDestroy(&mut s0);
-            read?;
-        }
+        me.factor.factor(k)?;
+        me.check_factor_error()?;
+        let mut base = me.factor.schur_complement()?;
+        symmetrise(&mut base, n);
         if let Some(layout) = Rc::get_mut(&mut me.layout) {
             layout.base = base;
         }
@@ -252,11 +172,8 @@ impl SchurFactor {
     /// MUMPS reports a failed factorisation (a singular K_II, say) through
     /// the factor's error type, not the call's code.
     fn check_factor_error(&self) -> Result<()> {
-        let mut err: sys::MatFactorError = 0;
-        // SAFETY: valid factor; out-pointer is a local.
-        unsafe { petsc_call!(MatFactorGetError(self.factor, &mut err))? };
-        if err != sys::MatFactorError_MAT_FACTOR_NOERROR {
-            return Err(error(
+        if let Some(err) = self.factor.error_type()? {
+            return Err(PetscError::new(
                 "MatFactorGetError",
                 format!("the MUMPS factorisation of the bulk stiffness with a Schur complement on {} contact DOFs failed (error type {err})", self.layout.c.len()),
             ));
@@ -291,16 +208,9 @@ impl SchurFactor {
             self.solve_lu(&mut v)?;
             return sol.with_array_mut(|a| a.copy_from_slice(&v));
         }
-        // SAFETY: valid factor whose Schur complement the last `update`
-        // factored (PETSc factors it first otherwise); vectors of the
-        // Schur size (PETSc checks).
-        unsafe {
-            petsc_call!(MatFactorSolveSchurComplement(
-                self.factor,
-                rhs.raw(),
-                sol.raw()
-            ))
-        }
+        // The Schur complement the last `update` factored (PETSc factors
+        // it first otherwise).
+        self.factor.solve_schur(rhs, sol)
     }
 
     /// The contact tangent's entries in C × C as (row, column, value) in
@@ -309,11 +219,13 @@ impl SchurFactor {
         let mut out = Vec::new();
         let l = &*self.layout;
         let (c, pos, fixed) = (&l.c, &l.pos, &l.fixed);
-        for_rows(kc.raw(), c.iter().copied(), |row, cols, vals| {
-            let Ok(i) = c.binary_search(&row) else { return };
+        kc.for_rows(c.iter().copied(), |row, cols, vals| {
+            let Ok(i) = c.binary_search(&row) else {
+                return Ok(());
+            };
             let r = pos[i];
             if fixed[r] {
-                return;
+                return Ok(());
             }
             for (&col, &v) in cols.iter().zip(vals) {
                 if v == 0.0 {
@@ -325,6 +237,7 @@ impl SchurFactor {
                     }
                 }
             }
+            Ok(())
         })?;
         Ok(out)
     }
@@ -368,7 +281,7 @@ impl SchurFactor {
         // solve); the first contact tangent is often a first touch, smaller
         // than the zone the later ones settle on, so the split waits for
         // the second. Without contact coupling S is S0: factored whole.
-        if !self.factored_once || self.partial_refused || d.is_empty() {
+        if !self.factor.schur_is_factored() || self.partial_refused || d.is_empty() {
             return Ok(false);
         }
         let first = d.iter().map(|&(r, c, _)| r.min(c)).min().unwrap_or(n);
@@ -385,7 +298,8 @@ impl SchurFactor {
         let split = partial.split();
         let leading = self.in_array != Some(split);
         let mut ok = false;
-        with_factored_schur(self.factor, n, |arr| {
+        // PETSc's dense solve reads the array as the Cholesky factor.
+        self.factor.write_schur_cholesky(|arr| {
             ok = partial.factor_into(d, arr, leading);
         })?;
         if !ok {
@@ -399,54 +313,11 @@ impl SchurFactor {
     }
 
     /// PETSc's factorisation of the whole dense S = `dense`: LDLᵀ (dsytrf,
-    /// S need not be definite) or LU (dgetrf).
+    /// S need not be definite), its old factors cleared (also the fast
+    /// path's Cholesky ones).
     fn factor_whole(&mut self, dense: &[f64]) -> Result<()> {
-        let n = self.layout.c.len();
-        let mut s: sys::Mat = std::ptr::null_mut();
-        let mut status: sys::MatFactorSchurStatus = 0;
         self.in_array = None;
-        self.factored_once = false;
-        // SAFETY: valid factor with a Schur complement of size n (set in
-        // `new`); the Schur matrix is the factor's own (borrowed between Get
-        // and Restore); its array holds n × n column-major values and is
-        // written only between MatDenseGetArray and its restore. Restoring
-        // it as unfactored clears its old dense factors, so the
-        // factorisation that follows is fresh.
-        unsafe {
-            petsc_call!(MatFactorGetSchurComplement(
-                self.factor,
-                &mut s,
-                &mut status
-            ))?;
-            petsc_call!(MatFactorRestoreSchurComplement(
-                self.factor,
-                &mut s,
-                sys::MatFactorSchurStatus_MAT_FACTOR_SCHUR_UNFACTORED
-            ))?;
-            petsc_call!(MatFactorGetSchurComplement(
-                self.factor,
-                &mut s,
-                &mut status
-            ))?;
-            let mut arr: *mut f64 = std::ptr::null_mut();
-            petsc_call!(MatDenseGetArray(s, &mut arr))?;
-            std::slice::from_raw_parts_mut(arr, n * n).copy_from_slice(dense);
-            petsc_call!(MatDenseRestoreArray(s, &mut arr))?;
-            // Cleared after the fast path's Cholesky factors.
-            petsc_call!(MatSetOption(
-                s,
-                sys::MatOption_MAT_SPD,
-                sys::PetscBool_PETSC_FALSE
-            ))?;
-            petsc_call!(MatFactorRestoreSchurComplement(
-                self.factor,
-                &mut s,
-                sys::MatFactorSchurStatus_MAT_FACTOR_SCHUR_UNFACTORED
-            ))?;
-            petsc_call!(MatFactorFactorizeSchurComplement(self.factor))?;
-        }
-        self.factored_once = true;
-        Ok(())
+        self.factor.set_schur_complement(dense)
     }
 
     /// x = (K + Kc)⁻¹ b with the Kc of the last [`Self::update`] (K with
@@ -488,10 +359,9 @@ impl SchurFactor {
     /// MatSolve with the factor: J⁻¹ b for the Jacobian whose Schur
     /// complement the factor matrix's array holds.
     fn sparse_solve(&self, b: &Vector, x: &mut Vector) -> Result<()> {
-        // SAFETY: valid factor, its Schur complement set and factored by
-        // `update` (MatSolve factors it first otherwise); vectors of the
-        // factored size (PETSc checks).
-        unsafe { petsc_call!(MatSolve(self.factor, b.raw(), x.raw())) }
+        // Its Schur complement set and factored by `update` (MatSolve
+        // factors it first otherwise).
+        self.factor.solve(b, x)
     }
 
     /// The non-symmetric path's set-up: the reference factored into the
@@ -518,13 +388,13 @@ impl SchurFactor {
             self.counts.leading += 1;
         }
         let Some(partial) = &self.partial else {
-            return Err(error(
+            return Err(PetscError::new(
                 "SchurFactor::update",
                 format!("the contact Schur complement's order ({n} DOFs) does not fit LAPACK"),
             ));
         };
         if !partial.factor_lu_into(d, &mut self.lu) {
-            return Err(error(
+            return Err(PetscError::new(
                 "SchurFactor::update",
                 format!("the contact Schur complement on {n} DOFs is singular (LU of its trailing {} DOFs)", n - partial.split()),
             ));
@@ -539,7 +409,7 @@ impl SchurFactor {
         if self.lu.solve(v) {
             return Ok(());
         }
-        Err(error(
+        Err(PetscError::new(
             "SchurFactor::solve",
             "the dense Schur complement is not factored".into(),
         ))
@@ -557,39 +427,6 @@ impl SchurFactor {
 /// line meshes and hertz-cylinder did not move (docs/performance.md).
 fn split_before(first: usize, n: usize) -> usize {
     first.saturating_sub((n - first) / 4)
-}
-
-/// `f` on the array of the factored Schur matrix of `factor` (n × n), which
-/// stays marked factored, as a Cholesky factor (dpotrs reads it).
-///
-/// The factor must hold a Schur complement that PETSc has factored before
-/// (its dense solve installed) and that nothing has marked unfactored since.
-fn with_factored_schur(factor: sys::Mat, n: usize, f: impl FnOnce(&mut [f64])) -> Result<()> {
-    let mut s: sys::Mat = std::ptr::null_mut();
-    let mut status: sys::MatFactorSchurStatus = 0;
-    // SAFETY: valid factor with a Schur complement of size n, factored by
-    // PETSc before (the caller's promise); the Schur matrix is the factor's
-    // own, borrowed between Get and Restore; its array holds n × n
-    // column-major values, written only between MatDenseGetArray and its
-    // restore.
-    unsafe {
-        petsc_call!(MatFactorGetSchurComplement(factor, &mut s, &mut status))?;
-        let mut arr: *mut f64 = std::ptr::null_mut();
-        petsc_call!(MatDenseGetArray(s, &mut arr))?;
-        f(std::slice::from_raw_parts_mut(arr, n * n));
-        petsc_call!(MatDenseRestoreArray(s, &mut arr))?;
-        petsc_call!(MatSetOption(
-            s,
-            sys::MatOption_MAT_SPD,
-            sys::PetscBool_PETSC_TRUE
-        ))?;
-        petsc_call!(MatFactorRestoreSchurComplement(
-            factor,
-            &mut s,
-            sys::MatFactorSchurStatus_MAT_FACTOR_SCHUR_FACTORED
-        ))?;
-    }
-    Ok(())
 }
 
 /// The Schur complement of an LDLᵀ factorisation may come with one
@@ -618,16 +455,3 @@ fn symmetrise(a: &mut [f64], n: usize) {
         }
     }
 }
-
-impl Drop for SchurFactor {
-    fn drop(&mut self) {
-        // SAFETY: owned and destroyed once (null handles are skipped by PETSc).
-        unsafe {
-            sys::MatDestroy(&mut self.factor);
-            sys::ISDestroy(&mut self.is);
-        }
-    }
-}
-
-pub use super::schur_preconditioner::SchurPreconditioner;
-pub(super) use super::shell::install;

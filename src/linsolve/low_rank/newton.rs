@@ -17,15 +17,14 @@
 //! G t: dense work on rank 0, no solve. x − λ y keeps the form (θ − λ θ_b,
 //! s − λ t).
 //!
-//! As on one rank (`petsc::condensed`), the SNES vector holds the true x_C
+//! As on one rank (`schur::newton`), the SNES vector holds the true x_C
 //! and carries θ off C as x0_I − (1 − θ) q_I, so the line search and the
 //! convergence tests are Newton's on the whole vector; s is read back from
 //! x_W as G_WW⁻¹ (x_W − x0_W − (θ − 1) z_W). The interior is formed once,
 //! when the step ends (one solve for K⁻¹ P s).
-use super::super::condensed::Armed;
-use super::super::shell::error;
-use super::super::{petsc_call, sys, Result, Vector};
-use super::{at_c, scatter, seq_vector, LowRankPreconditioner, OwnedScatter};
+use super::super::armed::Armed;
+use super::{at_c, LowRankPreconditioner};
+use crate::petsc::{PetscError, Result, Scatter, Vector};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -54,7 +53,7 @@ impl Window {
             None => {
                 let lu = m.lu();
                 if !lu.is_invertible() {
-                    return Err(error(
+                    return Err(PetscError::new(
                         "condensed Newton",
                         format!("G on the {} contact DOFs W is singular", w.len()),
                     ));
@@ -76,7 +75,7 @@ impl Window {
             Some(WindowFactor::Cholesky(c)) => c.solve(&d),
             Some(WindowFactor::Lu(lu)) => lu
                 .solve(&d)
-                .ok_or_else(|| error("condensed Newton", "G_WW is singular".into()))?,
+                .ok_or_else(|| PetscError::new("condensed Newton", "G_WW is singular".into()))?,
         };
         Ok(s.iter().copied().collect())
     }
@@ -105,14 +104,14 @@ pub(super) struct Step {
     pub(super) fixed: Vec<bool>,
     rc0: Option<Vec<f64>>,
     /// Full vector → C on rank 0, with its own sequential vector.
-    pick: OwnedScatter,
+    pick: Scatter,
     small: Vector,
     work: Vector,
 }
 
 impl Step {
     pub(super) fn gather(&mut self, v: &Vector) -> Result<Vec<f64>> {
-        at_c(self.pick.0, v, &mut self.small)
+        at_c(&self.pick, v, &mut self.small)
     }
 
     /// `out` = `scale` · q + P `on_c` (`on_c` rank 0's, empty elsewhere).
@@ -121,7 +120,7 @@ impl Step {
         out.copy_from(&self.q)?;
         out.scale(scale)?;
         self.small.with_array_mut(|a| a.copy_from_slice(on_c))?;
-        scatter(self.pick.0, self.small.raw(), out.raw(), true)
+        self.pick.reverse_add(&self.small, out)
     }
 
     /// b·q / q·q: the θ of a residual of the condensed form. Collective.
@@ -186,13 +185,13 @@ impl Reduced {
     }
 
     /// The step's first solve gave z = K⁻¹ `b` (`b` = R(x0)); `pick` is
-    /// the preconditioner's scatter onto C (referenced here), `shift` and
+    /// the preconditioner's scatter onto C (shared here), `shift` and
     /// `fixed` C's (rank 0). Collective.
     pub(super) fn start(
         &mut self,
         b: &Vector,
         z: &Vector,
-        pick: sys::VecScatter,
+        pick: &Scatter,
         shift: &[f64],
         fixed: &[bool],
     ) -> Result<()> {
@@ -200,17 +199,17 @@ impl Reduced {
             .armed
             .x0
             .as_ref()
-            .ok_or_else(|| error("Reduced::start", "not armed".into()))?;
-        let pick = OwnedScatter::reference(pick)?;
-        let mut small = seq_vector(fixed.len())?;
-        let b0 = at_c(pick.0, b, &mut small)?;
-        let zc = at_c(pick.0, z, &mut small)?;
-        let x0c = at_c(pick.0, x0, &mut small)?;
+            .ok_or_else(|| PetscError::new("Reduced::start", "not armed".into()))?;
+        let pick = pick.share()?;
+        let mut small = Vector::new_seq(fixed.len())?;
+        let b0 = at_c(&pick, b, &mut small)?;
+        let zc = at_c(&pick, z, &mut small)?;
+        let x0c = at_c(&pick, x0, &mut small)?;
         let mut q = b.duplicate()?;
         q.copy_from(b)?;
         // q = b − P b_C: zero on C exactly.
         small.with_array_mut(|a| a.iter_mut().zip(&b0).for_each(|(v, b)| *v = -b))?;
-        scatter(pick.0, small.raw(), q.raw(), true)?;
+        pick.reverse_add(&small, &mut q)?;
         let qq = q.dot(&q)?;
         let mut zz = z.duplicate()?;
         zz.copy_from(z)?;
@@ -236,7 +235,10 @@ impl Reduced {
     /// a failure on rank 0 leaves non-finite entries and is returned there.
     pub fn residual(&mut self, x: &Vector, rc: &Vector, out: &mut Vector) -> Result<()> {
         let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
-            return Err(error("Reduced::residual", "no condensed step".into()));
+            return Err(PetscError::new(
+                "Reduced::residual",
+                "no condensed step".into(),
+            ));
         };
         let theta = s.theta(x0, x)?;
         let xc = s.gather(x)?;
@@ -265,7 +267,7 @@ impl Reduced {
         let rc0 = s
             .rc0
             .as_ref()
-            .ok_or_else(|| error("Reduced::residual", "ρ0 not set".into()))?;
+            .ok_or_else(|| PetscError::new("Reduced::residual", "ρ0 not set".into()))?;
         let mut out: Vec<f64> = (0..xc.len())
             .map(|p| {
                 let contact = match s.fixed[p] {
@@ -289,7 +291,10 @@ impl Reduced {
     /// (rank 0). Collective.
     pub(super) fn theta_and_c(&mut self, x: &Vector) -> Result<(f64, Vec<f64>)> {
         let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
-            return Err(error("Reduced::expand", "no condensed step".into()));
+            return Err(PetscError::new(
+                "Reduced::expand",
+                "no condensed step".into(),
+            ));
         };
         let theta = s.theta(x0, x)?;
         Ok((theta, s.gather(x)?))
@@ -301,7 +306,7 @@ impl Reduced {
             .armed
             .step
             .as_ref()
-            .ok_or_else(|| error("Reduced::expand", "no condensed step".into()))?;
+            .ok_or_else(|| PetscError::new("Reduced::expand", "no condensed step".into()))?;
         let mut out = vec![0.0; xc.len()];
         let f = s.forces(&self.window, theta, xc)?;
         for (&p, v) in self.window.w.iter().zip(f) {
@@ -320,7 +325,10 @@ impl Reduced {
         xc: &[f64],
     ) -> Result<()> {
         let (Some(x0), Some(s)) = (&self.armed.x0, self.armed.step.as_mut()) else {
-            return Err(error("Reduced::expand", "no condensed step".into()));
+            return Err(PetscError::new(
+                "Reduced::expand",
+                "no condensed step".into(),
+            ));
         };
         x.copy_from(x0)?;
         x.axpy(theta - 1.0, &s.z)?;
@@ -328,7 +336,7 @@ impl Reduced {
         let now = s.gather(x)?;
         let fix: Vec<f64> = xc.iter().zip(&now).map(|(a, b)| a - b).collect();
         s.small.with_array_mut(|a| a.copy_from_slice(&fix))?;
-        scatter(s.pick.0, s.small.raw(), x.raw(), true)?;
+        s.pick.reverse_add(&s.small, x)?;
         self.disarm();
         Ok(())
     }
@@ -385,19 +393,27 @@ impl LowRankPreconditioner {
         };
         let Some(forces) = self.agreed(local)? else {
             r.disarm();
-            return Err(error(
+            return Err(PetscError::new(
                 "condensed Newton",
                 self.failed.clone().unwrap_or_default(),
             ));
         };
-        let (Some(t), Some(z), Some(small)) = (&mut self.t, &mut self.z, &mut self.small) else {
-            return Err(error("condensed Newton", "no work vectors".into()));
+        let (Some(t), Some(z), Some(small), Some(pick), Some(factor)) = (
+            &mut self.t,
+            &mut self.z,
+            &mut self.small,
+            &self.pick,
+            &self.factor,
+        ) else {
+            return Err(PetscError::new(
+                "condensed Newton",
+                "no work vectors".into(),
+            ));
         };
         t.set_all(0.0)?;
         small.with_array_mut(|a| a.copy_from_slice(&forces))?;
-        scatter(self.pick, small.raw(), t.raw(), true)?;
-        // SAFETY: valid factor and vectors of its size (PETSc checks).
-        unsafe { petsc_call!(MatSolve(self.factor, t.raw(), z.raw()))? };
+        pick.reverse_add(small, t)?;
+        factor.solve(t, z)?;
         self.sparse_solves += 1;
         r.finish(x, theta, z, &xc)
     }
@@ -412,22 +428,21 @@ impl LowRankPreconditioner {
     ) -> Result<()> {
         let mut red = r.borrow_mut();
         if red.awaits_first_solve() {
-            let z = self
-                .z
-                .as_mut()
-                .ok_or_else(|| error("condensed Newton", "no work vector".into()))?;
-            // SAFETY: valid factor and vectors of its size (PETSc checks).
-            unsafe { petsc_call!(MatSolve(self.factor, b.raw(), z.raw()))? };
+            let (Some(z), Some(pick), Some(factor)) = (&mut self.z, &self.pick, &self.factor)
+            else {
+                return Err(PetscError::new("condensed Newton", "no work vector".into()));
+            };
+            factor.solve(b, z)?;
             self.sparse_solves += 1;
             // C's parts live on rank 0 alone.
             let fixed: &[bool] = if self.root { &self.fixed } else { &[] };
-            red.start(b, z, self.pick, &self.shift_c, fixed)?;
+            red.start(b, z, pick, &self.shift_c, fixed)?;
         }
         let Reduced { armed, window } = &mut *red;
         let s = armed
             .step
             .as_mut()
-            .ok_or_else(|| error("condensed Newton", "no condensed step".into()))?;
+            .ok_or_else(|| PetscError::new("condensed Newton", "no condensed step".into()))?;
         let theta = s.theta_of(b)?;
         let bc = s.gather(b)?;
         let sigma: Vec<f64> = (0..bc.len())
@@ -445,7 +460,7 @@ impl LowRankPreconditioner {
             self.refresh_window(window)?;
         }
         let local = match (self.failed.is_some(), self.root) {
-            (true, _) => Err(error("condensed Newton", "failed set-up".into())),
+            (true, _) => Err(PetscError::new("condensed Newton", "failed set-up".into())),
             (false, true) => self.dense_step(theta, sigma, &s.zc),
             (false, false) => Ok(Vec::new()),
         };
@@ -476,12 +491,13 @@ impl LowRankPreconditioner {
         }
         let outer: Vec<usize> = (0..n).filter(|&j| t[j] != 0.0 && !in_u[j]).collect();
         if let Some(&j) = outer.iter().find(|&&j| !self.known[j]) {
-            return Err(error(
+            return Err(PetscError::new(
                 "condensed Newton",
                 format!("no column of G at DOF {}", self.c[j]),
             ));
         }
-        if let (Some(rhs), Some(sol)) = (self.m_rhs.as_mut(), self.m_sol.as_mut()) {
+        if let (Some(m), Some(rhs), Some(sol)) = (&self.m, self.m_rhs.as_mut(), self.m_sol.as_mut())
+        {
             // G t_outer at U's rows, then M_UU t_U = rhs_U − D (G t_outer).
             let mut g_outer = vec![0.0; n];
             for &k in &self.u {
@@ -493,9 +509,9 @@ impl LowRankPreconditioner {
                     *v = t[i] - d.row(i).map(|(k, dv)| dv * g_outer[k]).sum::<f64>();
                 }
             })?;
-            // SAFETY: M_UU is factored (the set-up succeeded on every rank
-            // before any solve); sequential vectors of its size.
-            unsafe { petsc_call!(MatSolve(self.m.0, rhs.raw(), sol.raw()))? };
+            // M_UU is factored: the set-up succeeded on every rank before
+            // any solve.
+            m.solve(rhs, sol)?;
             sol.with_array(|a| {
                 for (&i, &v) in u.iter().zip(a) {
                     t[i] = v;

@@ -1,5 +1,17 @@
-//! Process start-up and shut-down: MPI first, then PETSc on the same
-//! communicator; PETSc finalised before MPI.
+//! The process around a run: start-up and shut-down (MPI first, then
+//! PETSc on the same communicator; PETSc finalised before MPI), the C heap's
+//! settings (`heap`), the termination signals (`signals`) and the CPU clock
+//! (`clock`).
+//!
+//! `runtime/` (process signals, malloc and the clock, through libc) and
+//! `petsc/` (the PETSc and LAPACK bindings) are the only places with
+//! `unsafe` code; each block says why it holds.
+mod clock;
+pub mod heap;
+pub mod signals;
+
+pub use clock::cpu_seconds;
+
 use crate::error::{Error, Result};
 use crate::petsc::PetscGuard;
 use mpi::topology::{Communicator, SimpleCommunicator};
@@ -18,8 +30,8 @@ impl Runtime {
     /// included), e.g. `["-ksp_type", "cg"]`.
     pub fn start(petsc_args: &[String]) -> Result<Self> {
         run_alone_without_a_daemon();
-        // Before MPI and PETSc allocate (see `petsc::heap`).
-        crate::petsc::heap::restore_malloc_defaults();
+        // Before MPI and PETSc allocate (see `heap`).
+        heap::restore_malloc_defaults();
         let universe =
             mpi::initialize().ok_or_else(|| Error::Mpi("MPI was already initialised".into()))?;
         let world = universe.world();
@@ -28,18 +40,43 @@ impl Runtime {
         let petsc = PetscGuard::initialize(&world, &args)?;
         // After PETSc's start-up, which installs its own handlers: a
         // termination signal then ends the run at a step boundary.
-        crate::petsc::signals::defer_termination(world.rank() == 0).map_err(|e| {
+        signals::defer_termination(world.rank() == 0).map_err(|e| {
             let why = format!("cannot install the SIGTERM/SIGINT handler: {e}");
             Error::Io(std::io::Error::new(e.kind(), why))
         })?;
         // Set-up time counts from here: the scene, the mesh, the partition
         // and the matrix, not MPI's and PETSc's own start-up.
-        crate::footprint::setup_started();
-        crate::footprint::checkpoint("MPI and PETSc start-up");
+        crate::memory::setup_started();
+        crate::memory::checkpoint("MPI and PETSc start-up");
         Ok(Runtime {
             _petsc: petsc,
             universe,
         })
+    }
+
+    /// The options given to this run (command line, PETSC_OPTIONS, a
+    /// scene's `petsc_options`) that neither this program nor PETSc read on
+    /// any rank (`petsc::options::unread`), as (name, value): rank 0's
+    /// list, each kept if no rank read it. Collective; at the end of a run.
+    pub fn unread_options(&self) -> Result<Vec<(String, String)>> {
+        let world = self.world();
+        let local = crate::petsc::options::unread().map_err(Error::from);
+        let rank0 = crate::parallel::agree(&world, local)?;
+        let text: String = rank0
+            .iter()
+            .map(|(k, v)| format!("{k}{FIELD}{v}{RECORD}"))
+            .collect();
+        let text = crate::parallel::broadcast_text(&world, 0, &text);
+        let mut unread = Vec::new();
+        for entry in text.split(RECORD).filter(|e| !e.is_empty()) {
+            let (key, value) = entry.split_once(FIELD).unwrap_or((entry, ""));
+            let here = crate::petsc::options::was_read(key).map_err(Error::from);
+            let read_here = crate::parallel::agree(&world, here)?;
+            if !crate::parallel::any_rank(&world, read_here) {
+                unread.push((key.to_owned(), value.to_owned()));
+            }
+        }
+        Ok(unread)
     }
 
     pub fn world(&self) -> SimpleCommunicator {
@@ -54,6 +91,11 @@ impl Runtime {
         self.universe.world().size() as usize
     }
 }
+
+/// The separators of [`Runtime::unread_options`]'s broadcast: between an
+/// option's name and value, and after each option (no option holds them).
+const FIELD: char = '\u{1f}';
+const RECORD: char = '\u{1e}';
 
 /// A process started without a launcher (`contactlink run scene.toml`) is an
 /// MPI singleton. Open MPI then forks a daemon (`orted`) for it, and its

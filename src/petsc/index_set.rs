@@ -1,18 +1,18 @@
-//! The contact DOFs C of every rank, gathered on every rank.
-use super::super::{comm_world, petsc_call, sys, PetscInt, Result};
+//! Index sets as collectives: every rank's indices on every rank.
+use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result};
 
-/// Every rank's `local` indices on every rank, sorted and distinct.
+/// Every rank's `local` indices on every rank, in rank order (ISAllGather).
 /// Collective.
-pub fn gather_sorted(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
+pub fn all_gather(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
     let mut is: sys::IS = std::ptr::null_mut();
     let mut all: sys::IS = std::ptr::null_mut();
     // SAFETY: `local` is valid for its length and copied; both index sets
     // are destroyed on every path; the gathered indices are read only
     // between ISGetIndices and its restore.
-    let mut out = unsafe {
+    unsafe {
         petsc_call!(ISCreateGeneral(
             comm_world(),
-            super::super::to_petsc_int(local.len())?,
+            to_petsc_int(local.len())?,
             local.as_ptr(),
             sys::PetscCopyMode_PETSC_COPY_VALUES,
             &mut is
@@ -33,9 +33,6 @@ pub fn gather_sorted(local: &[PetscInt]) -> Result<Vec<PetscInt>> {
         })();
         sys::ISDestroy(&mut all);
         sys::ISDestroy(&mut is);
-        read?
-    };
-    out.sort_unstable();
-    out.dedup();
-    Ok(out)
+        read
+    }
 }

@@ -1,11 +1,19 @@
-//! The shell preconditioner's state on the one-rank contact Schur path:
+//! The contact Schur path on one rank: the shell preconditioner's state,
 //! K's handle and the constrained rows, the current [`SchurFactor`] (K
-//! factored again only when the contact DOFs C grow), and the condensed
-//! Newton state it shares with the residual (`super::condensed`).
-use super::condensed::Condensation;
-use super::schur::{DenseCounts, SchurFactor};
-use super::shell::{error, ShellState};
-use super::{Matrix, PetscInt, Result, Vector};
+//! factored once with a MUMPS Schur complement on the contact DOFs C, and
+//! again only when C grows; `factor.rs`, on `layout.rs`'s C and S0, with
+//! the dense factorisations of `partial.rs`), and the condensed Newton
+//! state it shares with the residual (`newton.rs`).
+mod factor;
+mod layout;
+mod newton;
+mod partial;
+
+pub use factor::DenseCounts;
+pub use newton::Condensation;
+
+use crate::petsc::{Matrix, PetscError, PetscInt, Result, ShellPreconditioner, Vector};
+use factor::SchurFactor;
 use std::cell::RefCell;
 use std::rc::Rc;
 
@@ -69,7 +77,7 @@ impl SchurPreconditioner {
     }
 
     /// Turns on Newton on the condensed system: the returned state is the
-    /// one the residual reads (see [`super::condensed`]).
+    /// one the residual reads (see `newton.rs`).
     pub fn condense(&mut self) -> Rc<RefCell<Condensation>> {
         self.condensed
             .get_or_insert_with(|| Rc::new(RefCell::new(Condensation::default())))
@@ -158,7 +166,7 @@ impl SchurPreconditioner {
                 .is_some_and(|c| c.borrow().is_active())
         {
             // The condensed state is in the old C's positions.
-            return Err(error(
+            return Err(PetscError::new(
                 "SchurPreconditioner::set_up",
                 "the contact DOFs grew inside a condensed Newton step".into(),
             ));
@@ -193,7 +201,7 @@ impl SchurPreconditioner {
         let f = self
             .factor
             .as_mut()
-            .ok_or_else(|| error("SchurPreconditioner::set_up", "no factor".into()))?;
+            .ok_or_else(|| PetscError::new("SchurPreconditioner::set_up", "no factor".into()))?;
         f.update(kc)?;
         self.schur_factorisations += 1;
         Ok(())
@@ -208,7 +216,7 @@ impl SchurPreconditioner {
             self.sparse_solves += 1;
         }
         let Some(f) = &self.factor else {
-            return Err(error(
+            return Err(PetscError::new(
                 "SchurPreconditioner::apply",
                 "applied before its set-up".into(),
             ));
@@ -228,7 +236,7 @@ impl SchurPreconditioner {
     }
 }
 
-impl ShellState for SchurPreconditioner {
+impl ShellPreconditioner for SchurPreconditioner {
     const NAME: &'static std::ffi::CStr = c"MUMPS Schur complement on the contact DOFs";
     fn set_up(&mut self, kc: &Matrix) -> Result<()> {
         SchurPreconditioner::set_up(self, kc)

@@ -1,8 +1,9 @@
 //! G = Pᵀ K⁻¹ P by MUMPS's selected inverse entries, a column once U
 //! first takes it.
-use super::super::shell::error;
-use super::super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result};
-use super::{AnyRank, LowRankPreconditioner, OwnedMat};
+use super::{AnyRank, LowRankPreconditioner};
+use crate::petsc::{
+    options, to_petsc_int, DenseMatrix, Factor, Matrix, PetscError, PetscInt, Result,
+};
 
 /// Columns of the inverse MUMPS computes together. Its default blocking
 /// (32 here) made the entries cost twice as much: graded line b/40 on 2
@@ -81,9 +82,7 @@ impl LowRankPreconditioner {
     /// The request is an N × N matrix held on rank 0 whose row C[c] lists
     /// C[rows]: K⁻¹'s column C[c] at those rows. Collective.
     fn inverse_entries(&mut self, cols: &[usize], rows: &[usize]) -> Result<()> {
-        let (mut size, mut size_c): (PetscInt, PetscInt) = (0, 0);
-        // SAFETY: valid matrix and out-pointers.
-        unsafe { petsc_call!(MatGetSize(self.k.raw(), &mut size, &mut size_c))? };
+        let (size, _) = self.k.size()?;
         let here = if self.root { size } else { 0 };
         let nr = to_petsc_int(rows.len())?;
         let at: Vec<PetscInt> = rows.iter().map(|&r| self.c[r]).collect();
@@ -97,67 +96,31 @@ impl LowRankPreconditioner {
             Vec::new()
         };
         let ones = vec![1.0; rows.len()];
-        let mut bt = OwnedMat(std::ptr::null_mut());
-        // SAFETY: the request matrix is owned by its guard; `lengths` holds
-        // one entry per local row and the rows set are local (rank 0 owns
-        // every row and column); MUMPS writes the entries into its values.
-        // ICNTL(30) and ICNTL(21) are put back to what MatSolve expects
-        // (PETSc leaves the selected-inverse mode and a centralised
-        // solution set).
-        unsafe {
-            petsc_call!(MatCreateAIJ(
-                comm_world(),
-                here,
-                here,
-                size,
-                size,
-                0,
-                if self.root {
-                    lengths.as_ptr()
-                } else {
-                    std::ptr::null()
-                },
-                0,
-                std::ptr::null(),
-                &mut bt.0
-            ))?;
-            let set = (|| -> Result<()> {
-                for &c in cols {
-                    petsc_call!(MatSetValues(
-                        bt.0,
-                        1,
-                        &self.c[c],
-                        nr,
-                        at.as_ptr(),
-                        ones.as_ptr(),
-                        sys::InsertMode_INSERT_VALUES
-                    ))?;
-                }
-                Ok(())
-            })();
-            all_or_none(&self.any_rank, set, "requesting G's entries")?;
-            petsc_call!(MatAssemblyBegin(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(
-                bt.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            let blocking = self.inverse_blocking()?;
-            let got = petsc_call!(MatMumpsGetInverseTranspose(self.factor, bt.0));
-            petsc_call!(MatMumpsSetIcntl(self.factor, 30, 0))?;
-            petsc_call!(MatMumpsSetIcntl(self.factor, 21, 1))?;
-            if let Some(before) = blocking {
-                petsc_call!(MatMumpsSetIcntl(self.factor, 27, before))?;
-            }
-            got?;
+        // Rank 0 owns every row and column of the request; MUMPS writes the
+        // entries into its values. ICNTL(30) and ICNTL(21) are put back to
+        // what MatSolve expects (PETSc leaves the selected-inverse mode and
+        // a centralised solution set).
+        let per_row = self.root.then_some(lengths.as_slice());
+        let mut bt = Matrix::new_aij(here, size, per_row)?;
+        let set = cols
+            .iter()
+            .try_for_each(|&c| bt.set_block(&[self.c[c]], &at, &ones));
+        all_or_none(&self.any_rank, set, "requesting G's entries")?;
+        bt.assemble()?;
+        let blocking = self.inverse_blocking()?;
+        let factor = self.factor_mut()?;
+        let got = factor.inverse_entries(&mut bt);
+        factor.set_icntl(30, 0)?;
+        factor.set_icntl(21, 1)?;
+        if let Some(before) = blocking {
+            factor.set_icntl(27, before)?;
         }
+        got?;
         let local = self.read_entries(&bt, cols, rows);
         let failed = (self.any_rank)(local.is_err());
         local?;
         if failed {
-            return Err(error(
+            return Err(PetscError::new(
                 "MatMumpsGetInverseTranspose",
                 "reading the inverse entries failed on rank 0".into(),
             ));
@@ -204,70 +167,35 @@ impl LowRankPreconditioner {
     /// `count` right-hand sides. Collective.
     fn solve_at_c(&mut self, rhs: &[Vec<(usize, f64)>], count: usize) -> Result<Vec<Vec<f64>>> {
         let Some(small) = &mut self.small else {
-            return Err(error("G's columns", "no work vector".into()));
+            return Err(PetscError::new("G's columns", "no work vector".into()));
         };
         if count == 0 {
             return Ok(Vec::new());
         }
-        let cols = to_petsc_int(count)?;
-        let (mut rows, mut local_cols): (PetscInt, PetscInt) = (0, 0);
-        let mut b = OwnedMat(std::ptr::null_mut());
-        let mut x = OwnedMat(std::ptr::null_mut());
-        // SAFETY: both dense matrices are owned by their guards and laid
-        // out as K's rows with `count` columns; rank 0 sets entries of the
-        // rows it names (PETSc stashes off-process ones until assembly);
-        // each column vector is restored before the next is taken.
-        unsafe {
-            petsc_call!(MatGetLocalSize(self.k.raw(), &mut rows, &mut local_cols))?;
-            petsc_call!(MatCreateDense(
-                comm_world(),
-                rows,
-                sys::PETSC_DECIDE,
-                sys::PETSC_DETERMINE,
-                cols,
-                std::ptr::null_mut(),
-                &mut b.0
-            ))?;
-            let set = (|| -> Result<()> {
-                for (i, entries) in rhs.iter().enumerate() {
-                    let col = to_petsc_int(i)?;
-                    for &(j, v) in entries {
-                        petsc_call!(MatSetValues(
-                            b.0,
-                            1,
-                            &self.c[j],
-                            1,
-                            &col,
-                            &v,
-                            sys::InsertMode_INSERT_VALUES
-                        ))?;
-                    }
-                }
-                Ok(())
-            })();
-            all_or_none(&self.any_rank, set, "setting G's right-hand sides")?;
-            petsc_call!(MatAssemblyBegin(
-                b.0,
-                sys::MatAssemblyType_MAT_FINAL_ASSEMBLY
-            ))?;
-            petsc_call!(MatAssemblyEnd(b.0, sys::MatAssemblyType_MAT_FINAL_ASSEMBLY))?;
-            petsc_call!(MatDuplicate(
-                b.0,
-                sys::MatDuplicateOption_MAT_DO_NOT_COPY_VALUES,
-                &mut x.0
-            ))?;
-            petsc_call!(MatMatSolve(self.factor, b.0, x.0))?;
-            let mut out = Vec::with_capacity(count);
-            for i in 0..cols {
-                let mut v: sys::Vec = std::ptr::null_mut();
-                petsc_call!(MatDenseGetColumnVecRead(x.0, i, &mut v))?;
-                let picked = super::scatter(self.pick, v, small.raw(), false);
-                petsc_call!(MatDenseRestoreColumnVecRead(x.0, i, &mut v))?;
-                picked?;
-                out.push(small.with_array(|a| a.to_vec())?);
-            }
-            Ok(out)
+        let (Some(pick), Some(factor)) = (&self.pick, &self.factor) else {
+            return Err(PetscError::new("G's columns", "K is not factored".into()));
+        };
+        // Both laid out as K's rows with `count` columns; rank 0 sets
+        // entries of the rows it names (PETSc stashes off-process ones
+        // until assembly).
+        let (rows, _) = self.k.local_size()?;
+        let mut b = DenseMatrix::new_mpi(rows.max(0) as usize, count)?;
+        let set = rhs.iter().enumerate().try_for_each(|(i, entries)| {
+            let col = to_petsc_int(i)?;
+            entries
+                .iter()
+                .try_for_each(|&(j, v)| b.set(self.c[j], col, v))
+        });
+        all_or_none(&self.any_rank, set, "setting G's right-hand sides")?;
+        b.assemble()?;
+        let mut x = b.duplicate_layout()?;
+        factor.solve_many(&b, &mut x)?;
+        let mut out = Vec::with_capacity(count);
+        for i in 0..count {
+            x.with_column(i, |v| pick.forward(v, small))??;
+            out.push(small.with_array(|a| a.to_vec())?);
         }
+        Ok(out)
     }
 
     /// Whether the selected inverse's columns `new` (at `rows`) agree with
@@ -305,53 +233,49 @@ impl LowRankPreconditioner {
     /// [`INVERSE_BLOCK`] columns at once, unless the user set
     /// `-mat_mumps_icntl_27`. Returns the value to put back (single solves
     /// do not depend on it). Collective (every rank sets the same value).
-    fn inverse_blocking(&self) -> Result<Option<PetscInt>> {
-        if super::super::options::has("-mat_mumps_icntl_27")? {
+    fn inverse_blocking(&mut self) -> Result<Option<PetscInt>> {
+        if options::has("-mat_mumps_icntl_27")? {
             return Ok(None);
         }
-        let mut before: PetscInt = 0;
-        // SAFETY: a valid MUMPS factor and out-pointer.
-        unsafe {
-            petsc_call!(MatMumpsGetIcntl(self.factor, 27, &mut before))?;
-            petsc_call!(MatMumpsSetIcntl(self.factor, 27, INVERSE_BLOCK))?;
-        }
+        let factor = self.factor_mut()?;
+        let before = factor.icntl(27)?;
+        factor.set_icntl(27, INVERSE_BLOCK)?;
         Ok(Some(before))
     }
 
     /// Rank 0: the answered request's rows into G, and by symmetry into
     /// the rows `cols` of the columns `rows`.
-    fn read_entries(&mut self, bt: &OwnedMat, cols: &[usize], rows: &[usize]) -> Result<()> {
+    fn read_entries(&mut self, bt: &Matrix, cols: &[usize], rows: &[usize]) -> Result<()> {
         let n = self.c.len();
-        // SAFETY: rank 0 reads its own rows of the assembled request, each
-        // between MatGetRow and its restore, `nz` entries each.
-        unsafe {
-            for &c in cols {
-                let d = self.c[c];
-                let mut nz: PetscInt = 0;
-                let mut at: *const PetscInt = std::ptr::null();
-                let mut vals: *const f64 = std::ptr::null();
-                petsc_call!(MatGetRow(bt.0, d, &mut nz, &mut at, &mut vals))?;
-                let ok = nz as usize == rows.len() && (nz == 0 || !vals.is_null());
-                if ok && nz > 0 {
-                    let vs = std::slice::from_raw_parts(vals, rows.len());
-                    for (&r, &v) in rows.iter().zip(vs) {
-                        self.g[c * n + r] = v;
-                        self.g[r * n + c] = v;
-                    }
-                }
-                petsc_call!(MatRestoreRow(bt.0, d, &mut nz, &mut at, &mut vals))?;
-                if !ok {
-                    return Err(error(
-                        "MatMumpsGetInverseTranspose",
-                        format!(
-                            "row {d} of the inverse entries has {nz} of {} entries",
-                            rows.len()
-                        ),
-                    ));
-                }
+        let (c, g) = (&self.c, &mut self.g);
+        let mut at = cols.iter();
+        bt.for_rows(cols.iter().map(|&p| c[p]), |d, _, vals| {
+            let Some(&col) = at.next() else {
+                return Ok(());
+            };
+            if vals.len() != rows.len() {
+                return Err(PetscError::new(
+                    "MatMumpsGetInverseTranspose",
+                    format!(
+                        "row {d} of the inverse entries has {} of {} entries",
+                        vals.len(),
+                        rows.len()
+                    ),
+                ));
             }
-        }
-        Ok(())
+            for (&r, &v) in rows.iter().zip(vals) {
+                g[col * n + r] = v;
+                g[r * n + col] = v;
+            }
+            Ok(())
+        })
+    }
+
+    /// K's factor (made at the first set-up).
+    fn factor_mut(&mut self) -> Result<&mut Factor> {
+        self.factor
+            .as_mut()
+            .ok_or_else(|| PetscError::new("G's columns", "K is not factored".into()))
     }
 }
 
@@ -363,7 +287,7 @@ fn all_or_none(any_rank: &AnyRank, local: Result<()>, what: &'static str) -> Res
         return Ok(());
     }
     local?;
-    Err(error(what, "failed on another rank".into()))
+    Err(PetscError::new(what, "failed on another rank".into()))
 }
 
 /// Rank 0's `local` (< 2^32) on every rank (the others pass 0): its bits
@@ -396,7 +320,11 @@ mod tests {
     fn a_failure_on_one_rank_stops_every_rank() {
         let alone: AnyRank = Box::new(|f| f);
         assert!(all_or_none(&alone, Ok(()), "x").is_ok());
-        let own = all_or_none(&alone, Err(error("MatSetValues", "bad row".into())), "x");
+        let own = all_or_none(
+            &alone,
+            Err(PetscError::new("MatSetValues", "bad row".into())),
+            "x",
+        );
         assert!(own.unwrap_err().to_string().contains("bad row"));
         // Another rank failed: this one's Ok turns into an error too.
         let other_failed: AnyRank = Box::new(|_| true);

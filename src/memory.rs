@@ -11,8 +11,8 @@
 //! MPI, hypre, MUMPS, BLAS; 33 MiB of the 40 MiB a rank starts at, 39–41
 //! MiB by the end of a GAMG solve).
 //! Those pages are one copy in the page cache for all the ranks on a node,
-//! though every rank's `VmHWM` counts them. Reading them needs no unsafe
-//! code and costs one small file read.
+//! though every rank's `VmHWM` counts them. Reading them costs one small
+//! file read (no libc call).
 //!
 //! Checkpoints print only when `CONTACTLINK_MEMORY` is set in the
 //! environment (to anything but `0`); each rank prints its own line to

@@ -1,15 +1,18 @@
-//! Which condensed Newton state the residual reads: the one-rank Schur
-//! path's (`condensed`) or the several-rank low-rank path's
-//! (`low_rank::condensed`). Both hold the true x on the contact DOFs and a
-//! scalar for the rest; the residual asks them the same questions.
-use super::condensed::Condensation;
+//! Newton on the condensed contact system, as the residual sees it: on
+//! either path the SNES vector then holds the true x on the contact DOFs C
+//! and one scalar for the rest, and the iterates are those Newton on the
+//! whole vector would take. The one-rank Schur path's state is
+//! `schur::newton`'s, the several-rank low-rank path's `low_rank::newton`'s
+//! (their step's life is `armed`); the residual asks both the same
+//! questions.
 use super::low_rank::Reduced;
-use super::{Result, Vector};
+use super::schur::Condensation;
+use crate::petsc::{Result, Vector};
 use std::cell::RefCell;
 use std::rc::Rc;
 
 /// The condensed Newton state the residual reads: the one-rank Schur
-/// path's or the several-rank low-rank path's (`super::low_rank`).
+/// path's or the several-rank low-rank path's.
 #[derive(Clone)]
 pub enum Condensed {
     One(Rc<RefCell<Condensation>>),

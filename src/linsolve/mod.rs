@@ -1,21 +1,39 @@
-//! The contact solve on the direct path of linear bodies as a bulk
-//! factorisation once per run plus a small dense one per Jacobian: the
-//! linear bulk stiffness K is factored with a MUMPS Schur complement on the
-//! DOFs the contact tangent can touch (`petsc::schur`), and the linear
-//! solver's preconditioner becomes that exact solve of (K + Kc) x = b.
+//! Newton's linear solves beyond PETSc's own solvers: the contact Schur
+//! path (`[solver] contact_schur`), its condensed Newton, the line
+//! search's slope on it, and the floor of the linear solves.
 //!
-//! On several ranks PETSc's MUMPS Schur complement is not available; there
-//! K gets an ordinary parallel MUMPS factor, once per run, and each
-//! Jacobian a low-rank update of it on C (`petsc::low_rank`).
+//! The contact Schur path solves the direct path of linear bodies as a bulk
+//! factorisation once per run plus a small dense one per Jacobian: on one
+//! rank the linear bulk stiffness K is factored with a MUMPS Schur
+//! complement on the DOFs the contact tangent can touch (`schur/`), and the
+//! linear solver's preconditioner becomes that exact solve of
+//! (K + Kc) x = b. On several ranks PETSc's MUMPS Schur complement is not
+//! available; there K gets an ordinary parallel MUMPS factor, once per run,
+//! and each Jacobian a low-rank update of it on C (`low_rank/`). Either
+//! may run Newton on the condensed contact system (`condensed.rs`), and
+//! either takes the line search's slope from its exact solves
+//! (`slope.rs`). `floor.rs` stops any linear solve of a contact Newton
+//! step once it has removed what Newton still needs.
 //!
-//! Chosen once per run when it applies: the direct path, every body linear-elastic,
-//! contact pairs, no follower load and no inertia (nothing but contact is
-//! added to K), K kept assembled, and `[solver] contact_schur` on. C is the
-//! union of the DOFs of every contact pattern built in the run; a pattern
-//! that reaches outside it makes the next set-up factor K again with the
-//! larger C (counted as a growth).
-use super::boundary::Dirichlet;
-use super::setup::TangentKind;
+//! The path is chosen once per run when it applies: the direct path, every
+//! body linear-elastic, contact pairs, no follower load and no inertia
+//! (nothing but contact is added to K), K kept assembled, and
+//! `[solver] contact_schur` on. C is the union of the DOFs of every contact
+//! pattern built in the run; a pattern that reaches outside it makes the
+//! next set-up factor K again with the larger C (counted as a growth).
+//!
+//! Nothing here calls PETSc or LAPACK directly: `petsc/` wraps every call.
+mod armed;
+mod condensed;
+mod floor;
+mod low_rank;
+mod schur;
+mod slope;
+
+pub use condensed::Condensed;
+pub use floor::set_linear_floor;
+pub use schur::SchurPreconditioner;
+
 use crate::assembly::{PatternSink, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::distribution::LocalMesh;
@@ -23,10 +41,9 @@ use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::Result;
 use crate::model::Model;
 use crate::parallel;
-use crate::petsc::condensed_state::Condensed;
-use crate::petsc::low_rank::LowRankPreconditioner;
-use crate::petsc::schur::SchurPreconditioner;
 use crate::petsc::{Matrix, PetscInt, Snes, Vector};
+use low_rank::LowRankPreconditioner;
+use slope::LastSolve;
 
 /// What the run's report says of the Schur path.
 #[derive(Debug, Clone, Copy, Default)]
@@ -68,12 +85,13 @@ pub struct SchurSummary {
     pub dense_cpu_seconds: f64,
 }
 
-/// Whether the run takes the Schur path. Collective: a follower load's
-/// facets may sit on some ranks only, so that is agreed; every other
+/// Whether the run takes the Schur path; `linear_contact`: the model has
+/// contact pairs and every body is linear-elastic. Collective: a follower
+/// load's facets may sit on some ranks only, so that is agreed; every other
 /// argument is the same on every rank, so is the answer.
-pub(super) fn applies(
+pub fn applies(
     model: &Model,
-    tangent: TangentKind,
+    linear_contact: bool,
     loads: &SurfaceLoads,
     global_dofs: usize,
 ) -> bool {
@@ -81,8 +99,7 @@ pub(super) fn applies(
     let follower = parallel::any_rank(&world, loads.has_follower());
     let s = &model.solver;
     s.contact_schur
-        && tangent.contact
-        && tangent.linear_bulk
+        && linear_contact
         && global_dofs <= s.direct_max_dofs
         && !follower
         && model.dynamics.is_none()
@@ -99,40 +116,49 @@ fn user_kept_direct_defaults() -> bool {
 
 /// Installs the Schur preconditioner (one rank) or the low-rank one
 /// (several) on `snes` from the kept bulk stiffness `k` (a second handle,
-/// no copy) and the Dirichlet rows the Jacobian replaces by the identity.
-/// Collective.
-pub(super) fn install(
+/// no copy) and the `constrained` rows the Jacobian replaces by the
+/// identity; `symmetric`: the contact tangent is. Its exact solves take
+/// the line search's slope (`slope`) and need no Krylov iterations around
+/// them (GMRES took one each, at twice the solves; a user's -ksp_type
+/// stands). Collective.
+pub fn install(
     snes: &mut Snes,
     k: &Matrix,
-    dirichlet: &Dirichlet,
-    tangent: TangentKind,
+    constrained: Vec<PetscInt>,
+    symmetric: bool,
     ranks: usize,
 ) -> Result<()> {
     if ranks > 1 {
         let world = mpi::topology::SimpleCommunicator::world();
         let any = Box::new(move |flag| parallel::any_rank(&world, flag));
-        let pc = LowRankPreconditioner::new(k.share()?, &dirichlet.global_rows(), any)?;
-        snes.install_low_rank(pc)?;
-        return Ok(());
+        let pc = LowRankPreconditioner::new(k.share()?, &constrained, any)?;
+        snes.install_shell_preconditioner(pc)?;
+    } else {
+        let pc = SchurPreconditioner::new(k.share()?, constrained, symmetric);
+        snes.install_shell_preconditioner(pc)?;
     }
-    let pc = SchurPreconditioner::new(k.share()?, dirichlet.global_rows(), tangent.symmetric);
-    snes.install_schur(pc)?;
+    snes.set_operator(LastSolve::default())?;
+    snes.apply_preconditioner_only()?;
     Ok(())
+}
+
+/// The one-rank path (the MUMPS Schur complement) is installed.
+pub fn schur_installed(snes: &Snes) -> bool {
+    snes.preconditioner::<SchurPreconditioner>().is_some()
 }
 
 /// Whether Newton may run on the condensed contact system: a Schur path
 /// (one rank or several) is installed.
-pub(super) fn condenses(snes: &Snes) -> bool {
-    snes.schur().is_some() || snes.low_rank().is_some()
+pub fn condenses(snes: &Snes) -> bool {
+    schur_installed(snes) || snes.preconditioner::<LowRankPreconditioner>().is_some()
 }
 
-/// A load step starts at `x0` (condensed Newton only; see
-/// `petsc::condensed` and `petsc::low_rank`).
-pub(super) fn arm(snes: &mut Snes, x0: &Vector) -> Result<()> {
-    if let Some(s) = snes.schur_mut() {
+/// A load step starts at `x0` (condensed Newton only; see `condensed`).
+pub fn arm(snes: &mut Snes, x0: &Vector) -> Result<()> {
+    if let Some(s) = snes.preconditioner_mut::<SchurPreconditioner>() {
         s.arm(x0)?;
     }
-    if let Some(s) = snes.low_rank_mut() {
+    if let Some(s) = snes.preconditioner_mut::<LowRankPreconditioner>() {
         s.arm(x0)?;
     }
     Ok(())
@@ -140,33 +166,33 @@ pub(super) fn arm(snes: &mut Snes, x0: &Vector) -> Result<()> {
 
 /// The step converged: its condensed vector `x` becomes the whole state.
 /// Collective.
-pub(super) fn expand(snes: &mut Snes, x: &mut Vector) -> Result<()> {
-    if let Some(s) = snes.schur_mut() {
+pub fn expand(snes: &mut Snes, x: &mut Vector) -> Result<()> {
+    if let Some(s) = snes.preconditioner_mut::<SchurPreconditioner>() {
         s.expand(x)?;
     }
-    if let Some(s) = snes.low_rank_mut() {
+    if let Some(s) = snes.preconditioner_mut::<LowRankPreconditioner>() {
         s.expand(x)?;
     }
     Ok(())
 }
 
 /// The step ended: its condensed state is dropped.
-pub(super) fn disarm(snes: &mut Snes) {
-    if let Some(s) = snes.schur_mut() {
+pub fn disarm(snes: &mut Snes) {
+    if let Some(s) = snes.preconditioner_mut::<SchurPreconditioner>() {
         s.disarm();
     }
-    if let Some(s) = snes.low_rank_mut() {
+    if let Some(s) = snes.preconditioner_mut::<LowRankPreconditioner>() {
         s.disarm();
     }
 }
 
 /// The condensed Newton state the residual reads, when the run's Schur
 /// path condenses.
-pub(super) fn condensed_state(snes: &mut Snes) -> Option<Condensed> {
-    if let Some(s) = snes.schur_mut() {
+pub fn condensed_state(snes: &mut Snes) -> Option<Condensed> {
+    if let Some(s) = snes.preconditioner_mut::<SchurPreconditioner>() {
         return Some(Condensed::One(s.condense()));
     }
-    snes.low_rank_mut()
+    snes.preconditioner_mut::<LowRankPreconditioner>()
         .map(|s| Condensed::Several(s.condense()))
 }
 
@@ -183,7 +209,7 @@ impl PatternSink for Touched {
 
 /// Every DOF the contact pairs' current pattern couples, with the DOFs of
 /// the nodes it names (whole nodes: a node's three DOFs go together).
-pub(super) fn contact_dofs(pairs: &[ContactPair], _dofs: &DofMap) -> Result<Vec<PetscInt>> {
+fn contact_dofs(pairs: &[ContactPair]) -> Result<Vec<PetscInt>> {
     let mut t = Touched::default();
     for p in pairs {
         p.add_pattern(&mut t)?;
@@ -220,14 +246,9 @@ fn whole_nodes(dofs: &[PetscInt]) -> Vec<PetscInt> {
 
 /// After a new Jacobian pattern: the DOFs C must hold from now on, and
 /// their order key (see [`distance_to_other_body`]).
-pub(super) fn want(
-    snes: &mut Snes,
-    pairs: &[ContactPair],
-    dofs: &DofMap,
-    mesh: &LocalMesh,
-) -> Result<()> {
-    if let Some(s) = snes.schur_mut() {
-        let c = contact_dofs(pairs, dofs)?;
+pub fn want(snes: &mut Snes, pairs: &[ContactPair], dofs: &DofMap, mesh: &LocalMesh) -> Result<()> {
+    if let Some(s) = snes.preconditioner_mut::<SchurPreconditioner>() {
+        let c = contact_dofs(pairs)?;
         let reserved = reserved_dofs(pairs);
         let mut all = [c.as_slice(), &reserved].concat();
         all.sort_unstable();
@@ -235,9 +256,9 @@ pub(super) fn want(
         s.order_by(distance_to_other_body(&all, dofs, mesh));
         s.want(c, reserved);
     }
-    if let Some(s) = snes.low_rank_mut() {
+    if let Some(s) = snes.preconditioner_mut::<LowRankPreconditioner>() {
         // Collective: this rank's share, gathered.
-        s.want(&contact_dofs(pairs, dofs)?)?;
+        s.want(&contact_dofs(pairs)?)?;
     }
     Ok(())
 }
@@ -284,25 +305,27 @@ fn distance_to_other_body(c: &[PetscInt], dofs: &DofMap, mesh: &LocalMesh) -> Ve
 }
 
 /// The run's Schur figures (None: not on the Schur path).
-pub(super) fn summary(snes: &Snes) -> Option<SchurSummary> {
-    let low_rank = snes.low_rank().map(|s| SchurSummary {
-        dofs: s.schur_size(),
-        bulk_factorisations: s.bulk_factorisations,
-        schur_factorisations: s.dense_factorisations,
-        growths: s.growths,
-        low_rank: true,
-        inverse_blocks: s.inverse_blocks,
-        inverse_columns: s.inverse_columns,
-        inverse_cpu_seconds: s.inverse_cpu_seconds,
-        dense_cpu_seconds: s.dense_cpu_seconds,
-        sparse_solves: s.sparse_solves,
-        dense_solves: s.dense_steps,
-        solved_columns: s.solved_columns,
-        probe_solves: s.probe_solves,
-        inverse_redone: s.inverse_redone,
-        ..SchurSummary::default()
-    });
-    snes.schur()
+pub fn summary(snes: &Snes) -> Option<SchurSummary> {
+    let low_rank = snes
+        .preconditioner::<LowRankPreconditioner>()
+        .map(|s| SchurSummary {
+            dofs: s.schur_size(),
+            bulk_factorisations: s.bulk_factorisations,
+            schur_factorisations: s.dense_factorisations,
+            growths: s.growths,
+            low_rank: true,
+            inverse_blocks: s.inverse_blocks,
+            inverse_columns: s.inverse_columns,
+            inverse_cpu_seconds: s.inverse_cpu_seconds,
+            dense_cpu_seconds: s.dense_cpu_seconds,
+            sparse_solves: s.sparse_solves,
+            dense_solves: s.dense_steps,
+            solved_columns: s.solved_columns,
+            probe_solves: s.probe_solves,
+            inverse_redone: s.inverse_redone,
+            ..SchurSummary::default()
+        });
+    snes.preconditioner::<SchurPreconditioner>()
         .map(|s| {
             let d = s.dense_counts();
             SchurSummary {

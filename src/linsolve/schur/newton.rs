@@ -1,5 +1,5 @@
-//! Newton on the condensed contact system, with the iterates Newton on the
-//! whole vector would take.
+//! Newton on the condensed contact system on one rank, with the iterates
+//! Newton on the whole vector would take.
 //!
 //! On the Schur path J = K + Kc with Kc non-zero only on C, and K linear:
 //! the rows off C of the residual, R_I(x) = (K x − b)_I, are linear in x,
@@ -19,124 +19,9 @@
 //! where each Newton iteration took one before; every later iteration is a
 //! dense solve on C, and each residual a dense product with S0 instead of
 //! one with K.
-use super::{PetscInt, Result, Vector};
-
-/// C and its Schur order, with S0.
-pub struct Layout {
-    /// The Schur DOFs, sorted.
-    pub c: Vec<PetscInt>,
-    /// The position in the Schur complement (the index set's order) of
-    /// each entry of `c`.
-    pub pos: Vec<usize>,
-    /// Whether the DOF at each position is constrained (its row and column
-    /// are the identity's in the factored K).
-    pub fixed: Vec<bool>,
-    /// S0, column-major |C| × |C|, both triangles.
-    pub base: Vec<f64>,
-}
-
-impl Layout {
-    /// S0 v, `v` in Schur positions.
-    pub fn times_base(&self, v: &[f64]) -> Vec<f64> {
-        let n = self.c.len();
-        let mut out = vec![0.0; n];
-        for (j, &vj) in v.iter().enumerate() {
-            if vj == 0.0 {
-                continue;
-            }
-            let col = &self.base[j * n..(j + 1) * n];
-            for (o, &s) in out.iter_mut().zip(col) {
-                *o += s * vj;
-            }
-        }
-        out
-    }
-
-    /// The mean of S0's diagonal over the unconstrained positions (1 when
-    /// there are none or it is not positive).
-    pub fn mean_free_diagonal(&self) -> f64 {
-        let n = self.c.len();
-        let free: Vec<f64> = (0..n)
-            .filter(|&p| !self.fixed[p])
-            .map(|p| self.base[p * n + p])
-            .collect();
-        let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
-        if mean > 0.0 && mean.is_finite() {
-            mean
-        } else {
-            1.0
-        }
-    }
-
-    /// The entries of the whole vector `a` on C, in Schur positions.
-    pub(super) fn gather(&self, a: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; self.c.len()];
-        for (&d, &p) in self.c.iter().zip(&self.pos) {
-            out[p] = a[d as usize];
-        }
-        out
-    }
-
-    /// Writes `v` (Schur positions) into the entries of `a` on C.
-    fn scatter(&self, v: &[f64], a: &mut [f64]) {
-        for (&d, &p) in self.c.iter().zip(&self.pos) {
-            a[d as usize] = v[p];
-        }
-    }
-}
-
-/// A condensed Newton load step's life, on either path (this one rank's
-/// and `low_rank::condensed`): its start x0 from `arm` until the step
-/// ends, and the path's `S` from the step's first linear solve on.
-pub struct Armed<S> {
-    pub(super) x0: Option<Vector>,
-    pub(super) step: Option<S>,
-}
-
-impl<S> Default for Armed<S> {
-    fn default() -> Self {
-        Armed {
-            x0: None,
-            step: None,
-        }
-    }
-}
-
-impl<S> Armed<S> {
-    /// A step starts at `x0`: the next linear solve is a whole one.
-    pub fn arm(&mut self, x0: &Vector) -> Result<()> {
-        let mut copy = x0.duplicate()?;
-        copy.copy_from(x0)?;
-        self.x0 = Some(copy);
-        self.step = None;
-        Ok(())
-    }
-
-    /// The step ended without `expand` (failed, or cut back).
-    pub fn disarm(&mut self) {
-        self.x0 = None;
-        self.step = None;
-    }
-
-    /// Armed, before the step's first linear solve.
-    pub fn awaits_first_solve(&self) -> bool {
-        self.x0.is_some() && self.step.is_none()
-    }
-
-    /// The SNES vector is the condensed one.
-    pub fn is_active(&self) -> bool {
-        self.step.is_some()
-    }
-
-    /// Before the first condensed residual: x0, when the step's state
-    /// still `needs` the contact residual there.
-    pub fn base_wanted(&self, needs: impl Fn(&S) -> bool) -> Option<&Vector> {
-        match &self.step {
-            Some(s) if needs(s) => self.x0.as_ref(),
-            _ => None,
-        }
-    }
-}
+use super::super::armed::Armed;
+use super::layout::Layout;
+use crate::petsc::{PetscError, Result, Vector};
 
 /// The condensed Newton state of one load step (one rank).
 #[derive(Default)]
@@ -239,7 +124,7 @@ impl Condensation {
     fn parts(&self) -> Result<(&Vector, &Step)> {
         match (&self.armed.x0, &self.armed.step) {
             (Some(x0), Some(s)) => Ok((x0, s)),
-            _ => Err(super::shell::error(
+            _ => Err(PetscError::new(
                 "Condensation",
                 "used outside a condensed step".into(),
             )),
@@ -281,7 +166,7 @@ impl Condensation {
         let lin0 = s
             .lin0
             .as_ref()
-            .ok_or_else(|| super::shell::error("Condensation::residual", "L0 not set".into()))?;
+            .ok_or_else(|| PetscError::new("Condensation::residual", "L0 not set".into()))?;
         let theta = Self::theta(x0, s, x)?;
         let sd = s.layout.times_base(&Self::moved(x0, s, x)?);
         let r = rc.with_array(|a| s.layout.gather(a))?;
@@ -307,7 +192,7 @@ impl Condensation {
         y: &mut Vector,
     ) -> Result<()> {
         let Some(s) = self.armed.step.as_mut() else {
-            return Err(super::shell::error(
+            return Err(PetscError::new(
                 "Condensation::step",
                 "no condensed step".into(),
             ));

@@ -66,7 +66,7 @@ mod tests {
         let out = std::process::Command::new(std::env::current_exe().unwrap())
             .args([
                 "--exact",
-                "petsc::heap::tests::child_block_slack",
+                "runtime::heap::tests::child_block_slack",
                 "--ignored",
                 "--nocapture",
                 "--test-threads=1",
