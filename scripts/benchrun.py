@@ -81,13 +81,15 @@ class Provenance:
     def __init__(self, make_target=None):
         self.date = today()
         self.load_start = load()
+        # The program measured is the one checked out when the run starts.
+        self.commit = commit()
         # Named only when make started the script.
         self.make_target = make_target if os.environ.get("MAKELEVEL") else None
 
     def text(self, note=""):
         make = f" (`make {self.make_target}`)" if self.make_target else ""
         extra = f"; {note}" if note else ""
-        return (f"{self.date}, {machine()}, commit `{commit()}`, load average "
+        return (f"{self.date}, {machine()}, commit `{self.commit}`, load average "
                 f"{self.load_start:.1f} → {load():.1f}{extra}: `{command()}`{make}")
 
 
@@ -331,11 +333,12 @@ def write_table(path, title, columns, rows, provenance, key=1, intro=""):
     print(f"table: {os.path.relpath(path, os.getcwd())}")
 
 
-def seeded(date, where, cmd, machine_text="Debian 12, 2 cores, this CI machine kind"):
+def seeded(date, where, cmd, note="", machine_text="Debian 12, 2 cores, this CI machine kind"):
     """The provenance text of rows copied from figures the docs stated as
     measured (not re-run since)."""
-    return (f"{date}, {machine_text}; seeded from the figures {where} stated as measured then, "
-            f"not re-run since: `{cmd}`")
+    extra = f"; {note}" if note else ""
+    return (f"{date}, {machine_text}: seeded from the figures {where} stated as measured then, "
+            f"not re-run since{extra}: `{cmd}`")
 
 
 if __name__ == "__main__":
