@@ -58,8 +58,10 @@ def commit():
         p = subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True)
         return p.stdout.strip() if p.returncode == 0 else ""
     head = git("rev-parse", "--short", "HEAD") or "unknown"
-    # Changes to the docs (the tables themselves) do not make a run dirty.
-    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs")
+    # Changes to the documentation (the tables themselves, the README) do
+    # not make a run dirty: only what is built or run does.
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs",
+                ":(exclude)*.md")
     return head + ("-dirty" if dirty else "")
 
 

@@ -9,7 +9,7 @@ slides from there): mean, max - min and standard deviation of |Fx|/|Fz|,
 the range of the contact-frame ratio T/N, and the Newton iterations and
 cutbacks of the run. Writes one row per history into
 docs/tables/ironing.md (`make ironing-compare`), named by the file:
-`out/ironing-links.csv` is the row "links".
+`out/ironing-links.csv` is the row "links" (the formulation).
 """
 import argparse
 import csv
@@ -49,9 +49,9 @@ def main():
     if not a.no_table:
         benchrun.write_table(
             a.table, "Ironing: the die's force ratio over the drag",
-            ["run", "steps", "drag steps", "mean \\|Fx\\|/\\|Fz\\|", "max − min", "std", "T/N",
+            ["formulation", "steps", "drag steps", "mean \\|Fx\\|/\\|Fz\\|", "max − min", "std", "T/N",
              "Newton", "cutbacks"],
-            cells, prov.text("the histories of `make ironing-compare NP=...`"),
+            cells, prov.text("the histories `make ironing-compare` wrote"),
             intro="`ironing` (μ = 0.3), links and mortar on the same mesh; over the steps at "
                   "load factor ≥ 0.3, where every contact point slides.")
 
