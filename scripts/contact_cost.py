@@ -111,7 +111,7 @@ def main():
     if not a.no_table:
         benchrun.write_table(
             a.table, "Contact solve against the plain elastic solve", columns, rows,
-            prov.text(f"plain and contact in turn, medians of {a.repeats}"), key=3,
+            prov.text(f"plain and contact in turn, medians of {a.repeats}"), key=4,
             intro="Seconds: the `done:` line's solve seconds (start-up excluded); per round: "
                   "each plain / contact pair's ratio. Plain: the same mesh, materials and "
                   "Dirichlet conditions without the contact pair.")
