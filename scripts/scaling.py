@@ -46,8 +46,6 @@ import re
 import benchrun
 
 DONE = re.compile(r"done: \d+ steps, (\d+) Newton iterations, (\d+) DOFs on (\d+) rank\(s\), ([0-9.]+) s")
-SOLVER = re.compile(r"solver: (\d+) Uzawa iterations, (\d+) linear iterations, preconditioner built (\d+) times")
-KSP_REASON = re.compile(r"Linear solve converged due to \w+ iterations (\d+)")
 PHASES = re.compile(r"time per phase \(largest over ranks\): (.*)")
 PHASE = re.compile(r"([A-Za-z ]+?) ([0-9.]+) s \([0-9.]+ %\)")
 HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
@@ -98,8 +96,10 @@ def run(np_, scene, args):
         lines = [ln for ln in out.splitlines() if not ln.startswith("memory: rank")]
         tail = "\n".join(lines[-30:])
         raise SystemExit(f"{' '.join(cmd)} failed (exit code {t.returncode}):\n{tail}")
-    solver = SOLVER.search(out)
-    ksp = [int(k) for k in KSP_REASON.findall(out)]
+    # Iterations from the run's machine output (every solve path writes them).
+    h5 = f"{OUT}/scaling-run-{np_}-ranks.h5"
+    counts = benchrun.totals(h5)
+    record = benchrun.run_attrs(h5)
     h = HERTZ.search(out.split("Hertz:")[-1]) if "Hertz:" in out else None
     halo = HALO.search(out)
     mem = MEMORY.search(out)
@@ -111,11 +111,9 @@ def run(np_, scene, args):
             phases[name.strip(" ,")] = float(secs)
     return {
         "ranks": np_, "dofs": int(d[2]), "newton": int(d[1]), "seconds": float(d[4]),
-        # No `solver:` line (the 1-rank contact Schur path of the direct case
-        # prints none) and no KSP reasons: counts unknown, printed as "-".
-        "uzawa": int(solver[1]) if solver else (0 if ksp else None),
-        "ksp": int(solver[2]) if solver else (sum(ksp) if ksp else None),
-        "pc_builds": int(solver[3]) if solver else len(ksp),
+        "uzawa": counts["uzawa"],
+        "ksp": counts["linear"],
+        "pc_builds": record.get("preconditioner_builds", 0),
         "run_wall_seconds": wall, "cpu_seconds": cpu,
         "load_start": load_before, "load_end": load(),
         "cells_largest": int(bal[1]) if bal else 0, "cells_smallest": int(bal[2]) if bal else 0,
