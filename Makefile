@@ -56,13 +56,15 @@ test-mpi:
 
 # The examples of examples/, each serially (no mpirun) and on 2 ranks; each
 # checks its own answer and exits with status 1 when it is wrong. Then the
-# Python example plots the Hertz pressure profile the Rust one wrote.
+# serial partition_balance on 2 and 4 ranks' partitions (under a second),
+# and the Python example plots the Hertz pressure profile the Rust one wrote.
 test-examples:
 	@mkdir -p out/examples
 	@set -e; \
 	hertz=$(call cargo_exe,example,hertz_cylinder,build --release --example hertz_cylinder); \
 	slide=$(call cargo_exe,example,block_slide,build --release --example block_slide); \
 	gmsh=$(call cargo_exe,example,gmsh_mesh,build --release --example gmsh_mesh); \
+	balance=$(call cargo_exe,example,partition_balance,build --release --example partition_balance); \
 	echo "== example hertz_cylinder, serial, then 2 ranks"; \
 	$$hertz 0.25 out/examples/hertz_cylinder-1.h5; \
 	$(MPIRUN) -n 2 $$hertz 0.25 out/examples/hertz_cylinder-2.h5; \
@@ -72,12 +74,19 @@ test-examples:
 	echo "== example gmsh_mesh, serial, then 2 ranks"; \
 	$$gmsh; \
 	$(MPIRUN) -n 2 $$gmsh; \
+	echo "== example partition_balance, 2 and 4 ranks' partitions (serial)"; \
+	$$balance 2; \
+	$$balance 4; \
 	echo "== example plot_pressure.py"; \
 	MPLBACKEND=Agg $(PYTHON) examples/plot_pressure.py out/examples/hertz_cylinder-2.h5
 
 # Assembly throughput and solve time against DOFs; one contact solve against one
 # plain elastic solve of the same mesh; what each reuse saves; 1 vs 2 ranks
-# (CSV in bench-results/).
+# (CSV in bench-results/, tables in docs/tables/bench-*.md).
+#
+# Every benchmark target below writes its tables into docs/tables/ (through
+# scripts/benchrun.py): re-running one replaces the figures it measured, with
+# the date, machine, commit and command in the table's run line.
 bench: deps
 	@mkdir -p bench-results
 	@set -e; bin=$(call cargo_exe,bench,assembly,bench --bench assembly --no-run); \
@@ -93,6 +102,7 @@ bench: deps
 	@set -e; bin=$(call cargo_exe,bench,search,bench --bench search --no-run); \
 	echo "contact search against slave points (serial)"; \
 	$$bin | tee bench-results/search.csv
+	$(PYTHON) scripts/bench_tables.py
 
 # contactlink beside CalculiX (penalty surface-to-surface, one thread) on the
 # same meshes: the graded Hertz line contact (Gmsh, h_c = b/5 ... b/40) and the
@@ -160,7 +170,8 @@ ironing: build
 	$(PYTHON) scripts/plot_history.py out/ironing.csv out/ironing.png --pair ironing --mu 0.3 --title "ironing: die dragged over a soft slab (μ = 0.3)"
 
 # Ironing with the links and with the mortar formulation: the die's force
-# ratio |Fx|/|Fz| over the drag (mean, max - min, std) side by side.
+# ratio |Fx|/|Fz| over the drag (mean, max - min, std) side by side
+# (docs/tables/ironing.md).
 ironing-compare: build
 	@mkdir -p out
 	$(MPIRUN) -n $(NP) target/release/contactlink run ironing -q -o out/ironing-links.h5 --set contact.formulation=links
@@ -168,17 +179,19 @@ ironing-compare: build
 	$(PYTHON) scripts/ironing_ratio.py out/ironing-links.csv out/ironing-mortar.csv
 
 # Mortar against links on the same scenes, alternated, median of REPEATS
-# runs each, 1 rank (the mortar cost table of docs/performance.md).
+# runs each, 1 rank (docs/tables/mortar-cost.md).
 mortar-cost: build
 	@mkdir -p out
 	$(PYTHON) scripts/mortar_cost.py target/release/contactlink $(or $(REPEATS),3)
 
-# Contact solve against the plain elastic solve of the same mesh (README's
-# table): the graded line meshes on 1 and 2 ranks, the 98k-DOF sphere.
+# Contact solve against the plain elastic solve of the same mesh: the graded
+# line meshes on 1 and 2 ranks, the spheres (docs/tables/contact-cost.md;
+# CASES="line mortar,sphere h=0.35 mortar" runs a subset and replaces only
+# its rows).
 contact-cost: build
 	@bash scripts/install-deps.sh --peers
 	$(PYTHON) scripts/bench_peers.py --cases line --dry-run --out bench-results/lines
-	$(PYTHON) scripts/contact_cost.py target/release/contactlink $(or $(REPEATS),3) --lines bench-results/lines
+	$(PYTHON) scripts/contact_cost.py target/release/contactlink $(or $(REPEATS),3) --cases "$(CASES)" --lines bench-results/lines
 
 # The friction and dynamics figures of docs/verification.md (block-slide, ironing, impact).
 friction-figures: ironing

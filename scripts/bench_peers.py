@@ -5,6 +5,7 @@ usage: bench_peers.py [--cases line,sphere] [--sizes 5,10,20,40]
                       [--sphere-sizes 0.5,0.35] [--np 1] [--repeats 1]
                       [--sphere-repeats 1] [--dry-run]
                       [--out bench-results/peers] [--bin target/release/contactlink]
+                      [--table-dir docs/tables | --no-table]
 
 Two cases, each at a few mesh sizes:
 
@@ -41,7 +42,9 @@ and prints one table per case: wall time of the whole process, Newton
 iterations, errors, the time ratio ours/ccx, and contactlink's contact/plain
 ratio of its own solve time (the `done:` line's seconds, start-up excluded).
 Writes <out>/peers.csv (with the CPU seconds of each process too, user +
-system, less dependent on the machine's load than wall time). --dry-run writes the meshes, scenes and decks (the
+system, less dependent on the machine's load than wall time), and each
+case's rows into docs/tables/peers-line.md and docs/tables/peers-sphere.md
+(`make bench-peers`; a subset of sizes replaces only its rows). --dry-run writes the meshes, scenes and decks (the
 sphere's mesh comes from one plain contactlink solve) and runs nothing else.
 Needs gmsh, calculix-ccx and python3-h5py (`bash scripts/install-deps.sh
 --peers` installs them).
@@ -51,11 +54,10 @@ import csv
 import math
 import os
 import re
-import resource
-import statistics
 import subprocess
 import sys
-import time
+
+import benchrun
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "peers"))
@@ -221,12 +223,6 @@ def mpi_env():
                 OMP_NUM_THREADS="1"), **os.environ)
 
 
-def children_cpu():
-    """CPU seconds (user + system) of the finished child processes so far."""
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
 def run_contactlink(a, scene, contact=True):
     """One contactlink run: on one rank the program is started by itself (a
     single MPI process needs no launcher, as ccx needs none), on more under
@@ -234,12 +230,10 @@ def run_contactlink(a, scene, contact=True):
     launch = [] if a.np == 1 else ["mpirun", "--allow-run-as-root", "--oversubscribe",
                                     "-n", str(a.np)]
     cmd = launch + [a.bin, "run", scene, "-o", scene[:-5] + ".h5"] + a.extra
-    t0, c0 = time.perf_counter(), children_cpu()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
-    wall, cpu = time.perf_counter() - t0, children_cpu() - c0
-    out = p.stdout + p.stderr
+    t = benchrun.run(cmd, env=mpi_env(), check=False)
+    wall, cpu, out = t.wall, t.cpu, t.text
     d, h = DONE.search(out), HERTZ.search(out)
-    if p.returncode != 0 or not d or (contact and not h):
+    if t.returncode != 0 or not d or (contact and not h):
         sys.exit(f"contactlink failed on {scene}:\n{out[-2000:]}")
     with open(scene[:-5] + ".csv") as f:
         rows = list(csv.DictReader(f))
@@ -251,26 +245,27 @@ def run_contactlink(a, scene, contact=True):
 
 
 def median_run(a, scene, repeats, contact=True):
-    runs = [run_contactlink(a, scene, contact) for _ in range(repeats)]
-    row = dict(runs[0])
-    for key in ("wall", "cpu"):
-        row[key] = statistics.median(r[key] for r in runs)
-    row["solve"] = statistics.median(r["solve"] for r in runs)
-    return row
+    runs = benchrun.repeat(lambda: run_contactlink(a, scene, contact), repeats)
+    return benchrun.medians(runs, ["wall", "cpu", "solve"])
 
 
 def run_peer(deck, repeats):
-    """(wall, CPU seconds, Newton iterations, increments) of ccx on a deck."""
-    walls, cpus = [], []
-    for _ in range(repeats):
-        c0 = children_cpu()
-        try:
-            walls.append(ccx.run_ccx(deck))
-        except RuntimeError as e:
-            sys.exit(str(e))
-        cpus.append(children_cpu() - c0)
-    newton, increments = ccx.ccx_newton(deck[:-4] + ".sta")
-    return statistics.median(walls), statistics.median(cpus), newton, increments
+    """(wall, CPU seconds, Newton iterations, increments) of ccx on a deck,
+    on one thread; medians of `repeats` runs."""
+    job = deck[:-4]
+
+    def once():
+        t = benchrun.run(["ccx", "-i", os.path.basename(job)], check=False,
+                         env=dict(os.environ, OMP_NUM_THREADS="1"),
+                         cwd=os.path.dirname(job) or ".")
+        if t.returncode != 0 or "Job finished" not in t.text:
+            sys.exit(f"ccx failed on {deck}:\n{t.text[-2000:]}")
+        return t
+
+    runs = benchrun.repeat(once, repeats)
+    newton, increments = ccx.ccx_newton(job + ".sta")
+    return (benchrun.median(r.wall for r in runs), benchrun.median(r.cpu for r in runs),
+            newton, increments)
 
 
 def ccx_fit(job, nodes, slave_nodes, load_of, exact_of, point):
@@ -381,6 +376,30 @@ def print_row(r):
           f"{r['contact_plain']:7.2f}", flush=True)
 
 
+def write_table(a, prov, case, title, repeats, rows):
+    """The case's rows into <table-dir>/peers-<case>.md."""
+    pct = lambda v: f"{100 * v:+.2f} %"  # noqa: E731
+    cells = [[f"{case} {r['size']}", f"{r['dofs']:,}",
+              f"{r['wall']:.2f} s / {r['newton']} / {r['uzawa']} / {r['steps']}",
+              f"{pct(r['e_p0'])} / {pct(r['e_w'])}",
+              f"{r['ccx_wall']:.2f} s / {r['ccx_newton']} / {r['ccx_increments']}",
+              f"{pct(r['ccx_e_p0'])} / {pct(r['ccx_e_w'])}",
+              f"{r['ratio']:.2f}",
+              f"{r['solve']:.2f} / {r['plain_solve']:.2f} s = {r['contact_plain']:.2f}"]
+             for r in rows]
+    columns = ["mesh", "DOFs", "contactlink: wall / Newton / Uzawa / steps", "e_p0 / e_w",
+               "CalculiX: wall / Newton / increments", "e_p0 / e_w", "ours / ccx",
+               "contactlink contact / plain solve"]
+    benchrun.write_table(
+        os.path.join(a.table_dir, f"peers-{case}.md"), f"{title}: contactlink beside CalculiX",
+        columns, cells,
+        prov.text(f"contactlink on {a.np} rank(s), CalculiX 2.20 on one thread; median of {repeats}"),
+        intro="Wall: the whole process. e_p0 / e_w: the errors of p0 and of the half-width "
+              "(line) or contact radius (sphere) against Hertz, each code's nodal pressures "
+              "fitted the same way. Contact / plain: contactlink's solve seconds (`done:` line) "
+              "against the same mesh solved without the contact pair.")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", default="line,sphere", help="line, sphere or both")
@@ -395,7 +414,11 @@ def main():
                     help="a contactlink --set override for every run (repeatable)")
     ap.add_argument("--dry-run", action="store_true",
                     help="write meshes, scenes and decks; run no solve but the sphere's plain one")
+    ap.add_argument("--table-dir", default=benchrun.TABLES,
+                    help="where peers-line.md and peers-sphere.md go (default docs/tables)")
+    ap.add_argument("--no-table", action="store_true", help="write no table file")
     a = ap.parse_args()
+    prov = benchrun.Provenance("bench-peers")
     a.extra = [x for s in a.extra for x in ("--set", s)]
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     for c in cases:
@@ -433,13 +456,17 @@ def main():
               f"{'e_p0':>8} {'e_w':>8} | {'ccx s':>7} {'Newton':>6} {'incs':>4} "
               f"{'e_p0':>8} {'e_w':>8} | {'ours/ccx':>8} | {'solve':>7} {'plain':>7} "
               f"{'Newton':>6} {'c/plain':>7}")
+        mine = []
         for s in sizes:
             r = run(a, s)
             r["ratio"] = r["wall"] / r["ccx_wall"]
             r["cpu_ratio"] = r["cpu"] / r["ccx_cpu"]
             r["contact_plain"] = r["solve"] / r["plain_solve"]
             rows.append(r)
+            mine.append(r)
             print_row(r)
+        if not a.no_table:
+            write_table(a, prov, case, title, repeats, mine)
     if a.dry_run:
         return
     keys = ["case", "size", "hc", "hc_mesh", "dofs", "wall", "cpu", "solve", "newton", "uzawa",

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Contact solve against the plain elastic solve of the same mesh.
 
-Usage: contact_cost.py EXE [REPEATS [CASE ...]] [--lines DIR]
+Usage: contact_cost.py EXE [REPEATS [CASE ...]] [--cases CASE,CASE] [--lines DIR]
+                       [--table PATH | --no-table]
 
 For each case below, runs the plain scene (the same mesh, materials and
 Dirichlet conditions without the contact pair) and the contact scene in
@@ -14,12 +15,13 @@ default formulation; cases without "mortar" in their name ask for the links). Th
 cases read the graded meshes that `python3 scripts/bench_peers.py --cases
 line --dry-run --out DIR` writes (DIR defaults to /tmp/lines). Several ranks
 run under mpirun (as root with --allow-run-as-root).
+
+Writes its rows into docs/tables/contact-cost.md (`make contact-cost`).
 """
-import os
+import argparse
 import re
-import statistics
-import subprocess
-import sys
+
+import benchrun
 
 SPHERE = ["--set", "mesh.fine_size=0.35"]
 SPHERE_DIRECT = SPHERE + ["--set", "solver.direct_max_dofs=200000"]
@@ -57,55 +59,62 @@ def cases(lines):
 
 
 def run(exe, ranks, args):
-    cmd = [exe, "run", *args, "-v"]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks), "--allow-run-as-root", "--oversubscribe", *cmd]
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    text = p.stdout + p.stderr
-    if p.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{text}")
-    done = re.search(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs.*?, ([\d.]+) s", text)
+    t = benchrun.run(benchrun.launcher(ranks, mpirun=None if ranks == 1 else
+                                       "mpirun --allow-run-as-root --oversubscribe")
+                     + [exe, "run", *args, "-v"], env=benchrun.mpi_env())
+    text = t.text
+    done = benchrun.DONE.search(text)
     solver = re.search(r"solver: (\d+) Uzawa iterations, (\d+) linear iterations", text)
     return {
         "steps": int(done.group(1)),
         "newton": int(done.group(2)),
         "dofs": int(done.group(3)),
-        "seconds": float(done.group(4)),
+        "seconds": float(done.group(5)),
         "uzawa": int(solver.group(1)) if solver else 0,
         "linear": int(solver.group(2)) if solver else 0,
     }
 
 
 def main():
-    argv = sys.argv[1:]
-    lines = "/tmp/lines"
-    if "--lines" in argv:
-        i = argv.index("--lines")
-        lines = argv[i + 1]
-        del argv[i:i + 2]
-    if not argv:
-        sys.exit(__doc__)
-    exe = argv[0]
-    repeats = int(argv[1]) if len(argv) > 1 else 3
-    wanted = argv[2:]
-    chosen = [c for c in cases(lines) if not wanted or any(c[0].startswith(w) for w in wanted)]
-    print(f"load average before: {os.getloadavg()[0]:.2f}")
-    print("| case | DOFs | ranks | path | plain s | contact s | contact / plain | per round | "
-          "steps, Newton / Uzawa / linear |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("exe")
+    ap.add_argument("repeats", nargs="?", type=int, default=3)
+    ap.add_argument("cases", nargs="*", help="case name prefixes")
+    ap.add_argument("--cases", dest="case_list", default="",
+                    help="case name prefixes, comma-separated (as `make contact-cost CASES=...`)")
+    ap.add_argument("--lines", default="/tmp/lines",
+                    help="where `bench_peers.py --cases line --dry-run` wrote the line meshes")
+    benchrun.add_table_args(ap, "contact-cost")
+    a = ap.parse_args()
+    prov = benchrun.Provenance("contact-cost")
+    wanted = a.cases + [c.strip() for c in a.case_list.split(",") if c.strip()]
+    chosen = [c for c in cases(a.lines) if not wanted or any(c[0].startswith(w) for w in wanted)]
+    print(f"load average before: {benchrun.load():.2f}")
+    columns = ["case", "DOFs", "ranks", "path", "plain s", "contact s", "contact / plain",
+               "per round", "steps, Newton / Uzawa / linear"]
+    print("| " + " | ".join(columns) + " |")
+    print("| " + " | ".join("---" for _ in columns) + " |")
+    rows = []
     for name, ranks, path, plain_args, contact_args in chosen:
-        plain, contact = [], []
-        for _ in range(repeats):
-            plain.append(run(exe, ranks, plain_args))
-            contact.append(run(exe, ranks, contact_args))
-        p = statistics.median(r["seconds"] for r in plain)
-        c = statistics.median(r["seconds"] for r in contact)
-        rounds = " ".join(f"{b['seconds'] / a['seconds']:.2f}" for a, b in zip(plain, contact))
+        runs = benchrun.alternate({"plain": lambda: run(a.exe, ranks, plain_args),
+                                   "contact": lambda: run(a.exe, ranks, contact_args)}, a.repeats)
+        plain, contact = runs["plain"], runs["contact"]
+        p = benchrun.median(r["seconds"] for r in plain)
+        c = benchrun.median(r["seconds"] for r in contact)
+        rounds = " ".join(f"{b['seconds'] / x['seconds']:.2f}" for x, b in zip(plain, contact))
         last = contact[-1]
-        print(f"| {name} | {last['dofs']:,} | {ranks} | {path} | {p:.2f} | {c:.2f} | {c / p:.2f} | "
-              f"{rounds} | {last['steps']}, {last['newton']} / {last['uzawa']} / {last['linear']} |",
-              flush=True)
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
+        row = [name, f"{last['dofs']:,}", str(ranks), path, f"{p:.2f}", f"{c:.2f}", f"{c / p:.2f}",
+               rounds, f"{last['steps']}, {last['newton']} / {last['uzawa']} / {last['linear']}"]
+        rows.append(row)
+        print("| " + " | ".join(row) + " |", flush=True)
+    print(f"load average after: {benchrun.load():.2f}")
+    if not a.no_table:
+        benchrun.write_table(
+            a.table, "Contact solve against the plain elastic solve", columns, rows,
+            prov.text(f"plain and contact in turn, medians of {a.repeats}"), key=4,
+            intro="Seconds: the `done:` line's solve seconds (start-up excluded); per round: "
+                  "each plain / contact pair's ratio. Plain: the same mesh, materials and "
+                  "Dirichlet conditions without the contact pair.")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 """Peak memory per rank against the number of ranks (`make memory`).
 
 usage: memory.py [--out bench-results] [--setup-ranks 1,2,4,8] [--solve-ranks 1,2,4]
-                 [--setup-args ...] [--mpirun "mpirun ..."]
+                 [--setup-args ...] [--solve-args ...] [--mpirun "mpirun ..."]
+                 [--table-dir docs/tables | --no-table]
 
 Two cases, both of scripts/scenes/sphere-no-contact.toml (hertz-sphere's
 mesh, materials and boundary conditions without the contact pair: a plain
@@ -18,16 +19,21 @@ the smallest rank's peak per rank count, their ratios to the 1-rank peak,
 the largest peak less each rank's file-backed pages (program and library
 code, shared by the ranks of a node), and the largest rank's ratio against
 the targets (set-up on 8
-ranks <= 0.2x, solve on 4 ranks <= 0.36x) and writes <out>/memory.csv.
-Exits 0 whatever the ratios (a report, not a test); 1 when a run fails.
+ranks <= 0.2x, solve on 4 ranks <= 0.36x) and writes <out>/memory.csv and
+the rows into docs/tables/memory-setup.md and docs/tables/memory-solve.md
+(`make memory`; a case run on fewer rank counts replaces only those rows;
+with other --setup-args or --solve-args give another --table-dir or
+--no-table). Exits 0 whatever the ratios (a report, not a test); 1 when a
+run fails.
 """
 import argparse
 import csv
 import os
 import re
 import shlex
-import subprocess
 import sys
+
+import benchrun
 
 SCENE = "scripts/scenes/sphere-no-contact.toml"
 SUMMARY = re.compile(r"memory: peak resident ([0-9.]+) MiB on the largest rank, ([0-9.]+) MiB on the smallest "
@@ -38,24 +44,12 @@ CHECKPOINT = re.compile(r"memory: rank (\d+) of (\d+) after (.+?): resident ([0-
 TARGETS = {("set-up", 8): 0.2, ("solve", 4): 0.36}
 
 
-def mpi_env():
-    env = dict(os.environ, CONTACTLINK_MEMORY="1")
-    # Local defaults only where the caller set nothing (a cluster sets its own).
-    for k, v in (("OMPI_MCA_btl", "self,vader"),
-                 ("OMPI_MCA_btl_vader_single_copy_mechanism", "none"),
-                 ("OMPI_MCA_pml", "ob1"),
-                 ("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
-                 ("OMPI_MCA_rmaps_base_oversubscribe", "1")):
-        env.setdefault(k, v)
-    return env
-
-
 def run(mpirun, np_, args):
-    cmd = shlex.split(mpirun) + ["-n", str(np_), "target/release/contactlink", "run", SCENE] + args
-    p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
-    out = p.stdout + p.stderr
+    cmd = benchrun.launcher(np_, mpirun) + ["target/release/contactlink", "run", SCENE] + args
+    t = benchrun.run(cmd, env=benchrun.mpi_env(CONTACTLINK_MEMORY="1"), check=False)
+    out = t.text
     m = SUMMARY.search(out)
-    if p.returncode != 0 or not m:
+    if t.returncode != 0 or not m:
         sys.exit(f"{' '.join(cmd)} failed:\n{out[-800:]}")
     # Phase -> resident memory of the largest rank after it (first occurrence
     # of each phase; load steps keep their first).
@@ -88,7 +82,11 @@ def main():
     ap.add_argument("--setup-args", default="--set mesh.level=1")
     ap.add_argument("--solve-args", default="")
     ap.add_argument("--mpirun", default=os.environ.get("MPIRUN", "mpirun --allow-run-as-root --oversubscribe"))
+    ap.add_argument("--table-dir", default=benchrun.TABLES,
+                    help="where memory-setup.md and memory-solve.md go (default docs/tables)")
+    ap.add_argument("--no-table", action="store_true", help="write no table file")
     a = ap.parse_args()
+    prov = benchrun.Provenance("memory")
     os.makedirs(a.out, exist_ok=True)
     cases = [("set-up", a.setup_ranks, ["--setup-only"] + shlex.split(a.setup_args)),
              ("solve", a.solve_ranks, shlex.split(a.solve_args))]
@@ -143,6 +141,27 @@ def main():
         w.writeheader()
         w.writerows(rows)
     print(f"memory: {a.out}/memory.csv (machine load inflates the set-up seconds, not the memory)")
+    if a.no_table:
+        return
+    for kind, name, args in (("set-up", "setup", a.setup_args), ("solve", "solve", a.solve_args)):
+        mine = [r for r in rows if r["kind"] == kind]
+        if not mine:
+            continue
+        what = f"`{SCENE}`" + (f" with `{args}`" if args else "")
+        cells = [[str(r["ranks"]), f"{r['dofs']:,}", f"{r['peak_largest_mib']:.1f}",
+                  f"{r['peak_smallest_mib']:.1f}", f"{r['ratio']:.3f}",
+                  f"{r['private_largest_mib']:.1f}", f"{r['setup_seconds']:.2f}"] for r in mine]
+        target = {"set-up": "≤ 0.2 on 8 ranks", "solve": "≤ 0.36 on 4 ranks"}[kind]
+        benchrun.write_table(
+            os.path.join(a.table_dir, f"memory-{name}.md"),
+            f"Peak memory per rank, {kind}: {what}",
+            ["ranks", "DOFs", "largest rank MiB", "smallest rank MiB",
+             "largest / 1 rank (same run)", "largest less file-backed MiB",
+             "set-up s"],
+            cells, prov.text("one run per rank count"),
+            intro=f"Peak resident set (VmHWM) of each rank, from the `memory:` line. Target of the "
+                  f"largest rank against 1 rank: {target}. File-backed pages (program and library "
+                  f"code) are one copy per node, counted in every rank's peak.")
 
 
 if __name__ == "__main__":

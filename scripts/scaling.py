@@ -2,7 +2,8 @@
 """Strong scaling of a 3D contact solve on the iterative path (`make scaling`).
 
 usage: scaling.py [--case sphere|sphere-links|cylinder-direct] [--repeats 3] [--four]
-                  [--no-plain] [--out bench-results] [-- extra contactlink args]
+                  [--no-plain] [--out bench-results] [--table PATH | --no-table]
+                  [-- extra contactlink args]
 
 Default case, `sphere`: hertz-sphere at its default mesh (h = 0.25,
 167,013 DOFs), one load step, above `direct_max_dofs`, so GMRES + GAMG
@@ -23,7 +24,9 @@ Prints one table (ranks, DOFs, Newton / Uzawa / KSP iterations, solve
 wall seconds, whole-run CPU seconds summed over the ranks, efficiency
 T1/(P*TP), peak resident memory of the largest and smallest rank, the
 work per rank and the halo), a table of the time per phase, and the
-headline lines. Writes <out>/scaling.csv. The load average is printed with
+headline lines. Writes <out>/scaling.csv and the table's rows into
+docs/tables/scaling-<case>.md (`make scaling`; with extra contactlink
+arguments, e.g. a smaller mesh, give another --table or --no-table). The load average is printed with
 every run: wall seconds only mean something on a quiet machine (load
 average below 1 at the start); iteration counts, memory and the work per
 rank mean something always. When 1 and 2 ranks do not take the same
@@ -39,15 +42,10 @@ import argparse
 import csv
 import os
 import re
-import resource
-import shlex
-import statistics
-import subprocess
-import time
+
+import benchrun
 
 DONE = re.compile(r"done: \d+ steps, (\d+) Newton iterations, (\d+) DOFs on (\d+) rank\(s\), ([0-9.]+) s")
-SOLVER = re.compile(r"solver: (\d+) Uzawa iterations, (\d+) linear iterations, preconditioner built (\d+) times")
-KSP_REASON = re.compile(r"Linear solve converged due to \w+ iterations (\d+)")
 PHASES = re.compile(r"time per phase \(largest over ranks\): (.*)")
 PHASE = re.compile(r"([A-Za-z ]+?) ([0-9.]+) s \([0-9.]+ %\)")
 HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
@@ -80,43 +78,28 @@ CASES = {
 }
 
 
-def mpi_env():
-    env = dict(os.environ)
-    # Local defaults only where the caller set nothing (a cluster sets its own).
-    for k, v in (("OMPI_MCA_btl", "self,vader"),
-                 ("OMPI_MCA_btl_vader_single_copy_mechanism", "none"),
-                 ("OMPI_MCA_pml", "ob1"),
-                 ("OMPI_ALLOW_RUN_AS_ROOT", "1"), ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")):
-        env.setdefault(k, v)
-    # For the `partition:` balance line (the memory checkpoints come along).
-    env["CONTACTLINK_MEMORY"] = "1"
-    return env
-
-
 def load():
-    return os.getloadavg()[0]
+    return benchrun.load()
 
 
 def run(np_, scene, args):
-    mpirun = shlex.split(os.environ.get("MPIRUN", "mpirun --allow-run-as-root --oversubscribe"))
-    cmd = mpirun + ["-n", str(np_), "target/release/contactlink", "run", scene, "-o",
-                    f"{OUT}/scaling-run-{np_}-ranks.h5"] + args
+    cmd = benchrun.launcher(np_, os.environ.get("MPIRUN", "mpirun --allow-run-as-root --oversubscribe")) + \
+        ["target/release/contactlink", "run", scene, "-o", f"{OUT}/scaling-run-{np_}-ranks.h5"] + args
     load_before = load()
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.monotonic()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env())
-    wall = time.monotonic() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    out = p.stdout + p.stderr
+    # CONTACTLINK_MEMORY for the `partition:` balance line (the memory
+    # checkpoints come along).
+    t = benchrun.run(cmd, env=benchrun.mpi_env(CONTACTLINK_MEMORY="1"), check=False)
+    wall, cpu, out = t.wall, t.cpu, t.text
     d = DONE.search(out)
-    if p.returncode != 0 or not d:
+    if t.returncode != 0 or not d:
         # The memory checkpoints (stderr) would bury the error message.
         lines = [ln for ln in out.splitlines() if not ln.startswith("memory: rank")]
         tail = "\n".join(lines[-30:])
-        raise SystemExit(f"{' '.join(cmd)} failed (exit code {p.returncode}):\n{tail}")
-    solver = SOLVER.search(out)
-    ksp = [int(k) for k in KSP_REASON.findall(out)]
+        raise SystemExit(f"{' '.join(cmd)} failed (exit code {t.returncode}):\n{tail}")
+    # Iterations from the run's machine output (every solve path writes them).
+    h5 = f"{OUT}/scaling-run-{np_}-ranks.h5"
+    counts = benchrun.totals(h5)
+    record = benchrun.run_attrs(h5)
     h = HERTZ.search(out.split("Hertz:")[-1]) if "Hertz:" in out else None
     halo = HALO.search(out)
     mem = MEMORY.search(out)
@@ -128,11 +111,9 @@ def run(np_, scene, args):
             phases[name.strip(" ,")] = float(secs)
     return {
         "ranks": np_, "dofs": int(d[2]), "newton": int(d[1]), "seconds": float(d[4]),
-        # No `solver:` line (the 1-rank contact Schur path of the direct case
-        # prints none) and no KSP reasons: counts unknown, printed as "-".
-        "uzawa": int(solver[1]) if solver else (0 if ksp else None),
-        "ksp": int(solver[2]) if solver else (sum(ksp) if ksp else None),
-        "pc_builds": int(solver[3]) if solver else len(ksp),
+        "uzawa": counts["uzawa"],
+        "ksp": counts["linear"],
+        "pc_builds": record.get("preconditioner_builds", 0),
         "run_wall_seconds": wall, "cpu_seconds": cpu,
         "load_start": load_before, "load_end": load(),
         "cells_largest": int(bal[1]) if bal else 0, "cells_smallest": int(bal[2]) if bal else 0,
@@ -148,21 +129,20 @@ def run(np_, scene, args):
 def series(kind, scene, args, ranks, repeats):
     """Median of `repeats` runs per rank count, the rank counts alternating
     (1, 2, 1, 2, ...) so that a change of load hits both alike."""
-    runs = {n: [] for n in ranks}
-    for i in range(repeats):
-        for n in ranks:
-            r = run(n, scene, args)
-            runs[n].append(r)
-            print(f"  {kind:<8} {n} rank(s), run {i + 1}/{repeats}: {r['seconds']:7.2f} s solve, "
-                  f"{r['cpu_seconds']:7.2f} s CPU, Newton {r['newton']}, KSP {r['ksp']}, "
-                  f"load average {r['load_start']:.1f} -> {r['load_end']:.1f}", flush=True)
+    def one(n):
+        r = run(n, scene, args)
+        print(f"  {kind:<8} {n} rank(s): {r['seconds']:7.2f} s solve, "
+              f"{r['cpu_seconds']:7.2f} s CPU, Newton {r['newton']}, KSP {r['ksp']}, "
+              f"load average {r['load_start']:.1f} -> {r['load_end']:.1f}", flush=True)
+        return r
+
+    runs = benchrun.alternate({n: (lambda n=n: one(n)) for n in ranks}, repeats)
     rows = []
     for n in ranks:
         rs = runs[n]
-        row = dict(rs[0], kind=kind, repeats=len(rs))
-        for k in ["seconds", "run_wall_seconds", "cpu_seconds", "peak_largest_mib", "peak_smallest_mib"] + \
-                [f"t_{p}" for p in PHASE_NAMES]:
-            row[k] = statistics.median(r[k] for r in rs)
+        row = benchrun.medians(rs, ["seconds", "run_wall_seconds", "cpu_seconds", "peak_largest_mib",
+                                    "peak_smallest_mib"] + [f"t_{p}" for p in PHASE_NAMES])
+        row.update(kind=kind, repeats=len(rs), seconds_spread=benchrun.spread(r["seconds"] for r in rs))
         row["load_start"] = max(r["load_start"] for r in rs)
         row["load_end"] = max(r["load_end"] for r in rs)
         # Iteration counts of every repeat (they should not vary).
@@ -222,7 +202,11 @@ def main():
     ap.add_argument("--no-plain", action="store_true", help="skip the plain elastic ceiling")
     ap.add_argument("--out", default="bench-results")
     ap.add_argument("extra", nargs="*", help="more contactlink arguments (after --)")
+    ap.add_argument("--table", default=None,
+                    help="markdown table to update (default docs/tables/scaling-CASE.md)")
+    ap.add_argument("--no-table", action="store_true", help="write no table file")
     a = ap.parse_args()
+    prov = benchrun.Provenance("scaling")
     OUT = a.out
     os.makedirs(a.out, exist_ok=True)
     scene, args, plain, what = CASES[a.case]
@@ -295,6 +279,21 @@ def main():
     print(f"load average during the runs: at most {max(r['load_end'] for r in everything):.1f}"
           + ("" if quiet else "; re-run on a quiet machine for meaningful seconds"))
     print(f"scaling: {a.out}/scaling.csv")
+    if not a.no_table:
+        cells = []
+        for r in everything:
+            eff = "" if r["ranks"] == 1 else f"{100 * r['efficiency']:.0f} % (per Newton {100 * r['newton_efficiency']:.0f} %)"
+            cells.append([r["kind"], str(r["ranks"]), f"{r['dofs']:,}",
+                          f"{r['newton']} / {count(r['uzawa'])} / {count(r['ksp'])}",
+                          str(r["seconds_spread"]), f"{r['cpu_seconds']:.2f}", eff,
+                          f"{r['peak_largest_mib']:.0f} / {r['peak_smallest_mib']:.0f}"])
+        benchrun.write_table(
+            a.table or benchrun.table_path(f"scaling-{a.case}"), f"Strong scaling: {what}",
+            ["kind", "ranks", "DOFs", "Newton / Uzawa / KSP", "solve s, median (min–max)",
+             "whole-run CPU s", "efficiency T1/(P·TP)", "peak MiB largest / smallest"],
+            cells, prov.text(f"medians of {a.repeats}, rank counts alternated"), key=2,
+            intro="Contact: the scene as shipped; plain: the same mesh without its contact pair "
+                  "(one CG + GAMG solve), the machine's ceiling for a bandwidth-bound solve.")
 
 
 OUT = "bench-results"

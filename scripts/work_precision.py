@@ -4,25 +4,25 @@
 usage: work_precision.py --scene hertz-cylinder [--np 2] [--repeats 3]
                          [--sizes 0.4,0.2,0.1] [--penalties 0.1,1,10]
                          [--tols 1e-2,1e-3,1e-4] [--out bench-results]
-                         [--bin target/release/contactlink]
+                         [--bin target/release/contactlink] [--table PATH | --no-table]
 
 Every configuration (contact-zone element size h, penalty as a multiple of
 the default 10·E/h, Uzawa tolerance for both penetration and multiplier
 change) runs `--repeats` times under mpirun; the row keeps the median wall
 time (the whole process, what a user waits), the DOFs, Newton and Uzawa
 iteration counts and the relative errors of p0 and of b (or a) against
-Hertz. Writes <out>/wp-<scene>.csv and a log-log PNG of max(|e_p0|, |e_b|)
-against wall time with the Pareto front (no other run is both faster and
-more accurate) marked.
+Hertz (the counts and errors from the run's history CSV and the `/run` and
+`/hertz` attributes of its result file). Writes <out>/wp-<scene>.csv, a
+log-log PNG of max(|e_p0|, |e_b|) against wall time with the Pareto front
+(no other run is both faster and more accurate) marked, and every row into
+docs/tables/work-precision-<scene>.md (`make work-precision`).
 """
 import argparse
 import csv
 import os
-import re
-import statistics
-import subprocess
 import sys
-import time
+
+import benchrun
 
 import matplotlib
 
@@ -30,31 +30,23 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 YOUNGS = 1000.0  # both Hertz scenes use E = 1000 on both bodies
-DONE = re.compile(r"done: (\d+) steps, (\d+) Newton iterations, (\d+) DOFs")
-HERTZ = re.compile(r"\(([+-]?[0-9.]+) %\).*\(([+-]?[0-9.]+) %\)")
 
 
 def run_once(binary, scene, np_, args, h5):
-    cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(np_),
-           binary, "run", scene, "-o", h5] + args
-    env = dict(dict(OMPI_MCA_btl="self,vader",
-               OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_pml="ob1",
-               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"), **os.environ)
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    out = p.stdout + p.stderr
-    if p.returncode != 0:
-        return None, out
-    d, h = DONE.search(out), HERTZ.search(out.split("Hertz:")[-1])
-    if not d or not h:
-        return None, out
-    with open(h5[:-3] + ".csv") as f:
-        uzawa = sum(int(r["uzawa"]) for r in csv.DictReader(f))
+    cmd = benchrun.launcher(np_, "mpirun --allow-run-as-root --oversubscribe") + \
+        [binary, "run", scene, "-q", "-o", h5] + args
+    t = benchrun.run(cmd, env=benchrun.mpi_env(), check=False)
+    if t.returncode != 0:
+        return None, t.text
+    rec = benchrun.run_attrs(h5)
+    if "hertz.p0_error" not in rec:
+        return None, t.text + "\n(no Hertz comparison in the result file)"
+    counts = benchrun.totals(h5)
     return {
-        "wall": wall, "steps": int(d[1]), "newton": int(d[2]), "dofs": int(d[3]),
-        "uzawa": uzawa, "e_p0": float(h[1]) / 100, "e_b": float(h[2]) / 100,
-    }, out
+        "wall": t.wall, "steps": counts["steps"], "newton": counts["newton"],
+        "dofs": rec["dofs"], "uzawa": counts["uzawa"],
+        "e_p0": rec["hertz.p0_error"], "e_b": rec["hertz.width_error"],
+    }, t.text
 
 
 def pareto(rows):
@@ -76,7 +68,11 @@ def main():
     ap.add_argument("--out", default="bench-results")
     ap.add_argument("--bin", default="target/release/contactlink",
                     help="the contactlink binary (a copy lets a sweep run while you rebuild)")
+    ap.add_argument("--table", default=None,
+                    help="markdown table to update (default docs/tables/work-precision-SCENE.md)")
+    ap.add_argument("--no-table", action="store_true", help="write no table file")
     a = ap.parse_args()
+    prov = benchrun.Provenance("work-precision")
     os.makedirs(a.out, exist_ok=True)
     rows = []
     for h in [float(v) for v in a.sizes.split(",")]:
@@ -88,18 +84,16 @@ def main():
                         "--set", f"contact.multiplier_tol={tol}",
                         "--set", "contact.max_uzawa=60",
                         "--set", "solver.direct_max_dofs=200000"]
-                runs = []
-                for i in range(a.repeats):
-                    r, out = run_once(a.bin, a.scene, a.np, args, f"{a.out}/wp-{a.scene}-run.h5")
-                    if r is None:
-                        print(f"h={h} penalty×{k} tol={tol}: failed\n{out[-400:]}",
-                              file=sys.stderr)
-                        break
-                    runs.append(r)
-                if not runs:
+                done = benchrun.repeat(
+                    lambda: run_once(a.bin, a.scene, a.np, args, f"{a.out}/wp-{a.scene}-run.h5"),
+                    a.repeats)
+                failed = [out for r, out in done if r is None]
+                if failed:
+                    print(f"h={h} penalty×{k} tol={tol}: failed\n{failed[0][-400:]}",
+                          file=sys.stderr)
                     continue
-                row = dict(runs[0])
-                row["wall"] = statistics.median(x["wall"] for x in runs)
+                runs = [r for r, _ in done]
+                row = benchrun.medians(runs, ["wall"])
                 row.update(h=h, penalty_factor=k, tol=tol, repeats=len(runs))
                 row["error"] = max(abs(row["e_p0"]), abs(row["e_b"]))
                 rows.append(row)
@@ -139,6 +133,21 @@ def main():
     for r in front:
         print(f"  h={r['h']} penalty×{r['penalty_factor']} tol={r['tol']}: "
               f"{r['wall']:.2f} s, error {100 * r['error']:.3f} %")
+    if not a.no_table:
+        width = "e_b" if a.scene == "hertz-cylinder" else "e_a (or e_b)"
+        cells = [[f"{r['h']:g}", f"×{r['penalty_factor']:g}", f"{r['tol']:g}", f"{r['dofs']:,}",
+                  f"{r['wall']:.2f} s", f"{r['newton']} / {r['uzawa']}",
+                  f"{100 * r['e_p0']:+.3f} %", f"{100 * r['e_b']:+.3f} %",
+                  "yes" if r["pareto"] else ""] for r in rows]
+        benchrun.write_table(
+            a.table or benchrun.table_path(f"work-precision-{a.scene}"),
+            f"Work against precision: {a.scene}",
+            ["h", "penalty", "Uzawa tol", "DOFs", "wall", "Newton / Uzawa", "e_p0", width, "front"],
+            cells, prov.text(f"{a.np} rank(s), medians of {a.repeats} (whole process)"), key=3,
+            intro="Penalty: a multiple of the default 10·E/h; Uzawa tol: penetration and "
+                  "multiplier change alike. Front: on the Pareto front of max(|e_p0|, |e_b|) "
+                  "against wall time (no run both faster and more accurate), over the rows of "
+                  "the run that measured them.")
 
 
 if __name__ == "__main__":

@@ -227,6 +227,18 @@ fn run_model_with(
         }
         None => sim.run(rt, &mut hertz, echo, restart)?,
     };
+    if let Some(path) = output {
+        // The file is closed (its sinks are gone): rank 0 adds the run's
+        // totals and the last Hertz comparison, which tests and benchmark
+        // scripts read instead of the printed summary.
+        let written = if rt.rank() == 0 {
+            let record = crate::output::RunRecord::of(&report, rt.size());
+            crate::output::write_run_record(path, &record, hertz.last.as_ref()).map_err(Into::into)
+        } else {
+            Ok(())
+        };
+        crate::parallel::agree(&rt.world(), written)?;
+    }
     Ok(RunSummary {
         model_name: model.name.clone(),
         report,

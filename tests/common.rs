@@ -172,6 +172,40 @@ pub fn csv_steps(path: &Path) -> Vec<usize> {
         .collect()
 }
 
+/// The per-step history CSV written next to result file `h5`: one map of
+/// column name to value per converged step.
+pub fn history(h5: &Path) -> Vec<std::collections::HashMap<String, f64>> {
+    let path = h5.with_extension("csv");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("history {}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("history header").split(',').collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .zip(l.split(','))
+                .map(|(k, v)| {
+                    let value = v
+                        .parse()
+                        .unwrap_or_else(|_| panic!("{k} = {v:?} in {}", path.display()));
+                    (k.to_string(), value)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A column of a history summed over its steps, as a count.
+pub fn history_sum(rows: &[std::collections::HashMap<String, f64>], column: &str) -> usize {
+    rows.iter()
+        .map(|r| {
+            r.get(column)
+                .unwrap_or_else(|| panic!("no {column} column"))
+        })
+        .sum::<f64>() as usize
+}
+
 /// Every step the CSV lists is in the HDF5 file, and its displacement reads.
 pub fn assert_file_holds(h5: &Path, csv_listed: &[usize]) {
     let steps = contactlink::output::list_steps(h5)

@@ -252,7 +252,7 @@ fn try_case(
     formulation: &str,
     ranks: usize,
     extra: &[&str],
-) -> Result<(Vec<f64>, Vec<f64>, String), String> {
+) -> Result<(Vec<f64>, Vec<f64>, contactlink::output::RunRecord), String> {
     let out = output_path(dir, case, formulation, ranks, extra);
     let name = out.with_extension("toml");
     let name = name.file_name().expect("a file name").to_string_lossy();
@@ -275,7 +275,10 @@ fn try_case(
     )
     .expect("force")
     .0;
-    Ok((slave_pressures(&out, case.slave().0), force, text(&o)))
+    let record = contactlink::output::read_run_record(&out)
+        .expect("read /run")
+        .expect("the run's /run");
+    Ok((slave_pressures(&out, case.slave().0), force, record))
 }
 
 /// The mortar pair's nodal datasets at the slave nodes: λ, g̃ and the traction.
@@ -399,11 +402,12 @@ fn mortar_on_two_ranks_takes_the_low_rank_path_with_the_same_answer() {
                 .unwrap_or_else(|t| panic!("{}: {t}", case.name))
         };
         let (p1, f1, _) = run(1, &["-q"]);
-        let (p, f, log) = run(2, &["-v"]);
-        let (pf, ff, full) = run(2, &["-v", "--set", "solver.contact_schur=false"]);
+        let (p, f, on) = run(2, &["-q"]);
+        let (pf, ff, off) = run(2, &["-q", "--set", "solver.contact_schur=false"]);
+        let low_rank = |r: &contactlink::output::RunRecord| r.schur.is_some_and(|s| s.low_rank);
         assert!(
-            log.contains("contact low-rank update on") && !full.contains("contact low-rank update"),
-            "{}: the low-rank path was not taken, or not only when on:\n{log}\n{full}",
+            low_rank(&on) && !low_rank(&off),
+            "{}: the low-rank path was not taken, or not only when on:\n{on:?}\n{off:?}",
             case.name
         );
         for (what, q, fq) in [("full factorisation", &pf, &ff), ("1 rank", &p1, &f1)] {
@@ -536,22 +540,18 @@ fn mortar_search_follows_a_contact_zone_that_grows_past_the_steps_margin() {
     );
 }
 
-/// The percentages of a run's two Hertz lines: (p0, width) read as point
-/// values ("Hertz: ... (e %) ... (e %)") and read as nodal averages.
-fn hertz_errors(run_text: &str) -> [(f64, f64); 2] {
-    let percents = |marker: &str| -> (f64, f64) {
-        let line = run_text
-            .lines()
-            .find(|l| l.contains(marker))
-            .unwrap_or_else(|| panic!("no {marker:?} line in:\n{run_text}"));
-        let values: Vec<f64> = line
-            .split(" %")
-            .filter_map(|part| part.rsplit([' ', '(']).next()?.parse().ok())
-            .collect();
-        assert_eq!(values.len(), 2, "two percentages in {line:?}");
-        (values[0], values[1])
-    };
-    [percents("Hertz: load"), percents("read as nodal averages")]
+/// The Hertz errors a run wrote on its result file's `/hertz` (the last
+/// step's comparison), in percent: (p0, width) read as point values and
+/// read as nodal averages.
+fn hertz_errors(h5: &Path) -> [(f64, f64); 2] {
+    let h = contactlink::output::read_hertz_record(h5)
+        .unwrap_or_else(|e| panic!("{}: {e}", h5.display()))
+        .unwrap_or_else(|| panic!("{}: no Hertz figures", h5.display()));
+    let (ap, aw) = h.averaged_errors.expect("the nodal-average fit");
+    [
+        (100.0 * h.p0_error, 100.0 * h.width_error),
+        (100.0 * ap, 100.0 * aw),
+    ]
 }
 
 /// Hertz line contact (`hertz-cylinder`, h = 0.2, 1 rank), both
@@ -565,8 +565,10 @@ fn hertz_errors(run_text: &str) -> [(f64, f64); 2] {
 /// reading and misses by 0.005 points in the second).
 #[test]
 fn mortar_hertz_line_errors_match_the_links() {
+    let dir = scratch("mortar-hertz-line-errors");
     let errors = |formulation: &str| {
         let set = format!("contact.formulation={formulation}");
+        let out = dir.join(format!("{formulation}.h5"));
         let o = run(&[
             "run",
             "hertz-cylinder",
@@ -578,9 +580,12 @@ fn mortar_hertz_line_errors_match_the_links() {
             "contact.multiplier_tol=1e-6",
             "--set",
             "contact.penetration_tol=1e-6",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{formulation} failed:\n{}", text(&o));
-        hertz_errors(&text(&o))
+        hertz_errors(&out)
     };
     let (links, mortar) = (errors("links"), errors("mortar"));
     println!("point reading, nodal averages (p0 %, width %): links {links:?}, mortar {mortar:?}");
@@ -598,17 +603,27 @@ fn mortar_hertz_line_errors_match_the_links() {
 }
 
 /// The nodal-average Hertz fit gathers each loaded node's shape-function
-/// samples from the ranks that hold its facets: 1 and 3 ranks print the
-/// same figures.
+/// samples from the ranks that hold its facets: 1 and 3 ranks give the
+/// same figures to the digits the run prints (0.001 points).
 #[test]
 fn nodal_average_hertz_fit_is_the_same_on_one_and_three_ranks() {
+    let dir = scratch("mortar-hertz-fit-ranks");
     let errors = |ranks: usize| {
+        let out = dir.join(format!("hc-{ranks}.h5"));
         let o = mpirun(
             ranks,
-            &["run", "hertz-cylinder", "--set", "mesh.fine_size=0.2"],
+            &[
+                "run",
+                "hertz-cylinder",
+                "--set",
+                "mesh.fine_size=0.2",
+                "-q",
+                "-o",
+                out.to_str().unwrap(),
+            ],
         );
         assert!(o.status.success(), "{ranks} ranks failed:\n{}", text(&o));
-        hertz_errors(&text(&o))
+        hertz_errors(&out).map(|(p0, w)| format!("{p0:+.3} / {w:+.3} %"))
     };
     let (one, three) = (errors(1), errors(3));
     println!("point reading, nodal averages: 1 rank {one:?}, 3 ranks {three:?}");

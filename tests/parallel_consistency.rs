@@ -157,26 +157,26 @@ fn master_is_held_in_pieces_on_4_ranks() {
         &[
             "run",
             path.to_str().unwrap(),
-            "-v",
+            "-q",
             "-o",
             out.to_str().unwrap(),
         ],
     );
     assert!(o.status.success(), "{}", text(&o));
-    let line = text(&o)
-        .lines()
-        .find(|l| l.contains("facets held per rank"))
-        .map(str::to_owned)
-        .expect("the -v output names the held master facets");
-    // "... held per rank MIN..MAX of WHOLE (received at most R)"
-    let numbers: Vec<usize> = line
-        .split(|c: char| !c.is_ascii_digit())
-        .filter(|w| !w.is_empty())
-        .map(|w| w.parse().unwrap())
-        .collect();
-    let [.., max, whole, received] = numbers[..] else {
-        panic!("unexpected line: {line}");
+    // The history's first step: master facets held per rank (most), the
+    // whole master's, and the most any rank received.
+    let rows = history(&out);
+    let step = rows.first().expect("a converged step");
+    let column = |k: &str| {
+        *step
+            .get(&format!("interface.{k}"))
+            .unwrap_or_else(|| panic!("no interface.{k} in the history: {step:?}"))
     };
-    assert!(max > 0 && max < whole, "{line}");
-    assert!(received > 0, "no rank received master facets: {line}");
+    let (max, whole, received) = (
+        column("master_held_max"),
+        column("master_facets"),
+        column("master_received_max"),
+    );
+    assert!(max > 0.0 && max < whole, "held {max} of {whole}");
+    assert!(received > 0.0, "no rank received master facets: {step:?}");
 }

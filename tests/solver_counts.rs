@@ -5,10 +5,13 @@
 //! for round-off (a count moves by one when a residual lands on the other
 //! side of a tolerance), not for a lost lever.
 //!
-//! Counts are summed over the steps of one serial run (`-v` step lines and
-//! the summary's solver line). Small meshes only: the whole file runs in
-//! seconds. Each scene is pinned with the links (`LINKS`, their counts
-//! since these pins were set) and with the mortar, the default.
+//! Counts are summed over the steps of one serial run, read from its
+//! machine output: the history CSV next to the result file (Newton, Uzawa
+//! and linear iterations and cutbacks per step) and the file's `/run`
+//! attributes (preconditioner builds and reuses, the contact Schur path's
+//! factorisations). Small meshes only: the whole file runs in seconds.
+//! Each scene is pinned with the links (`LINKS`, their counts since these
+//! pins were set) and with the mortar, the default.
 mod common;
 use common::LINKS;
 
@@ -30,52 +33,46 @@ struct Counts {
 fn counts(args: &[&str]) -> Counts {
     let dir = common::scratch(&format!(
         "counts-{}",
-        args.join("-").replace(['=', '.'], "_")
+        args.join("-").replace(['=', '.', '/'], "_")
     ));
     let out = dir.join("run.h5");
     let mut all = vec!["run"];
     all.extend_from_slice(args);
-    all.extend_from_slice(&["-v", "-o", out.to_str().unwrap()]);
+    all.extend_from_slice(&["-q", "-o", out.to_str().unwrap()]);
     let o = common::run(&all);
     let text = common::text(&o);
     assert!(o.status.success(), "{args:?} failed:\n{text}");
-    let mut c = Counts::default();
-    for line in text.lines() {
-        let w: Vec<&str> = line.split_whitespace().collect();
-        if w.first() == Some(&"step") && w.get(4) == Some(&"newton") {
-            c.steps += 1;
-            c.newton += w[5].parse::<usize>().unwrap();
-            c.uzawa += w[7].parse::<usize>().unwrap();
-            c.ksp += w[9].parse::<usize>().unwrap();
-        }
-        if line.trim_start().starts_with("cutback:") {
-            c.cutbacks += 1;
-        }
-        if let (Some(bulk), Some(dense)) = (
-            line.split("bulk stiffness factored ").nth(1),
-            line.split("Schur complement factored ").nth(1),
-        ) {
-            let first = |s: &str| {
-                s.split_whitespace()
-                    .next()
-                    .unwrap()
-                    .parse::<usize>()
-                    .unwrap()
-            };
-            c.schur = Some((first(bulk), first(dense)));
-        }
-        if let Some(rest) = line.split("preconditioner built ").nth(1) {
-            let n: Vec<usize> = rest
-                .split_whitespace()
-                .filter_map(|t| t.parse().ok())
-                .collect();
-            c.builds = n[0];
-            c.reuses = n[1];
-        }
-    }
-    assert!(
-        c.steps > 0,
-        "no step lines in the output of {args:?}:\n{text}"
+    let rows = common::history(&out);
+    let sum = |column| common::history_sum(&rows, column);
+    let run = contactlink::output::read_run_record(&out)
+        .unwrap_or_else(|e| panic!("{args:?}: {e}"))
+        .unwrap_or_else(|| panic!("{args:?}: no /run in {}", out.display()));
+    let c = Counts {
+        steps: rows.len(),
+        newton: sum("newton"),
+        uzawa: sum("uzawa"),
+        ksp: sum("linear"),
+        cutbacks: sum("cutbacks"),
+        builds: run.preconditioner_builds,
+        reuses: run.preconditioner_reuses,
+        // One rank: the Schur complement's own path (several ranks take
+        // the low-rank update, whose dense factorisations are of I + D·G).
+        schur: run
+            .schur
+            .filter(|s| !s.low_rank)
+            .map(|s| (s.bulk_factorisations, s.schur_factorisations)),
+    };
+    assert!(c.steps > 0, "no steps in the history of {args:?}");
+    // The run's own totals agree with its per-step history.
+    assert_eq!(
+        (run.steps, run.newton_iterations, run.uzawa_iterations),
+        (c.steps, c.newton, c.uzawa),
+        "{args:?}: /run against the history"
+    );
+    assert_eq!(
+        (run.linear_iterations, run.cutbacks),
+        (c.ksp, c.cutbacks),
+        "{args:?}: /run against the history"
     );
     c
 }

@@ -1,21 +1,24 @@
 //! `contactlink summary` and `contactlink plot` on a real run: a coarse
 //! Hertz line contact on 2 ranks. The summary must reproduce what the run
-//! itself printed (force, normal force, active points, peak pressure) and
+//! itself recorded (force, normal force, active points in its history CSV;
+//! the fitted peak pressure on `/hertz`) and
 //! the contact area must match the Hertz width 2·b·thickness.
 mod common;
 use common::*;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// The coarse Hertz line contact, with per-step lines (-v) to compare with.
-fn hertz_run(dir: &Path) -> (std::path::PathBuf, String) {
+/// The coarse Hertz line contact on 2 ranks; its result file, whose
+/// history CSV and `/hertz` figures are the run's own record to compare
+/// `summary` and `plot` with.
+fn hertz_run(dir: &Path) -> std::path::PathBuf {
     let out = dir.join("hc.h5");
     let o = mpirun(
         2,
         &[
             "run",
             "hertz-cylinder",
-            "-v",
+            "-q",
             "-o",
             out.to_str().unwrap(),
             "--set",
@@ -27,41 +30,7 @@ fn hertz_run(dir: &Path) -> (std::path::PathBuf, String) {
     );
     let t = text(&o);
     assert!(o.status.success(), "hertz-cylinder failed:\n{t}");
-    (out, t)
-}
-
-/// The last line of the run's output containing `marker`.
-fn last_line<'a>(text: &'a str, marker: &str) -> &'a str {
-    text.lines()
-        .rev()
-        .find(|l| l.contains(marker))
-        .unwrap_or_else(|| panic!("no line with {marker:?} in:\n{text}"))
-}
-
-/// The number right after `key` in `line` ("normal 5.26e1," → 52.6).
-fn number_after(line: &str, key: &str) -> f64 {
-    let at = line
-        .find(key)
-        .unwrap_or_else(|| panic!("{key:?} in {line:?}"));
-    let token: String = line[at + key.len()..]
-        .trim_start()
-        .chars()
-        .take_while(|c| c.is_ascii_digit() || "+-.e".contains(*c))
-        .collect();
-    token
-        .parse()
-        .unwrap_or_else(|_| panic!("{key:?} in {line:?}"))
-}
-
-/// The number right before `key` ("20 active points" → 20).
-fn number_before(line: &str, key: &str) -> f64 {
-    let at = line
-        .find(key)
-        .unwrap_or_else(|| panic!("{key:?} in {line:?}"));
-    let token = line[..at].split_whitespace().next_back().unwrap_or("");
-    token
-        .parse()
-        .unwrap_or_else(|_| panic!("{key:?} in {line:?}"))
+    out
 }
 
 fn csv_rows(text: &str) -> Vec<HashMap<String, String>> {
@@ -84,7 +53,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 #[test]
 fn summary_and_plot_of_a_hertz_run() {
     let dir = scratch("summary-hertz");
-    let (h5, run) = hertz_run(&dir);
+    let h5 = hertz_run(&dir);
     let file = h5.to_str().unwrap();
 
     let o = run_cmd(&["summary", file, "--csv"]);
@@ -100,34 +69,25 @@ fn summary_and_plot_of_a_hertz_run() {
     };
     println!("{csv}");
 
-    // The run's own last-step line (7 significant digits): force [x, y, z],
-    // normal, active points.
-    let step = last_line(&run, "contact hertz:");
-    let inner = &step[step.find('[').unwrap() + 1..step.find(']').unwrap()];
-    let force: Vec<f64> = inner
-        .split(',')
-        .map(|v| v.trim().parse().unwrap())
-        .collect();
-    assert!(
-        close(col("fz"), force[2], 1e-6),
-        "fz {} vs run {force:?}",
-        col("fz")
-    );
-    let normal = number_after(step, "normal");
+    // The run's own last-step record (its history CSV, 13 significant
+    // digits): force z, normal force, active points.
+    let history = history(&h5);
+    let step = history.last().expect("history rows");
+    let (fz, normal) = (step["hertz.fz"], step["hertz.normal"]);
+    assert!(close(col("fz"), fz, 1e-6), "fz {} vs run {fz}", col("fz"));
     assert!(
         close(col("normal"), normal, 1e-6),
         "normal {} vs run {normal}",
         col("normal")
     );
     // Active slave nodes of the (default) mortar pair, in both.
-    assert_eq!(col("active"), number_before(step, "active nodes"));
+    assert_eq!(col("active"), step["hertz.active"]);
 
-    // "Hertz: load P; p0 computed p, analytic p0 (e %); half-width/radius
-    // computed w, analytic b (e %)".
-    let hertz = last_line(&run, "Hertz:");
-    let (p0_part, width_part) = hertz.split_once("half-width").expect("Hertz line");
-    let p0 = number_after(p0_part, "p0 computed");
-    let b_exact = number_after(width_part, "analytic");
+    // The run's Hertz comparison of its last step (`/hertz`).
+    let hertz = contactlink::output::read_hertz_record(&h5)
+        .expect("read /hertz")
+        .expect("the run's Hertz figures");
+    let (p0, b_exact) = (hertz.p0, hertz.width_exact);
     // Peak nodal pressure against the p0 the run fitted to the same nodes.
     assert!(
         close(col("max_pressure"), p0, 0.05),
@@ -164,12 +124,15 @@ fn summary_and_plot_of_a_hertz_run() {
     let png = dir.join("profile.png");
     let o = run_cmd(&["plot", file, "-o", png.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
-    // Of the last step, as the run's Hertz lines: both readings, the
-    // nodal-average one from the file's own slave facets.
-    let averaged = last_line(&run, "read as nodal averages:")
-        .split_once("nodal averages: ")
-        .expect("averaged figures")
-        .1;
+    // Of the last step, as the run's Hertz figures: both readings, the
+    // nodal-average one from the file's own slave facets (printed as the
+    // run prints it).
+    let (ep, ew) = hertz.averaged_errors.expect("nodal-average fit");
+    let averaged = format!(
+        "p0 {:+.3} %, half-width/radius {:+.3} %",
+        100.0 * ep,
+        100.0 * ew
+    );
     assert!(
         text(&o).contains(&format!("(read as nodal averages: {averaged})")),
         "plot {:?} against the run's {averaged:?}",

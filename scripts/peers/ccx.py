@@ -1,5 +1,5 @@
-"""CalculiX side of the peer benchmark: a deck from a hex8 mesh, the run, and
-what its output files say (nodal contact pressure, reaction totals, Newton
+"""CalculiX side of the peer benchmark: a deck from a hex8 mesh and what its
+output files say (nodal contact pressure, reaction totals, Newton
 iterations).
 
 The mesh is given as plain Python data, whatever file it came from:
@@ -8,10 +8,7 @@ numbered as CalculiX's C3D8 (bottom face counter-clockwise seen from the
 top, then the top face), node sets {name: [tags]} and surfaces
 {name: [[4 node tags], ...]} (each quad a face of some hex).
 """
-import os
 import re
-import subprocess
-import time
 
 # C3D8 faces (CalculiX/Abaqus numbering S1..S6) as local node indices.
 HEX_FACES = [(0, 1, 2, 3), (4, 7, 6, 5), (0, 4, 5, 1),
@@ -95,20 +92,6 @@ def deck_lines(title, nodes, hexes, bodies, nsets, surfaces, fixed, step, load_s
 def write_deck(path, *args, **kwargs):
     with open(path, "w") as f:
         f.write("\n".join(deck_lines(*args, **kwargs)) + "\n")
-
-
-def run_ccx(deck):
-    """Runs `ccx` on one thread; the wall time of the whole process."""
-    job = deck[:-4]
-    t0 = time.perf_counter()
-    p = subprocess.run(["ccx", "-i", os.path.basename(job)], capture_output=True, text=True,
-                       cwd=os.path.dirname(job) or ".",
-                       env=dict(os.environ, OMP_NUM_THREADS="1"))
-    wall = time.perf_counter() - t0
-    out = p.stdout + p.stderr
-    if p.returncode != 0 or "Job finished" not in out:
-        raise RuntimeError(f"ccx failed on {deck}:\n{out[-2000:]}")
-    return wall
 
 
 def read_frd_pressure(path):

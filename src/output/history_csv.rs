@@ -9,10 +9,13 @@ use crate::solve::phases::Phase;
 use crate::solve::{PairFields, StepReport, StepSink};
 
 /// Per-step history as CSV next to the HDF5 file (rank 0 writes it): load
-/// factor, time, iterations, each pair's contact force (vector, normal and
-/// tangential parts, active and sliding points), each Dirichlet set's
-/// reaction, and in dynamics the energies and momentum. One row per
-/// converged step, flushed as it goes.
+/// factor, time, Newton, Uzawa and linear iterations and the cutbacks taken
+/// before the step converged, each pair's contact force (vector, normal and
+/// tangential parts, active and sliding points; a pair with a deformable
+/// master also the master facets held per rank, least and most,
+/// the most received, and the whole master's), each Dirichlet set's
+/// reaction, in dynamics the energies and momentum, and the seconds per
+/// phase. One row per converged step, flushed as it goes.
 pub struct HistoryCsv {
     out: Option<std::io::BufWriter<std::fs::File>>,
     path: PathBuf,
@@ -38,10 +41,18 @@ impl HistoryCsv {
     }
 
     fn header(report: &StepReport) -> Vec<String> {
-        let mut h: Vec<String> = ["step", "load_factor", "time", "newton", "uzawa"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let mut h: Vec<String> = [
+            "step",
+            "load_factor",
+            "time",
+            "newton",
+            "uzawa",
+            "linear",
+            "cutbacks",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         for c in &report.contact {
             for k in [
                 "fx",
@@ -53,6 +64,16 @@ impl HistoryCsv {
                 "sliding",
             ] {
                 h.push(format!("{}.{k}", c.name));
+            }
+            if c.master_held.is_some() {
+                for k in [
+                    "master_held_min",
+                    "master_held_max",
+                    "master_received_max",
+                    "master_facets",
+                ] {
+                    h.push(format!("{}.{k}", c.name));
+                }
             }
         }
         for (i, (set, _)) in report.reactions.iter().enumerate() {
@@ -77,6 +98,8 @@ impl HistoryCsv {
             format!("{time:.12e}"),
             report.newton_iterations.to_string(),
             report.uzawa_iterations.to_string(),
+            report.linear_iterations.to_string(),
+            report.cutbacks.to_string(),
         ];
         let num = |v: f64| format!("{v:.12e}");
         for c in &report.contact {
@@ -85,6 +108,9 @@ impl HistoryCsv {
             r.push(num(c.tangential_force));
             r.push(c.active_points.to_string());
             r.push(c.sliding_points.to_string());
+            if let Some(held) = c.master_held {
+                r.extend(held.iter().map(|n| n.to_string()));
+            }
         }
         for (_, f) in &report.reactions {
             r.extend(f.iter().map(|v| num(*v)));

@@ -83,6 +83,58 @@ pub const HERTZ_THICKNESS_ATTR: &str = "thickness";
 /// Values of [`HERTZ_KIND_ATTR`].
 pub const HERTZ_KIND_LINE: &str = "line";
 pub const HERTZ_KIND_POINT: &str = "point";
+/// Attributes of `/hertz` added at the end of a run: the comparison of the
+/// last step (the `Hertz:` summary lines). The load from the pair's contact
+/// force, the fitted and the closed-form p0 and half-width (line) or radius
+/// (point), their relative errors, and the errors of the fit that reads the
+/// nodal pressures as nodal averages (absent when that fit failed).
+pub const HERTZ_LOAD_ATTR: &str = "load";
+pub const HERTZ_P0_ATTR: &str = "p0";
+pub const HERTZ_P0_EXACT_ATTR: &str = "p0_exact";
+pub const HERTZ_WIDTH_ATTR: &str = "width";
+pub const HERTZ_WIDTH_EXACT_ATTR: &str = "width_exact";
+pub const HERTZ_P0_ERROR_ATTR: &str = "p0_error";
+pub const HERTZ_WIDTH_ERROR_ATTR: &str = "width_error";
+pub const HERTZ_P0_ERROR_AVERAGED_ATTR: &str = "p0_error_nodal_average";
+pub const HERTZ_WIDTH_ERROR_AVERAGED_ATTR: &str = "width_error_nodal_average";
+
+/// `/run`: the run's totals, written once the run has ended (the `done:`
+/// and `solver:` summary lines as attributes). Counts are i64, seconds f64.
+pub const RUN: &str = "/run";
+pub const RUN_NAME: &str = "run";
+/// Ranks, global DOFs and converged steps.
+pub const RUN_RANKS_ATTR: &str = "ranks";
+pub const RUN_DOFS_ATTR: &str = "dofs";
+pub const RUN_STEPS_ATTR: &str = "steps";
+/// Summed over the converged steps (also [`NEWTON_ATTR`], [`UZAWA_ATTR`]
+/// and [`WALL_SECONDS_ATTR`], the run's solve seconds): linear iterations
+/// and the cutbacks taken before a step converged.
+pub const LINEAR_ATTR: &str = "linear_iterations";
+pub const CUTBACKS_ATTR: &str = "cutbacks";
+/// Bulk tangent assemblies and sparsity pattern builds over the run.
+pub const BULK_TANGENT_ASSEMBLIES_ATTR: &str = "bulk_tangent_assemblies";
+pub const PATTERN_BUILDS_ATTR: &str = "pattern_builds";
+/// Preconditioner builds and reuses decided by the active-set watch (both 0
+/// when it is off).
+pub const PRECONDITIONER_BUILDS_ATTR: &str = "preconditioner_builds";
+pub const PRECONDITIONER_REUSES_ATTR: &str = "preconditioner_reuses";
+/// Which contact Schur path the run took: one of the three values below.
+pub const SCHUR_PATH_ATTR: &str = "schur_path";
+pub const SCHUR_PATH_NONE: &str = "none";
+/// One rank: K factored with a Schur complement on the contact DOFs.
+pub const SCHUR_PATH_ONE_RANK: &str = "schur";
+/// Several ranks: K's factor with a low-rank update.
+pub const SCHUR_PATH_LOW_RANK: &str = "low-rank";
+/// On a Schur path only: the contact DOFs |C| at the end of the run, the
+/// sparse factorisations of K, the dense factorisations (of the Schur
+/// complement on one rank, of I + D·G on several), the times C grew, the
+/// solves with the sparse factor and the dense (condensed Newton) steps.
+pub const SCHUR_DOFS_ATTR: &str = "schur_dofs";
+pub const BULK_FACTORISATIONS_ATTR: &str = "bulk_factorisations";
+pub const SCHUR_FACTORISATIONS_ATTR: &str = "schur_factorisations";
+pub const SCHUR_GROWTHS_ATTR: &str = "schur_growths";
+pub const SPARSE_SOLVES_ATTR: &str = "sparse_solves";
+pub const DENSE_SOLVES_ATTR: &str = "dense_solves";
 
 /// The group name of step `index`: six digits, zero-padded, so the groups
 /// sort in step order under a plain name sort.

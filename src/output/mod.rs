@@ -27,6 +27,19 @@
 //!     <cell field>                 (M,c) f64
 //!     <any relative path>          (K,) or (K,c) f64 from [`ResultFile::write_step_block`],
 //!                                  (n,) f64 from [`ResultFile::write_step_small`]
+//! /run                             attrs written once the run has ended (rank 0, file
+//!                                  closed; [`write_run_record`]): ranks, dofs, steps,
+//!                                  newton_iterations, uzawa_iterations, linear_iterations,
+//!                                  cutbacks, bulk_tangent_assemblies, pattern_builds,
+//!                                  preconditioner_builds, preconditioner_reuses (i64),
+//!                                  wall_seconds (f64), schur_path ("none" | "schur" |
+//!                                  "low-rank") and on a Schur path schur_dofs,
+//!                                  bulk_factorisations, schur_factorisations,
+//!                                  schur_growths, sparse_solves, dense_solves (i64)
+//! /hertz                           (scenes with [hertz]) the set-up attrs, and at the end
+//!                                  of the run the last step's comparison: load, p0,
+//!                                  p0_exact, width, width_exact, p0_error, width_error,
+//!                                  p0_error_nodal_average, width_error_nodal_average (f64)
 //! ```
 //!
 //! A facet set is a group rather than a single `(F,k)` dataset because each
@@ -67,6 +80,7 @@ pub mod layout;
 pub mod paths;
 mod reader;
 mod result_sink;
+mod run_record;
 mod tee;
 mod writer;
 pub mod xdmf;
@@ -79,6 +93,9 @@ pub use reader::{
     read_string_attr,
 };
 pub use result_sink::{create_result_file, Hdf5Sink, Provenance};
+pub use run_record::{
+    read_hertz_record, read_run_record, write_run_record, HertzRecord, RunRecord, SchurRecord,
+};
 pub use tee::Tee;
 pub use writer::ResultFile;
 
