@@ -11,7 +11,7 @@ use hdf5::types::VarLenUnicode;
 
 use super::{layout, read_f64_attr, read_string_attr, OutputError};
 use crate::solve::RunReport;
-use crate::verify::HertzComparison;
+use crate::hertz::HertzComparison;
 
 /// What `/run` holds.
 #[derive(Debug, Clone, Default, PartialEq)]
