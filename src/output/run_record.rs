@@ -10,8 +10,8 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 
 use super::{layout, read_f64_attr, read_string_attr, OutputError};
-use crate::solve::RunReport;
 use crate::hertz::HertzComparison;
+use crate::solve::RunReport;
 
 /// What `/run` holds.
 #[derive(Debug, Clone, Default, PartialEq)]
