@@ -1,5 +1,5 @@
 """Hertz closed forms and the profile fit contactlink itself reports
-(src/verify.rs): least squares of p^2 = p0^2 (1 - s^2/w^2) in (s^2, p^2)
+(src/hertz.rs): least squares of p^2 = p0^2 (1 - s^2/w^2) in (s^2, p^2)
 over the points inside 90 % of the loaded zone, s = |x| for the line
 contact, sqrt(x^2 + y^2) for the point contact."""
 import math

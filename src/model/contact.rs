@@ -1,6 +1,6 @@
 //! Contact pairs as a scene states them: which surfaces meet (facet sets or
 //! rigid analytic surfaces), the formulation, the penalty, friction and the
-//! Uzawa tolerances. The pair at run time is `contact::pair_state`.
+//! Uzawa tolerances. The pair at run time is `contact::pair::ContactPair`.
 use crate::amplitude::Amplitude;
 use crate::fem::{FacetType, QuadRule};
 use crate::vec3::{dot, norm, sub};
