@@ -4,12 +4,13 @@
 //! Each figure is the median of several repetitions, maximised over ranks
 //! (the slowest rank is what the run waits for). Output: CSV on rank 0.
 use contactlink::assembly::BulkAssembler;
+use contactlink::assembly::PatternBuilder;
 use contactlink::dofs::{DofMap, DIM};
 use contactlink::fem::Material;
 use contactlink::mesh::generate::{self, BoxSpec};
 use contactlink::model::FacetLoad;
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
-use contactlink::petsc::{GhostedVector, PatternBuilder};
+use contactlink::petsc::GhostedVector;
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
 use mpi::collective::SystemOperation;

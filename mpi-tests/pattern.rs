@@ -1,6 +1,7 @@
 //! The pattern builder: couplings recorded on any rank, in rows any rank
 //! owns, end up in the matrix exactly (no entry missing, none extra).
-use contactlink::petsc::{PatternBuilder, PetscInt, Vector};
+use contactlink::assembly::PatternBuilder;
+use contactlink::petsc::{PetscInt, Vector};
 use contactlink::runtime::Runtime;
 use mpi::traits::Communicator;
 use std::collections::BTreeMap;

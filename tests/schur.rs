@@ -6,8 +6,9 @@
 //! and whole runs of hertz-cylinder, frictionless (LDLᵀ), with Coulomb
 //! friction over two steps and with a mortar pair (both non-symmetric:
 //! the dense LU path), with and without the Schur path.
+use contactlink::assembly::PatternBuilder;
 use contactlink::linsolve::SchurPreconditioner;
-use contactlink::petsc::{Matrix, PatternBuilder, PetscInt, Vector};
+use contactlink::petsc::{Matrix, PetscInt, Vector};
 use contactlink::pipeline;
 use contactlink::runtime::Runtime;
 

@@ -1,6 +1,7 @@
 //! Assembly: element and facet kernels (from `fem`) gathered from this rank's
 //! local arrays and added into a matrix or pattern through the traits of
-//! `sink` (which the PETSc types implement).
+//! `sink` (which the PETSc matrix and `pattern`'s builder implement); the
+//! sparsity pattern (symbolic) is recorded apart from the values (numeric).
 //!
 //! Local arrays are PETSc ghosted-vector local forms: entry 3·l + c is
 //! component c of local node l (owned nodes first, then ghosts). Residuals are
@@ -9,11 +10,13 @@
 pub mod bulk;
 pub mod halo;
 pub mod loads;
+pub mod pattern;
 pub mod sink;
 
 pub use bulk::BulkAssembler;
 pub use halo::{Halo, HaloFactory, MpiRanks, PetscHalos, RankExchange, SingleRank};
 pub use loads::SurfaceLoads;
+pub use pattern::PatternBuilder;
 pub use sink::{MatrixSink, PatternSink};
 
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};

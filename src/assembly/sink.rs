@@ -2,9 +2,10 @@
 //! element blocks through these traits and never name the storage behind
 //! them; the PETSc matrix and pattern builder implement them here, the one
 //! place where `GlobalDof`s become PETSc indices.
+use super::pattern::PatternBuilder;
 use crate::dofs::GlobalDof;
 use crate::error::Result;
-use crate::petsc::{Matrix, PatternBuilder, PetscInt};
+use crate::petsc::{Matrix, PetscInt};
 
 /// Something dense blocks of a matrix are added to.
 pub trait MatrixSink {

@@ -1,6 +1,6 @@
-//! Distributed sparse matrices (MPIAIJ); `pattern` creates them exactly
-//! preallocated.
-use super::{comm_world, petsc_call, sys, PetscError, PetscInt, Result, Vector};
+//! Distributed sparse matrices (MPIAIJ), created exactly preallocated for a
+//! pattern the caller gives (`assembly::pattern` records it).
+use super::{comm_world, petsc_call, sys, to_petsc_int, PetscError, PetscInt, Result, Vector};
 
 pub struct Matrix {
     raw: sys::Mat,
@@ -337,6 +337,157 @@ impl Matrix {
             }
         }
         Ok(())
+    }
+}
+
+impl Matrix {
+    /// A dense row-major block's values match its rows and columns.
+    pub fn check_block(rows: &[PetscInt], cols: &[PetscInt], values: &[f64]) -> Result<()> {
+        check_block(rows, cols, values)
+    }
+
+    /// An AIJ matrix of `rows` rows on this rank (following the lower
+    /// ranks'), block size `block_size`, not yet preallocated. Collective.
+    fn create_aij(rows: usize, block_size: usize) -> Result<Matrix> {
+        let n = to_petsc_int(rows)?;
+        let mut raw: sys::Mat = std::ptr::null_mut();
+        // SAFETY: PETSc is initialised; out-pointer valid; `m` owns the new
+        // matrix and destroys it on every exit.
+        unsafe {
+            petsc_call!(MatCreate(comm_world(), &mut raw))?;
+            let m = Matrix::owned(raw);
+            petsc_call!(MatSetSizes(
+                raw,
+                n,
+                n,
+                sys::PETSC_DETERMINE,
+                sys::PETSC_DETERMINE
+            ))?;
+            petsc_call!(MatSetBlockSize(raw, to_petsc_int(block_size)?))?;
+            petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
+            Ok(m)
+        }
+    }
+
+    /// Fixes the pattern: inserting outside it is an error (a bug, not a
+    /// slowdown), and zeroed rows (Dirichlet) keep their entries, so the
+    /// pattern and the preconditioner's symbolic set-up survive across
+    /// Newton iterations.
+    fn fix_pattern(self) -> Result<Matrix> {
+        // SAFETY: `self.raw` is a valid assembled matrix this value owns.
+        unsafe {
+            petsc_call!(MatSetOption(
+                self.raw,
+                sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+            petsc_call!(MatSetOption(
+                self.raw,
+                sys::MatOption_MAT_KEEP_NONZERO_PATTERN,
+                sys::PetscBool_PETSC_TRUE
+            ))?;
+        }
+        Ok(self)
+    }
+
+    /// One rank: the matrix of `rows` rows whose row `i` has `lengths[i]`
+    /// columns, the rows' column indices one after another in `cols`
+    /// (sorted and distinct per row, below the size), fixed with explicit
+    /// zeros. PETSc copies the indices.
+    pub fn with_compressed_rows(
+        rows: usize,
+        block_size: usize,
+        lengths: &[PetscInt],
+        cols: &mut [PetscInt],
+    ) -> Result<Matrix> {
+        let total: usize = lengths.iter().map(|&l| l.max(0) as usize).sum();
+        if lengths.len() != rows || total != cols.len() {
+            return Err(PetscError {
+                call: "MatSeqAIJSetColumnIndices",
+                code: -1,
+                message: format!(
+                    "{} row lengths summing to {total} for {rows} rows and {} column indices",
+                    lengths.len(),
+                    cols.len()
+                ),
+            });
+        }
+        let m = Self::create_aij(rows, block_size)?;
+        // SAFETY: `m` is a valid, not yet preallocated sequential AIJ matrix
+        // of `rows` rows; `lengths` holds one count per row and `cols` that
+        // many indices in all, which is what MatSeqAIJSetColumnIndices reads.
+        unsafe {
+            petsc_call!(MatSeqAIJSetPreallocation(m.raw, 0, lengths.as_ptr()))?;
+            petsc_call!(MatSeqAIJSetColumnIndices(m.raw, cols.as_mut_ptr()))?;
+            final_assembly(m.raw)?;
+            petsc_call!(MatZeroEntries(m.raw))?;
+        }
+        m.fix_pattern()
+    }
+
+    /// Several ranks: the matrix of `rows` rows on this rank, row `i`
+    /// holding `on[i]` columns inside the diagonal block and `off[i]`
+    /// outside it; `fill` is handed a setter it calls once per row with
+    /// the row's global index and its columns (sorted, distinct, in range,
+    /// as many as counted), which puts explicit zeros there. Collective.
+    pub fn with_rows(
+        rows: usize,
+        block_size: usize,
+        (on, off): (&[PetscInt], &[PetscInt]),
+        fill: impl FnOnce(&mut dyn FnMut(PetscInt, &[PetscInt]) -> Result<()>) -> Result<()>,
+    ) -> Result<Matrix> {
+        if on.len() != rows || off.len() != rows {
+            return Err(PetscError {
+                call: "MatMPIAIJSetPreallocation",
+                code: -1,
+                message: format!("{} and {} row counts for {rows} rows", on.len(), off.len()),
+            });
+        }
+        let widest = on
+            .iter()
+            .zip(off)
+            .map(|(a, b)| (a + b).max(0) as usize)
+            .max();
+        let zeros = vec![0.0; widest.unwrap_or(0)];
+        let m = Self::create_aij(rows, block_size)?;
+        // SAFETY: `m` is a valid, not yet preallocated MPIAIJ matrix of
+        // `rows` local rows and `on`/`off` hold one count per row.
+        unsafe {
+            petsc_call!(MatMPIAIJSetPreallocation(
+                m.raw,
+                0,
+                on.as_ptr(),
+                0,
+                off.as_ptr()
+            ))?;
+        }
+        let raw = m.raw;
+        fill(&mut |row, cols| {
+            let n = to_petsc_int(cols.len())?;
+            if cols.len() > zeros.len() {
+                return Err(PetscError {
+                    call: "MatSetValues",
+                    code: -1,
+                    message: format!("row {row}: {n} columns, more than counted"),
+                });
+            }
+            // SAFETY: `raw` is the matrix preallocated above; one row of
+            // `n` columns with as many zeros, which MatSetValues reads and
+            // copies.
+            unsafe {
+                petsc_call!(MatSetValues(
+                    raw,
+                    1,
+                    &row,
+                    n,
+                    cols.as_ptr(),
+                    zeros.as_ptr(),
+                    sys::InsertMode_INSERT_VALUES
+                ))
+            }
+        })?;
+        final_assembly(raw)?;
+        m.fix_pattern()
     }
 }
 

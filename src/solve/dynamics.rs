@@ -9,12 +9,13 @@
 //! contribution `γ/(βΔt) ∂f/∂v` (docs/formulation.md §8).
 use super::newmark::Coefficients;
 use crate::assembly::BulkAssembler;
+use crate::assembly::PatternBuilder;
 use crate::contact::SlipRate;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, DIM};
 use crate::error::{Error, Result};
 use crate::model::DynamicsSpec;
-use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
+use crate::petsc::{GhostedVector, Matrix, Vector};
 use mpi::traits::*;
 
 /// The inertia term of the current step: `M (a_u u + offset)` with

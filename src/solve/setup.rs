@@ -6,6 +6,7 @@
 //! solver and preconditioner) chosen from the kind of tangent, and Newton
 //! (SNES) with the settings' tolerances.
 use super::boundary::Dirichlet;
+use crate::assembly::PatternBuilder;
 use crate::assembly::{BulkAssembler, SurfaceLoads};
 use crate::contact::ContactPair;
 use crate::distribution;
@@ -16,7 +17,7 @@ use crate::fem::Material;
 use crate::mesh::Mesh;
 use crate::model::{Model, SolverSettings};
 use crate::parallel;
-use crate::petsc::{self, Matrix, PatternBuilder, Snes, Vector};
+use crate::petsc::{self, Matrix, Snes, Vector};
 use crate::runtime::Runtime;
 use mpi::traits::*;
 use std::borrow::Cow;

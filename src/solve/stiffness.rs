@@ -10,9 +10,10 @@
 //! beside the Jacobian (copying it in is cheaper than assembling it).
 use super::boundary::Dirichlet;
 use crate::assembly::BulkAssembler;
+use crate::assembly::PatternBuilder;
 use crate::dofs::{DofMap, DIM};
 use crate::error::Result;
-use crate::petsc::{GhostedVector, Matrix, PatternBuilder, Vector};
+use crate::petsc::{GhostedVector, Matrix, Vector};
 
 /// Whether and where a run keeps K (linear bodies only).
 pub enum KeepStiffness<'j> {

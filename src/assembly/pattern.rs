@@ -1,18 +1,15 @@
 //! The non-zero pattern of a distributed matrix, recorded before any value
-//! exists, and the matrix created exactly preallocated for it.
+//! exists (the symbolic half of assembly), and the matrix created exactly
+//! preallocated for it.
 //!
 //! The record is kept here, not in PETSc: couplings of whole nodes (a block
 //! of `bs` consecutive DOFs starting at a multiple of `bs`) in global node
 //! numbers, single entries for anything else. A hex8 block is 64 node pairs
-//! instead of PETSc MATPREALLOCATOR's 576 hashed entries; on two ranks the
-//! preallocator took 0.21 s of the graded line contact's 2.6 s solve
-//! (143,694 DOFs) and 0.38 s of the 98k-DOF sphere's, once for set-up and
-//! once more when the first contact search adds the links' couplings.
-//! Rows other ranks own are sent to them when the matrix is built; each
-//! rank then gives PETSc exact row counts and fills its own rows with
-//! zeros (one rank: the column indices in one copy).
-use super::matrix::{check_block, final_assembly, Matrix};
-use super::{comm_world, petsc_call, sys, to_petsc_int, PetscInt, Result};
+//! instead of PETSc MATPREALLOCATOR's 576 hashed entries. Rows other ranks
+//! own are sent to them when the matrix is built; each rank then gives
+//! PETSc exact row counts and fills its own rows with zeros (one rank: the
+//! column indices in one copy).
+use crate::petsc::{to_petsc_int, Matrix, PetscError, PetscInt, Result};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
@@ -64,7 +61,7 @@ impl PatternBuilder {
         cols: &[PetscInt],
         values: &[f64],
     ) -> Result<()> {
-        check_block(rows, cols, values)?;
+        Matrix::check_block(rows, cols, values)?;
         self.record.add_entries(rows, cols)
     }
 
@@ -74,100 +71,29 @@ impl PatternBuilder {
         let rank = self.world.rank() as usize;
         let (start, end) = (self.row_starts[rank], self.row_starts[rank + 1]);
         let record = self.record.gather_owned(&self.world, &self.row_starts)?;
-        let n = to_petsc_int(end - start)?;
-        let mut raw: sys::Mat = std::ptr::null_mut();
-        // SAFETY: PETSc is initialised; out-pointer valid; `m` owns the new
-        // matrix and destroys it on every exit. `lengths` holds one count per
-        // owned row and `cols` their column indices, sorted and distinct per
-        // row and below the global size, which is what
-        // MatSeqAIJSetColumnIndices reads (PETSc copies them).
-        unsafe {
-            petsc_call!(MatCreate(comm_world(), &mut raw))?;
-            let m = Matrix::owned(raw);
-            petsc_call!(MatSetSizes(
-                raw,
-                n,
-                n,
-                sys::PETSC_DETERMINE,
-                sys::PETSC_DETERMINE
-            ))?;
-            petsc_call!(MatSetBlockSize(raw, to_petsc_int(self.block_size)?))?;
-            petsc_call!(MatSetType(raw, c"aij".as_ptr()))?;
-            if self.world.size() == 1 {
-                // Exact row lengths, then the column indices in one copy.
-                let (lengths, mut cols) = record.compressed_rows(start, end)?;
-                petsc_call!(MatSeqAIJSetPreallocation(raw, 0, lengths.as_ptr()))?;
-                petsc_call!(MatSeqAIJSetColumnIndices(raw, cols.as_mut_ptr()))?;
-                final_assembly(raw)?;
-                petsc_call!(MatZeroEntries(raw))?;
-            } else {
-                set_rows(raw, &record, start, end)?;
-            }
-            // Inserting outside the recorded pattern is a bug, not a slowdown.
-            petsc_call!(MatSetOption(
-                raw,
-                sys::MatOption_MAT_NEW_NONZERO_ALLOCATION_ERR,
-                sys::PetscBool_PETSC_TRUE
-            ))?;
-            // Zeroed rows (Dirichlet) keep their entries, so the pattern, and the
-            // preconditioner's symbolic set-up, survive across Newton iterations.
-            petsc_call!(MatSetOption(
-                raw,
-                sys::MatOption_MAT_KEEP_NONZERO_PATTERN,
-                sys::PetscBool_PETSC_TRUE
-            ))?;
-            Ok(m)
+        if self.world.size() == 1 {
+            // Exact row lengths, then the column indices in one copy (the
+            // record freed before PETSc allocates).
+            let (lengths, mut cols) = record.compressed_rows(start, end)?;
+            return Matrix::with_compressed_rows(end - start, self.block_size, &lengths, &mut cols);
         }
-    }
-}
-
-/// Preallocates the several-rank matrix `raw` (created, sized, typed,
-/// not yet preallocated) for `record`'s rows `start..end` and fixes that
-/// pattern with explicit zeros, a row at a time: a whole local copy of the
-/// column indices (what MatSeqAIJSetColumnIndices on PETSc's two local
-/// blocks needs, 0.05 s faster per build on the 2-rank graded line) raised
-/// the largest rank's set-up peak by 42 MiB (1.28M DOFs on 8 ranks,
-/// 339.4 -> 381.5 MiB).
-fn set_rows(raw: sys::Mat, record: &NodePattern, start: usize, end: usize) -> Result<()> {
-    let (first, stop) = (to_petsc_int(start)?, to_petsc_int(end)?);
-    let rows = end - start;
-    let mut on = Vec::with_capacity(rows);
-    let mut off = Vec::with_capacity(rows);
-    let mut widest = 0;
-    record.for_each_row(start, end, |_, cols| {
-        let inside = cols.partition_point(|&c| c < stop) - cols.partition_point(|&c| c < first);
-        on.push(to_petsc_int(inside)?);
-        off.push(to_petsc_int(cols.len() - inside)?);
-        widest = widest.max(cols.len());
-        Ok(())
-    })?;
-    let zeros = vec![0.0; widest];
-    // SAFETY: `raw` is a valid, not yet preallocated MPIAIJ matrix of
-    // `rows` local rows; `on`/`off` hold one count per row, and each row
-    // then gets exactly those columns (sorted, distinct, in range) with as
-    // many zeros, which MatSetValues reads and copies.
-    unsafe {
-        petsc_call!(MatMPIAIJSetPreallocation(
-            raw,
-            0,
-            on.as_ptr(),
-            0,
-            off.as_ptr()
-        ))?;
-        record.for_each_row(start, end, |row, cols| {
-            let row = to_petsc_int(row)?;
-            let n = to_petsc_int(cols.len())?;
-            petsc_call!(MatSetValues(
-                raw,
-                1,
-                &row,
-                n,
-                cols.as_ptr(),
-                zeros.as_ptr(),
-                sys::InsertMode_INSERT_VALUES
-            ))
+        // Several ranks: exact counts of each row's columns inside and
+        // outside the diagonal block, then a row at a time (a whole local
+        // copy of the column indices, what PETSc's two local blocks would
+        // take in one go, raises the largest rank's set-up peak).
+        let (first, stop) = (to_petsc_int(start)?, to_petsc_int(end)?);
+        let rows = end - start;
+        let mut on = Vec::with_capacity(rows);
+        let mut off = Vec::with_capacity(rows);
+        record.for_each_row(start, end, |_, cols| {
+            let inside = cols.partition_point(|&c| c < stop) - cols.partition_point(|&c| c < first);
+            on.push(to_petsc_int(inside)?);
+            off.push(to_petsc_int(cols.len() - inside)?);
+            Ok(())
         })?;
-        final_assembly(raw)
+        Matrix::with_rows(rows, self.block_size, (&on, &off), |set| {
+            record.for_each_row(start, end, |row, cols| set(to_petsc_int(row)?, cols))
+        })
     }
 }
 
@@ -204,8 +130,8 @@ impl NodePattern {
         }
     }
 
-    fn out_of_range(&self, d: PetscInt) -> super::PetscError {
-        super::PetscError {
+    fn out_of_range(&self, d: PetscInt) -> PetscError {
+        PetscError {
             call: "MatSetValues",
             code: -1,
             message: format!("index {d} outside the {} rows of the pattern", self.rows),
