@@ -69,13 +69,10 @@ pub(super) fn tangent_kind(
 }
 
 /// Up to this many DOFs a one-rank direct solve factors with PETSc's own
-/// LU / Cholesky, above it with MUMPS. Linear-solve seconds of whole runs,
-/// MUMPS against PETSc's with nested dissection (`contactlink run SCENE
-/// --set mesh.divisions=... -v -pc_factor_mat_solver_type P`): impact
-/// (225 DOFs, LU) 0.264 / 0.082 s; Neo-Hookean block-on-plane (Cholesky)
-/// 375 DOFs 0.023 / 0.013, 1029 DOFs 0.062 / 0.081; block-compress (LU)
-/// 375 DOFs 0.047 / 0.026, 648 DOFs 0.059 / 0.058, 1536 DOFs 0.258 /
-/// 0.335. The contact Schur path keeps MUMPS whatever the size.
+/// LU / Cholesky (nested dissection), above it with MUMPS, whose set-up per
+/// factorisation dominates small solves; the two cross near this size
+/// (docs/performance.md, "The solver paths"). The contact Schur path keeps
+/// MUMPS whatever the size.
 const NATIVE_FACTOR_MAX_DOFS: usize = 600;
 
 /// Sets the program's PETSc defaults; the user's options win.
@@ -97,11 +94,10 @@ pub(super) fn set_solver_defaults(
     if linear_bulk {
         // The secant (l2) line search instead of backtracking: a penalty
         // contact residual is piecewise smooth, and backtracking keeps
-        // shortening steps that cross a change of the contact set
-        // (hertz-cylinder 23 → 18 Newton iterations, hertz-sphere 26 → 25).
-        // It costs two extra residuals per iteration, cheap only when the
-        // bulk residual is K u − f (ironing, Neo-Hookean: 1479 → 1406
-        // iterations but more time), so nonlinear bodies keep backtracking.
+        // shortening steps that cross a change of the contact set. It costs
+        // two extra residuals per iteration, cheap only when the bulk
+        // residual is K u − f, so nonlinear bodies keep backtracking (fewer
+        // iterations there, but more time).
         //
         // Not with friction: its return map switches between stick and
         // slip along a Newton direction, where ‖R‖ has a kink, and l2's
@@ -144,22 +140,16 @@ pub(super) fn set_solver_defaults(
         petsc::options::set_default("-ksp_gmres_restart", "100")?;
     }
     petsc::options::set_default("-pc_type", "gamg")?;
-    // Unsmoothed aggregation: 8-22 % more Krylov iterations than smoothed
-    // (81 / 70 CG on the 167k-DOF plain sphere, 134 / 110 GMRES on
-    // hertz-sphere), but a sparser prolongator makes each cheaper and the
-    // set-up's Galerkin product smaller, so the runs took at most 2 % more
-    // time, mostly less, at every size measured, 1 and 2 ranks
-    // (hertz-sphere 97k / 167k / 318k DOFs on 2 ranks: 6.30 / 11.46 / 43.6
-    // s against 6.75 / 11.20 / 46.9 s, plain 3.09 / 6.50 / 24.4 s against
-    // 3.61 / 6.90 / 25.5 s; docs/performance.md) with 8-18 % less peak
-    // memory (hertz-sphere's largest of 4 ranks 265 MiB against 309, 1 rank
-    // 806 against 843).
+    // Unsmoothed aggregation: more Krylov iterations than smoothed, but a
+    // sparser prolongator makes each cheaper and the set-up's Galerkin
+    // product smaller: about the same time and less peak memory on every
+    // rank count (docs/performance.md, "The solver paths").
     petsc::options::set_default("-pc_gamg_agg_nsmooths", "0")?;
     // A pair whose Newton converges in one or two iterations per Uzawa
     // iteration only when its linear solves are accurate gets GMRES to a
     // fixed 1e-4 instead of Eisenstat–Walker (a loose solve makes its
-    // Newton crawl); the others
-    // keep Eisenstat–Walker, which suits them (below).
+    // Newton crawl); the others keep Eisenstat–Walker, which suits them
+    // (below).
     let rtol = if accurate_linear_solves {
         "1e-4"
     } else {
@@ -169,18 +159,16 @@ pub(super) fn set_solver_defaults(
     if constant && settings.reuse.linear_stiffness {
         // The Jacobian is set once, so GAMG's set-up runs once: free the
         // Galerkin products' intermediate data (P^T A P keeps A P and the
-        // transpose of P for a numeric refresh that never comes). Several
-        // ranks only gain (167k-DOF plain sphere, largest of 4 ranks 226.3
-        // -> 215.5 MiB, of 2 376.1 -> 361.8, 1 rank unchanged; same CG
-        // iterations). Where the matrix changes and GAMG reuses its
+        // transpose of P for a numeric refresh that never comes): several
+        // ranks' peak memory falls, the iterations stay. Where the matrix
+        // changes and GAMG reuses its
         // interpolation, the cleared products would be formed again from
         // scratch at every set-up.
         petsc::options::set_default("-mat_product_clear", "true")?;
         // Plain path, several ranks: hypre's Galerkin product instead of
         // PETSc's parallel P^T A P, whose A P and ghost rows of P are the
-        // set-up peak that did not split over the ranks (167k-DOF plain
-        // sphere, largest of 4 ranks 220.9 -> 174.9 MiB, 69 -> 70 CG
-        // iterations, same run time within the load's noise). One rank
+        // set-up peak that does not split over the ranks (the largest
+        // rank's peak falls by a fifth, the iterations and time stay). One rank
         // keeps PETSc's sequential product: hypre's breaks its preconditioner
         // there (DIVERGED_INDEFINITE_PC).
         if mpi::topology::SimpleCommunicator::world().size() > 1 {
@@ -191,26 +179,21 @@ pub(super) fn set_solver_defaults(
         // The contact Jacobian's AMG hierarchy is built once a step and kept
         // while it works (`lagging`), so its Galerkin products' intermediate
         // data waits for a refresh that rarely comes: freed, as on the
-        // plain path (hertz-sphere, 167k DOFs, one run each: largest of 4
-        // ranks 331.4 -> 304.1 MiB, of 2 581.4 -> 534.0, 1 rank 818.2 ->
-        // 818.3; the same 20 / 7 / 201 Newton / Uzawa / GMRES iterations).
-        // A rebuild forms them again from scratch. hypre's product, the
-        // plain path's other saving, moved the trajectory here (2 ranks:
-        // 31 / 10 / 333 iterations, 451 MiB), so contact keeps PETSc's.
+        // plain path (less peak memory, the same iterations); a rebuild
+        // forms them again from scratch. hypre's product, the plain path's
+        // other saving, changes the contact trajectory for the worse, so
+        // contact keeps PETSc's.
         petsc::options::set_default("-mat_product_clear", "true")?;
     }
     if contact && !accurate_linear_solves {
         // Eisenstat–Walker: each linear solve only as tight as Newton's
-        // progress needs (hertz-sphere h = 0.35, 2 ranks: 977 -> 152 GMRES
-        // iterations for 12 -> 31 Newton iterations, 241 s -> 100 s on a
-        // loaded machine, same Hertz errors). A direct solve gains nothing.
+        // progress needs (far fewer GMRES iterations for some more Newton
+        // ones, the same answer). A direct solve gains nothing.
         petsc::options::set_default("-snes_ksp_ew", "true")?;
-        // ... but never looser than 0.1. PETSc's default ceiling (0.9) let
+        // ... but never looser than 0.1: PETSc's default ceiling (0.9) lets
         // a slowly converging Newton keep asking for one or two GMRES
-        // iterations per step, each step only ~0.8 of the residual off
-        // (hertz-sphere h = 0.5, 2 ranks: 37 -> 18 Newton iterations,
-        // 155 -> 158 GMRES, 15 -> 11 preconditioner set-ups; 0.05: 18
-        // Newton, 207 GMRES; 0.2: 25 Newton, 153 GMRES).
+        // iterations per step, each step taking only a fraction of the
+        // residual off.
         petsc::options::set_default("-snes_ksp_ew_rtolmax", "0.1")?;
     }
     petsc::options::set_default("-ksp_max_it", "2000")?;

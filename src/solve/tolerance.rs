@@ -3,33 +3,28 @@
 //! Only the last Uzawa iteration's displacement is kept; every earlier one
 //! is the start of the next, whose multiplier update moves the residual by
 //! the size of the multiplier change anyway. Solving those to the step's
-//! final tolerance (|R| ≈ 1e-9 of the step's own residual) is oversolving:
-//! on the graded Hertz line contact it costs one to two Newton iterations
-//! (and, in the first round, factorisations) per Uzawa iteration.
+//! final tolerance is oversolving: it costs Newton iterations (and, in the
+//! first round, factorisations) per Uzawa iteration.
 //!
 //! The two tolerances are coupled, not fixed apart: a non-final Newton solve
 //! stops once its residual has fallen by `forcing` relative to that solve's
 //! own start, i.e. relative to the last multiplier update, so the error it
 //! leaves is a fixed fraction of the change the Uzawa test measures and the
-//! test can still resolve convergence (a fixed absolute loose tolerance,
-//! tried before, left errors above the test's resolution and the loop
-//! stalled). When the Uzawa test passes after a loose solve, the multipliers
+//! test can still resolve convergence (a fixed absolute loose tolerance
+//! leaves errors above the test's resolution and the loop stalls). When the Uzawa test passes after a loose solve, the multipliers
 //! are kept and Newton runs once more to the final tolerance, followed by
 //! the usual update and test: the step's answer is as tight as before.
 
 /// The forcing of non-final solves on the Krylov path (GMRES + AMG) when
 /// the settings keep the default (`DEFAULT_FORCING`, 1e-3).
 ///
-/// There every decade of residual costs about six GMRES iterations with
-/// the same preconditioner applications a plain solve makes, while on the
-/// direct path it costs a Newton iteration around kept factors (one
-/// triangular solve). A non-final solve's error is only the start of the
-/// next multiplier update, so on the Krylov path one decade less per
-/// Uzawa iteration is cheaper than the Uzawa iterations it may add:
-/// hertz-sphere h = 0.35, 2 ranks, 21 → 17 Newton, 227 → 177 GMRES, PETSc
-/// flops 2.89e10 → 2.29e10, the same 7 Uzawa iterations; hertz-cylinder
-/// h = 0.4 on GMRES + GAMG 320 → 227 GMRES (1.85e9 → 1.39e9 flops);
-/// Hertz errors unchanged to 0.003 points.
+/// There every decade of residual costs GMRES iterations with the same
+/// preconditioner applications a plain solve makes, while on the direct
+/// path it costs a Newton iteration around kept factors (one triangular
+/// solve). A non-final solve's error is only the start of the next
+/// multiplier update, so on the Krylov path one decade less per Uzawa
+/// iteration is cheaper than the Uzawa iterations it may add
+/// (docs/performance.md, "The solver paths").
 pub const KRYLOV_FORCING: f64 = 1e-2;
 
 /// The forcing of non-final solves: the setting, except that the Krylov
@@ -44,14 +39,11 @@ pub fn inner_forcing(setting: f64, krylov: bool) -> f64 {
 
 /// The Anderson depth of the Uzawa updates (`solve::anderson`): the
 /// setting, or unset `DEFAULT_ACCELERATION` on the Krylov path and 0 on
-/// the direct path. On the Krylov path an Uzawa iteration saved is a Newton solve
-/// of 20-50 GMRES iterations (hertz-sphere h = 0.35, 2 ranks: 17 → 15
-/// Newton, 164 → 141 GMRES, 2.148e10 → 1.869e10 flops; hertz-cylinder
-/// h = 0.4 on GMRES + GAMG 43 → 36 Newton); on the direct path Newton
-/// iterations around kept factors are cheap and the extrapolated
+/// the direct path. On the Krylov path an Uzawa iteration saved is a
+/// Newton solve of tens of GMRES iterations; on the direct path Newton
+/// iterations around kept factors are cheap, and the extrapolated
 /// multipliers' larger residual costs more of them than the Uzawa
-/// iterations saved (hertz-cylinder h = 0.4 13 → 20 Newton; graded line
-/// b/5 11 → 12, b/10 12 → 10, b/40 11 → 10).
+/// iterations saved.
 pub fn inner_acceleration(setting: Option<usize>, krylov: bool) -> usize {
     match setting {
         Some(depth) => depth,
@@ -62,20 +54,13 @@ pub fn inner_acceleration(setting: Option<usize>, krylov: bool) -> usize {
 
 /// On the Krylov path with contact, a Newton iteration's GMRES stops once
 /// its residual is below this fraction of what the Newton solve still has
-/// to remove (`linsolve::set_linear_floor`), however tight the Eisenstat–Walker
-/// tolerance. That tolerance follows Newton's last rate and asks the last
-/// iteration of a solve for far more than is left (hertz-sphere h = 0.35:
-/// a non-final solve that had to reach 5e-4 went from 1.9e-3 to 4.1e-5 in
-/// 24 GMRES iterations; the step's last solve needed a third of its
-/// residual removed and took 27 GMRES iterations to remove 97 %). Every
-/// solve of a contact step gets it, the last one too, which then ends a
-/// tenth below the step's tolerance instead of 2-40 times further down:
-/// hertz-sphere h = 0.35, 146 -> 131 GMRES on 2 ranks and 134 -> 128 on
-/// one, the contact force off the body's reactions by 1.4e-8 and 2.1e-8
-/// relative instead of 9.8e-9 and 1.7e-9 (tests/contact.rs accepts 1e-7),
-/// the same Hertz digits. At 0.5 the sphere's Newton stalled at its
-/// iteration limit and the run failed after its cutbacks; 0.1 and 0.2 ran
-/// alike (136 and 130 GMRES with the non-final solves alone).
+/// to remove (`linsolve::set_linear_floor`), however tight the
+/// Eisenstat–Walker tolerance: that tolerance follows Newton's last rate
+/// and asks the last iteration of a solve for far more than is left.
+/// Every solve of a contact step gets it, the last one too, which then
+/// ends a tenth below the step's tolerance instead of orders of magnitude
+/// further down (the contact force still balances the reactions to the
+/// 1e-7 tests/contact.rs asks). At 0.5 Newton stalls on the Hertz sphere.
 pub const LINEAR_FLOOR: f64 = 0.1;
 
 /// SNES's stopping rule for one Newton solve: |R| ≤ max(atol, rtol·|R0|).
