@@ -206,14 +206,7 @@ impl MortarPair {
         let mut rows = Rows::new(self.node_local.len());
         self.stream_tangent(&interface, &e, x, u_local, rate, &mut rows);
         rows.add_to(|id, c| self.global_dof(id, c), k)?;
-        Ok(signature(
-            &e.segments,
-            &e.states,
-            &e.frictions,
-            &self.slave_facets,
-            self.facet_type.nodes(),
-            &self.nodal,
-        ))
+        Ok(self.signature_of(&e))
     }
 
     /// The tangent at the node states (and friction) of the f64
@@ -299,14 +292,19 @@ impl MortarPair {
         let add = |r, c, v| rows.add(r, c, v);
         super::main_part::tangent(&interface, &self.nodal, &e.segments, &e.states, add);
         rows.add_to(|id, c| self.global_dof(id, c), k)?;
-        Ok(signature(
+        Ok(self.signature_of(&e))
+    }
+
+    /// The active-set signature of an evaluation (see `MortarPair::tangent`).
+    fn signature_of(&self, e: &Evaluation) -> u64 {
+        signature(
             &e.segments,
             &e.states,
             &e.frictions,
             &self.slave_facets,
             self.facet_type.nodes(),
             &self.nodal,
-        ))
+        )
     }
 
     /// Node states and, per assembled facet row, `(slot, Σ_k D_jk,
