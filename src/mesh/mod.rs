@@ -15,6 +15,7 @@ pub mod generate;
 mod geometry;
 mod gmsh;
 mod ops;
+mod orient;
 mod tets;
 mod topology;
 mod validate;

@@ -41,14 +41,22 @@ impl Mesh {
     /// Faces that belong to exactly one cell, sorted by (cell, face). For a
     /// conforming mesh these are the body surfaces.
     pub fn boundary_facets(&self) -> Vec<FacetRef> {
-        let mut boundary: Vec<FacetRef> = self
-            .faces_by_key()
-            .into_values()
-            .filter(|owners| owners.len() == 1)
-            .map(|owners| owners[0])
-            .collect();
+        let mut boundary: Vec<FacetRef> = self.boundary_faces_by_key().into_values().collect();
         boundary.sort_unstable();
         boundary
+    }
+
+    /// Faces owned by exactly one cell, by face key: what a reader matches
+    /// the surface elements of a file against. Interior faces are left out:
+    /// a contact or load surface must be on the outside of a body.
+    pub(crate) fn boundary_faces_by_key(&self) -> HashMap<FaceKey, FacetRef> {
+        self.faces_by_key()
+            .into_iter()
+            .filter_map(|(key, owners)| match owners.as_slice() {
+                [only] => Some((key, *only)),
+                _ => None,
+            })
+            .collect()
     }
 
     /// Cell dual graph for graph partitioning: cells `a` and `b` are

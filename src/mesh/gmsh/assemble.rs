@@ -1,13 +1,12 @@
 //! Assembly of what was read into a validated [`Mesh`]: bodies, node
 //! renumbering, cell orientation, facet and node sets.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 use super::kind::Kind;
 use super::sections::{ElementList, Raw};
 use super::{GmshError, GmshErrorKind, GmshReport, Location};
-use crate::mesh::geometry::{hex_corner_jacobians, tet_jacobian};
-use crate::mesh::topology::{face_key, FaceKey};
+use crate::mesh::topology::face_key;
 use crate::mesh::{CellType, FacetRef, Mesh};
 
 /// File name for errors found after parsing.
@@ -128,53 +127,21 @@ fn compact_nodes(num_nodes: usize, cell_nodes: &[usize]) -> Vec<Option<usize>> {
         .collect()
 }
 
-/// Renumbering that reverses a cell: tet swaps nodes 1 and 2; hex swaps the
-/// bottom and top quads (a reflection ζ → −ζ of the reference cube).
-fn reversal(cell_type: CellType) -> &'static [usize] {
-    match cell_type {
-        CellType::Tet4 => &[0, 2, 1, 3],
-        CellType::Hex8 => &[4, 5, 6, 7, 0, 1, 2, 3],
-    }
-}
-
-/// Jacobian determinants of a cell: the tet's one, the hex's eight corners.
-fn cell_jacobians(mesh: &Mesh, ids: &[usize]) -> Vec<f64> {
-    let p = |k: usize| mesh.nodes[ids[k]];
-    match mesh.cell_type {
-        CellType::Tet4 => vec![tet_jacobian(&std::array::from_fn(p))],
-        CellType::Hex8 => hex_corner_jacobians(&std::array::from_fn(p)).to_vec(),
-    }
-}
-
 /// Reverses fully inverted cells (some generators emit them), rejects
-/// tangled ones; returns how many were reversed.
+/// tangled ones naming the Gmsh element; returns how many were reversed.
 pub(super) fn orient_cells(
     mesh: &mut Mesh,
     volumes: &ElementList,
     ctx: &Ctx,
 ) -> Result<usize, GmshError> {
-    let per = mesh.cell_type.nodes();
-    let perm = reversal(mesh.cell_type);
-    let mut reversed = 0;
-    for c in 0..mesh.num_cells() {
-        let ids: Vec<usize> = mesh.cell(c).to_vec();
-        let dets = cell_jacobians(mesh, &ids);
-        let min = dets.iter().copied().fold(f64::INFINITY, f64::min);
-        let max = dets.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if min > 0.0 {
-            continue;
-        }
-        if max >= 0.0 {
-            let element = volumes.tags[c];
-            let kind = GmshErrorKind::TangledCell { element, min, max };
-            return Err(ctx.error(volumes.locations[c], kind));
-        }
-        for (k, &from) in perm.iter().enumerate() {
-            mesh.cells[c * per + k] = ids[from];
-        }
-        reversed += 1;
-    }
-    Ok(reversed)
+    crate::mesh::orient::orient_cells(mesh).map_err(|t| {
+        let kind = GmshErrorKind::TangledCell {
+            element: volumes.tags[t.cell],
+            min: t.min,
+            max: t.max,
+        };
+        ctx.error(volumes.locations[t.cell], kind)
+    })
 }
 
 /// Builds the facet and node sets of the physical groups below dimension 3.
@@ -222,7 +189,7 @@ impl SetBuilder<'_> {
     }
 
     fn facet_sets(&self, mesh: &mut Mesh) -> Result<(), GmshError> {
-        let boundary = boundary_faces(mesh);
+        let boundary = mesh.boundary_faces_by_key();
         let mut facet_sets: BTreeMap<String, Vec<FacetRef>> = BTreeMap::new();
         for kind in [Kind::Tri, Kind::Quad] {
             let list = self.raw.list(kind);
@@ -269,18 +236,6 @@ impl SetBuilder<'_> {
         finish_node_sets(&mut mesh.node_sets);
         Ok(())
     }
-}
-
-/// Faces owned by exactly one cell, by face key. Interior faces are left
-/// out: a contact or load surface must be on the outside of a body.
-fn boundary_faces(mesh: &Mesh) -> HashMap<FaceKey, FacetRef> {
-    mesh.faces_by_key()
-        .into_iter()
-        .filter_map(|(key, owners)| match owners.as_slice() {
-            [only] => Some((key, *only)),
-            _ => None,
-        })
-        .collect()
 }
 
 fn insert_nodes(sets: &mut BTreeMap<String, Vec<usize>>, name: &str, nodes: &[usize]) {
