@@ -14,6 +14,7 @@ mod error;
 pub mod generate;
 mod geometry;
 mod gmsh;
+mod inp;
 mod ops;
 mod orient;
 mod tets;
@@ -33,6 +34,7 @@ pub use generate::{
 };
 pub use geometry::BoundingBox;
 pub use gmsh::{parse_gmsh, read_gmsh, GmshError, GmshErrorKind, GmshReport, Location};
+pub use inp::{parse_inp, read_inp, InpError, InpErrorKind, InpReport, InpRequest};
 pub use topology::Csr;
 
 /// One face of one cell; its orientation is the cell's outward one as given

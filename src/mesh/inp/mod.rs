@@ -1,0 +1,298 @@
+//! Reader for Abaqus/CalculiX input files (`.inp`): the mesh of a deck as
+//! CalculiX, Gmsh (`-format inp`), FreeCAD, Salome and Abaqus/CAE (flat
+//! input, without parts) write it. The physics stays in the scene.
+//!
+//! The format: keyword lines (`*ELEMENT, TYPE=C3D8, ELSET=Part`), keywords,
+//! parameters and set names case-insensitive; data lines of comma-separated
+//! fields, a trailing comma continuing an element's node list (and a keyword
+//! line) on the next line; `**` comment lines and blank lines ignored;
+//! `*INCLUDE, INPUT=file` reads a file relative to the including one, in
+//! place (it may hold data lines of the block it is included in).
+//!
+//! What becomes what:
+//!
+//! * `*NODE` (optionally `NSET=`): nodes with arbitrary positive ids, sparse
+//!   and in any order. Nodes that no 3D element uses are dropped, the rest
+//!   numbered from 0 in file order; messages keep the file's ids.
+//! * `*ELEMENT, TYPE=..` (optionally `ELSET=`): C3D4 cells (tet4) or C3D8,
+//!   C3D8R, C3D8I cells (hex8; the program's full integration), one cell
+//!   type per file. Abaqus numbers both as [`CellType`] does; fully inverted
+//!   cells are renumbered and counted, tangled ones are an error. Triangles
+//!   and quadrilaterals (S3, S4, S4R, CPS3, CPS4, M3D3, ...: what meshers
+//!   write for boundary groups) must each be a boundary face of a cell, matched
+//!   by their nodes. Second-order and other 3D types, beams, trusses, springs
+//!   and unknown types are one error naming the type, file and line.
+//! * Bodies are element sets: the sets the scene's `[[body]]` names give (a
+//!   3D element in none of them, or in two, is an error naming it); without
+//!   names, each `ELSET=` of the `*ELEMENT` lines of 3D elements (`EALL` for
+//!   those without one).
+//! * `*NSET` and `*ELSET` (id lists, set names inside lists, `GENERATE`
+//!   first, last, step): node sets, and element sets. An element set of
+//!   triangles or quadrilaterals is a facet set and a node set.
+//! * `*SURFACE, TYPE=ELEMENT` (the default): lines `element or set, S1..S6`,
+//!   faces numbered as Abaqus does (C3D8: S1 = 1-2-3-4, S2 = 5-8-7-6, S3 =
+//!   1-5-6-2, S4 = 2-6-7-3, S5 = 3-7-8-4, S6 = 4-8-5-1; C3D4: S1 = 1-2-3,
+//!   S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1), a facet set and a node set.
+//!   `*SURFACE, TYPE=NODE`: a node set.
+//! * A set name used inside a list must be defined above it (as CalculiX
+//!   reads); a set named twice collects both. A node set wins over a facet
+//!   set's node set of the same name.
+//! * Every other keyword (`*MATERIAL`, `*STEP`, `*BOUNDARY`, ...) is skipped
+//!   with its data lines and listed once in [`InpReport::note`]; `*HEADING`
+//!   silently. Parts and instances and the mesh generation keywords (`*NGEN`,
+//!   `*ELGEN`, ...) are errors: what they define would be missing.
+//!
+//! Every error is one line naming the file, the line and the element, node
+//! or set id as the file writes it. The reader never panics on bad input; a
+//! `GENERATE` range costs at most the number of ids defined.
+
+mod assemble;
+mod deck;
+mod kind;
+mod read;
+mod sets;
+#[cfg(test)]
+mod tests;
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use super::{CellType, Mesh, MeshError};
+use deck::Fail;
+
+/// What the scene asks of the file: the element sets that are its bodies,
+/// and the spelling of the names it uses (Abaqus names are case-insensitive:
+/// a set the scene spells `Top` is found as `TOP` and named `Top`).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct InpRequest {
+    /// Element sets that are the bodies, named as given; empty: each
+    /// `ELSET=` of an `*ELEMENT` line of 3D elements is a body.
+    pub bodies: Vec<String>,
+    /// Node and facet set names as the scene spells them.
+    pub names: Vec<String>,
+}
+
+/// What the reader did besides reading, for `check` and the run to print.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct InpReport {
+    /// The file read, as given.
+    pub file: String,
+    /// The files `*INCLUDE` read, in the order first read.
+    pub included: Vec<PathBuf>,
+    /// Keywords skipped, each once, with where it first appears
+    /// (`*MATERIAL (line 120)`, `*STEP (steps.inp, line 3)`).
+    pub skipped: Vec<String>,
+    /// Cells that came fully inverted and were renumbered.
+    pub reoriented: usize,
+    /// Nodes that no 3D element uses (dropped).
+    pub unused_nodes: usize,
+}
+
+impl InpReport {
+    /// The note a run prints once: what was read and what was not.
+    pub fn note(&self) -> String {
+        let name = Path::new(&self.file)
+            .file_name()
+            .map_or(self.file.clone(), |n| n.to_string_lossy().into_owned());
+        let mut note = format!("read the mesh of {name}");
+        if !self.skipped.is_empty() {
+            note.push_str(&format!(
+                "; not read (the scene holds the physics): {}",
+                self.skipped.join(", ")
+            ));
+        }
+        if self.reoriented > 0 {
+            note.push_str(&format!("; {} inverted cells renumbered", self.reoriented));
+        }
+        note
+    }
+}
+
+/// An error of the reader: the file, the line when there is one, and what.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{file}{}: {kind}", line.map_or(String::new(), |l| format!(", line {l}")))]
+pub struct InpError {
+    pub file: String,
+    pub line: Option<usize>,
+    pub kind: InpErrorKind,
+}
+
+/// What went wrong while reading an `.inp` file. Ids are the file's.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum InpErrorKind {
+    #[error("cannot read the file: {0}")]
+    Io(String),
+    #[error("cannot read the included file {path}: {reason}")]
+    Include { path: String, reason: String },
+    #[error("include cycle: {0}")]
+    IncludeCycle(String),
+    #[error("includes nested deeper than {0} files")]
+    IncludeDepth(usize),
+    #[error("a data line before any keyword: `{0}`")]
+    DataBeforeKeyword(String),
+    #[error("bad keyword line `{0}`")]
+    BadKeyword(String),
+    #[error("*{keyword} needs {parameter}=")]
+    MissingParameter {
+        keyword: String,
+        parameter: &'static str,
+    },
+    #[error("*{keyword}: parameter {parameter} is not supported{hint}")]
+    UnsupportedParameter {
+        keyword: String,
+        parameter: String,
+        hint: &'static str,
+    },
+    #[error("*{keyword}: {parameter}={value} is not supported; {expected}")]
+    BadParameter {
+        keyword: &'static str,
+        parameter: &'static str,
+        value: String,
+        expected: &'static str,
+    },
+    #[error("*{0}: parts, assemblies and instances are not supported: write a flat input file (Abaqus/CAE: Model > Edit Attributes > Do not use parts and assemblies in input files)")]
+    Parts(String),
+    #[error("*{0} generates or transforms nodes or elements, which this reader does not do: write the mesh out as nodes and elements (a mesher's export does)")]
+    Generation(String),
+    #[error("cannot read {what} from `{token}`")]
+    BadNumber { what: &'static str, token: String },
+    #[error("{what} {id} is not a positive integer")]
+    BadId { what: &'static str, id: String },
+    #[error("{what}: expected {expected}, found {found} fields")]
+    FieldCount {
+        what: &'static str,
+        expected: &'static str,
+        found: usize,
+    },
+    #[error("node {0} is defined twice")]
+    DuplicateNode(u64),
+    #[error("element {0} is defined twice")]
+    DuplicateElement(u64),
+    #[error("element {element} ({ty}) has {found} nodes, {ty} has {expected} (a line ending in a comma continues on the next)")]
+    NodeCount {
+        element: u64,
+        ty: String,
+        expected: usize,
+        found: usize,
+    },
+    #[error("element {element} refers to node {node}, which no *NODE line defines")]
+    UnknownNode { element: u64, node: u64 },
+    #[error("{ty} elements are not supported yet: this program reads first-order C3D4 and C3D8 (C3D8R, C3D8I) cells")]
+    NotYet { ty: String },
+    #[error("{ty} elements ({what}) in element set {set} are not supported: the mesh is volumes of C3D4 or C3D8 cells, triangles or quadrilaterals on their faces, and sets")]
+    Unsupported {
+        ty: String,
+        what: &'static str,
+        set: String,
+    },
+    #[error("element type {0} is not known to this reader (it reads C3D4, C3D8, C3D8R, C3D8I and the triangles and quadrilaterals S3, S4, S4R, CPS3, CPS4, CPE3, CPE4, M3D3, M3D4, SFM3D3, SFM3D4 on their faces)")]
+    UnknownType(String),
+    #[error("element {element} is a {found} cell but element {first} (line {first_line}) is a {first_type}: a mesh holds one cell type today (mesh all volumes with tetrahedra, or all with hexahedra)")]
+    MixedCellTypes {
+        element: u64,
+        found: &'static str,
+        first: u64,
+        first_line: usize,
+        first_type: &'static str,
+    },
+    #[error("no 3D elements (C3D4 or C3D8): the file holds no volume mesh")]
+    NoVolumeCells,
+    #[error("{kind} {name} is not defined above this line")]
+    UnknownSet { kind: &'static str, name: String },
+    #[error("{what} {set}: {item} {id} is not defined in the file")]
+    UnknownMember {
+        what: &'static str,
+        set: String,
+        item: &'static str,
+        id: u64,
+    },
+    #[error("GENERATE needs first, last[, step] with 0 < first ≤ last and step ≥ 1, found `{0}`")]
+    BadGenerate(String),
+    #[error(
+        "surface {surface}: face `{label}` of element {element} ({ty}) is not one of S1..S{}",
+        kind::face_count(ty)
+    )]
+    BadFace {
+        surface: String,
+        label: Box<str>,
+        element: u64,
+        ty: String,
+    },
+    #[error("surface {surface}: element {element} is a {ty}, not a 3D element: *SURFACE faces are faces of C3D4 or C3D8 elements")]
+    FaceOfNonCell {
+        surface: String,
+        element: u64,
+        ty: String,
+    },
+    #[error("cell from element {element} is tangled or degenerate (Jacobian determinants of mixed sign or zero, from {min:e} to {max:e})")]
+    TangledCell { element: u64, min: f64, max: f64 },
+    #[error("{ty} element {element} of element set {set} is no boundary face of a 3D element (matched by its nodes): shells and membranes are not supported")]
+    FacetNotOnCell {
+        ty: String,
+        element: u64,
+        set: String,
+    },
+    #[error("{ty} element {element} of element set {set} has {found} nodes, but the faces of {} cells are {}", cells.name(), cells.facet_type().name())]
+    FacetTypeMismatch {
+        ty: String,
+        element: u64,
+        set: String,
+        found: usize,
+        cells: CellType,
+    },
+    #[error("no element set {name} of 3D elements for the body {name} (element sets of 3D elements: {known})")]
+    UnknownBodySet { name: String, known: String },
+    #[error("element {element} is in the element sets {first} and {second}, which are both bodies; a cell belongs to one body")]
+    ElementInTwoBodies {
+        element: u64,
+        first: String,
+        second: String,
+    },
+    #[error(
+        "{count} 3D elements are in no element set that is a body ({bodies}): elements {list}"
+    )]
+    ElementsWithoutBody {
+        count: usize,
+        bodies: String,
+        list: String,
+    },
+    #[error("the mesh read is not valid: {error}{}", element.map_or(String::new(), |e| format!(" (the cell of element {e})")))]
+    Invalid {
+        error: Box<MeshError>,
+        element: Option<u64>,
+    },
+}
+
+/// Reads an `.inp` file (and what it includes) into a validated [`Mesh`].
+pub fn read_inp(path: &Path, request: &InpRequest) -> Result<(Mesh, InpReport), InpError> {
+    let name = path.display().to_string();
+    let text = std::fs::read(path).map_err(|e| InpError {
+        file: name.clone(),
+        line: None,
+        kind: InpErrorKind::Io(e.to_string()),
+    })?;
+    parse_inp(&String::from_utf8_lossy(&text), path, request)
+}
+
+/// Parses the text of an `.inp` file; `path` names it in messages and is
+/// where `*INCLUDE` paths are relative to.
+pub fn parse_inp(
+    text: &str,
+    path: &Path,
+    request: &InpRequest,
+) -> Result<(Mesh, InpReport), InpError> {
+    let mut reader = deck::Reader::new(path);
+    let mut raw = read::Raw::default();
+    let read = reader.read_main(text, &mut raw).and_then(|()| raw.finish());
+    let result = read.and_then(|()| assemble::assemble(&raw, request));
+    let (mesh, mut report) = result.map_err(|f: Fail| reader.error(f))?;
+    report.file = path.display().to_string();
+    report.included = reader.included();
+    report.skipped = raw
+        .skipped
+        .iter()
+        .map(|(keyword, at)| format!("*{keyword} ({})", reader.place(*at)))
+        .collect();
+    Ok((mesh, report))
+}
