@@ -56,6 +56,9 @@ pub fn summary(c: &Checked) -> String {
     if let Some(g) = &c.mesh_report.gmsh {
         line(format!("  gmsh: {} cells reoriented", g.reoriented));
     }
+    for note in c.mesh_report.notes() {
+        line(format!("  note: {note}"));
+    }
     for d in &model.dirichlet {
         let comps: Vec<&str> = d.components.iter().map(|&c| ["x", "y", "z"][c]).collect();
         line(format!(

@@ -55,28 +55,42 @@ pub struct RunSummary {
 /// Loads a scene by built-in name or path and builds its model.
 pub fn load_model(name_or_path: &str, overrides: &[String]) -> Result<(Model, Option<String>)> {
     let src = SceneSource::resolve(name_or_path)?;
-    let (model, output, _) = build_model(&src, overrides)?;
-    Ok((model, output))
+    let built = build_model(&src, overrides)?;
+    Ok((built.model, built.output))
 }
 
-/// Builds the model of a resolved scene; returns its [output] path and the
-/// files it reads (scene, mesh), which no output may replace.
-fn build_model(
-    src: &SceneSource,
-    overrides: &[String],
-) -> Result<(Model, Option<String>, Vec<Input>)> {
+/// A scene's model, its `[output] path`, the files it reads (scene, mesh
+/// and what the mesh includes), which no output may replace, and the notes
+/// about the mesh a run prints once.
+struct Built {
+    model: Model,
+    output: Option<String>,
+    inputs: Vec<Input>,
+    notes: Vec<String>,
+}
+
+/// Builds the model of a resolved scene.
+fn build_model(src: &SceneSource, overrides: &[String]) -> Result<Built> {
     let parsed = scene::parse(src, overrides)?;
-    let model = parsed.build(&src.origin)?;
+    let (model, report) = parsed.build_with_report(&src.origin)?;
     let scene_file = src.path.clone().map(|path| Input {
         what: "scene file",
         path,
     });
-    let mesh_file = parsed.mesh_file(&src.origin).map(|path| Input {
-        what: "mesh file",
-        path,
-    });
-    let inputs = scene_file.into_iter().chain(mesh_file).collect();
-    Ok((model, parsed.output_path().map(str::to_owned), inputs))
+    let mesh_files = parsed
+        .mesh_file(&src.origin)
+        .into_iter()
+        .chain(report.included_files())
+        .map(|path| Input {
+            what: "mesh file",
+            path,
+        });
+    Ok(Built {
+        model,
+        output: parsed.output_path().map(str::to_owned),
+        inputs: scene_file.into_iter().chain(mesh_files).collect(),
+        notes: report.notes(),
+    })
 }
 
 /// Runs a scene on all ranks of the runtime.
@@ -94,6 +108,11 @@ pub fn run_scene(rt: &Runtime, name_or_path: &str, opts: &RunOptions) -> Result<
         .as_ref()
         .map(|from| read_restart(from, output.as_deref(), &loaded.model))
         .transpose()?;
+    if rt.rank() == 0 && !opts.quiet {
+        for note in &loaded.notes {
+            eprintln!("contactlink: note: {note}");
+        }
+    }
     let mut inputs = std::mem::take(&mut loaded.inputs);
     if let Some(out) = &output {
         // Every rank sees the same paths and files: the same answer.

@@ -40,6 +40,9 @@ pub struct Loaded {
     pub inputs: Vec<Input>,
     /// The scene text, for the result file's provenance.
     pub scene_text: String,
+    /// What reading the mesh found, for rank 0 to print once (empty on the
+    /// other ranks).
+    pub notes: Vec<String>,
 }
 
 impl Loaded {
@@ -58,14 +61,15 @@ const INPUTS: [&str; 2] = ["scene file", "mesh file"];
 /// Loads a scene on every rank as one process would.
 pub fn everywhere(name_or_path: &str, overrides: &[String]) -> Result<Loaded> {
     let src = SceneSource::resolve(name_or_path)?;
-    let (mut model, output, inputs) = super::build_model(&src, overrides)?;
-    let mesh = Some(model.take_mesh());
+    let mut built = super::build_model(&src, overrides)?;
+    let mesh = Some(built.model.take_mesh());
     Ok(Loaded {
-        model,
+        model: built.model,
         mesh,
-        output,
-        inputs,
+        output: built.output,
+        inputs: built.inputs,
         scene_text: src.text,
+        notes: built.notes,
     })
 }
 
@@ -145,5 +149,6 @@ fn decode(words: &[u64]) -> Result<Loaded> {
         output: has_output.then_some(output),
         inputs,
         scene_text,
+        notes: Vec::new(),
     })
 }

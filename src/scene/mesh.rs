@@ -1,21 +1,23 @@
 //! The scene's mesh: generated from a `[mesh]` generator or read from a
-//! Gmsh file, and what reading it found ([`MeshReport`]).
+//! Gmsh or Abaqus/CalculiX file, and what reading it found ([`MeshReport`]).
 use super::lines::{self, Seg};
-use super::sections::{GmshSection, MeshSection, Scene};
+use super::sections::{MeshSection, Scene};
 use super::source::BUILTIN;
 use crate::error::{Error, Result};
 use crate::fem::CellType;
 use crate::mesh::generate::{
     self, BoxSpec, Grading, HertzCylinderSpec, HertzSphereSpec, StackedSpec,
 };
-use crate::mesh::Mesh;
+use crate::mesh::{InpErrorKind, InpRequest, Mesh};
 use std::path::Path;
 
 impl Scene {
-    /// The mesh file the scene reads, if any (a Gmsh `[mesh] file`).
+    /// The mesh file the scene reads, if any (a Gmsh or `.inp` `[mesh] file`;
+    /// the files an `.inp` includes are in its [`MeshReport`]).
     pub fn mesh_file(&self, origin: &str) -> Option<std::path::PathBuf> {
         match &self.mesh {
-            MeshSection::Gmsh(g) => Some(gmsh_path(g, origin)),
+            MeshSection::Gmsh(g) => Some(mesh_path(&g.file, origin)),
+            MeshSection::Inp(i) => Some(mesh_path(&i.file, origin)),
             _ => None,
         }
     }
@@ -86,22 +88,59 @@ impl Scene {
                 })?
             }
             MeshSection::Gmsh(g) => {
-                let (mesh, gmsh) = crate::mesh::read_gmsh(&gmsh_path(g, origin)).map_err(|e| {
-                    let at = [Seg::Key("mesh"), Seg::Key("file")];
-                    self.error_at(origin, &at, format!("[mesh] gmsh: {e}"))
-                })?;
+                let (mesh, gmsh) =
+                    crate::mesh::read_gmsh(&mesh_path(&g.file, origin)).map_err(|e| {
+                        let at = [Seg::Key("mesh"), Seg::Key("file")];
+                        self.error_at(origin, &at, format!("[mesh] gmsh: {e}"))
+                    })?;
                 report.gmsh = Some(gmsh);
+                mesh
+            }
+            MeshSection::Inp(i) => {
+                let path = mesh_path(&i.file, origin);
+                let (mesh, inp) =
+                    crate::mesh::read_inp(&path, &self.inp_request()).map_err(|e| {
+                        // A body the file has no element set for is the
+                        // [[body]]'s error.
+                        let body = match &e.kind {
+                            InpErrorKind::UnknownBodySet { name, .. } => {
+                                self.bodies.iter().position(|b| &b.name == name)
+                            }
+                            _ => None,
+                        };
+                        let at = match body {
+                            Some(b) => [Seg::Key("body"), Seg::Index(b), Seg::Key("name")].to_vec(),
+                            None => [Seg::Key("mesh"), Seg::Key("file")].to_vec(),
+                        };
+                        self.error_at(origin, &at, format!("[mesh] inp: {e}"))
+                    })?;
+                report.inp = Some(inp);
                 mesh
             }
         };
         Ok((mesh, report))
     }
+
+    /// What an `.inp` file is asked for: the `[[body]]` names are its
+    /// element sets, and the sets the scene names keep the scene's spelling.
+    fn inp_request(&self) -> InpRequest {
+        let bodies = self.bodies.iter().map(|b| b.name.clone()).collect();
+        let sets = self.dirichlet.iter().map(|d| &d.set);
+        let sets = sets.chain(self.pressure.iter().map(|p| &p.set));
+        let sets = sets.chain(self.traction.iter().map(|t| &t.set));
+        let sets = sets.chain(self.contact.iter().map(|c| &c.slave));
+        let sets = sets.chain(self.contact.iter().filter_map(|c| c.master.as_ref()));
+        InpRequest {
+            bodies,
+            names: sets.cloned().collect(),
+        }
+    }
 }
 
-/// A Gmsh `file` as a path: relative to the scene's directory. `origin`
+/// A mesh `file` as a path: relative to the scene's directory. `origin`
 /// is the scene's path, or names a built-in scene, which is compiled in
 /// from the crate's scenes/ directory.
-pub(super) fn gmsh_path(g: &GmshSection, origin: &str) -> std::path::PathBuf {
+pub(super) fn mesh_path(file: &str, origin: &str) -> std::path::PathBuf {
     let builtin = BUILTIN
         .iter()
         .any(|(n, _, _)| origin == format!("built-in scene '{n}'"));
@@ -110,7 +149,7 @@ pub(super) fn gmsh_path(g: &GmshSection, origin: &str) -> std::path::PathBuf {
         Some(dir) => dir.to_path_buf(),
         None => Default::default(),
     };
-    base.join(&g.file)
+    base.join(file)
 }
 
 /// What reading the mesh found besides the mesh (for `check` to print).
@@ -119,4 +158,22 @@ pub struct MeshReport {
     /// The Gmsh reader's report (reoriented cells, skipped sections), for a
     /// `generator = "gmsh"` mesh.
     pub gmsh: Option<crate::mesh::GmshReport>,
+    /// The `.inp` reader's report (keywords not read, included files,
+    /// reoriented cells), for a `generator = "inp"` mesh.
+    pub inp: Option<crate::mesh::InpReport>,
+}
+
+impl MeshReport {
+    /// What a run prints once about the mesh read (the keywords of an
+    /// `.inp` file that were not read).
+    pub fn notes(&self) -> Vec<String> {
+        self.inp.iter().map(crate::mesh::InpReport::note).collect()
+    }
+
+    /// The files read besides the `[mesh] file` (an `.inp`'s includes).
+    pub fn included_files(&self) -> Vec<std::path::PathBuf> {
+        self.inp
+            .as_ref()
+            .map_or_else(Vec::new, |i| i.included.clone())
+    }
 }

@@ -9,7 +9,7 @@
 //! - `sections`: the TOML sections as read;
 //! - `parse`: text and `--set` overrides → [`Scene`]; errors at a key's line;
 //! - `build`: [`Scene::build`] → [`Model`];
-//! - `mesh`: the generated or Gmsh mesh;
+//! - `mesh`: the generated, Gmsh or `.inp` mesh;
 //! - `conditions`: Dirichlet conditions, amplitudes, dynamics, solver settings;
 //! - `contact`: contact pairs and the Hertz check;
 //! - `held`: which static bodies nothing holds;

@@ -45,6 +45,7 @@ pub enum MeshSection {
     HertzSphere(HertzSphereSection),
     StackedBlocks(StackedSection),
     Gmsh(GmshSection),
+    Inp(InpSection),
 }
 
 /// A Gmsh `.msh` 4.1 file; a relative `file` is relative to the scene
@@ -52,6 +53,14 @@ pub enum MeshSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GmshSection {
+    pub file: String,
+}
+
+/// An Abaqus/CalculiX `.inp` file (its mesh; the physics is the scene's);
+/// a relative `file` is relative to the scene file's directory, as for Gmsh.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InpSection {
     pub file: String,
 }
 
