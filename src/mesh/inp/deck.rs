@@ -68,28 +68,26 @@ impl Keyword {
         })
     }
 
-    /// Every parameter is one of `known`; `INSTANCE` is the sign of a file
-    /// with parts, `INPUT` of data in another file.
-    pub(super) fn check_params(&self, known: &[&str]) -> Result<(), Fail> {
+    /// The parameters not in `known`, which the reader does not read (the
+    /// caller lists them in the note); `INSTANCE` (a file with parts) and
+    /// `INPUT` (data lines in another file) are errors: what they change
+    /// would be missed.
+    pub(super) fn unknown_params(&self, known: &[&str]) -> Result<Vec<&str>, Fail> {
+        let mut unknown = Vec::new();
         for (name, _) in &self.params {
-            if known.contains(&name.as_str()) {
-                continue;
-            }
-            let hint = match name.as_str() {
+            match name.as_str() {
+                n if known.contains(&n) => {}
                 "INSTANCE" => {
                     return Err(Fail::at(self.at, InpErrorKind::Parts(self.name.clone())))
                 }
-                "INPUT" => " (put the data lines in the file, or *INCLUDE them)",
-                _ => "",
-            };
-            let kind = InpErrorKind::UnsupportedParameter {
-                keyword: self.name.clone(),
-                parameter: name.clone(),
-                hint,
-            };
-            return Err(Fail::at(self.at, kind));
+                "INPUT" => {
+                    let kind = InpErrorKind::DataElsewhere(self.name.clone());
+                    return Err(Fail::at(self.at, kind));
+                }
+                n => unknown.push(n),
+            }
         }
-        Ok(())
+        Ok(unknown)
     }
 }
 
@@ -214,7 +212,6 @@ impl Reader {
 
     /// Reads the file an `*INCLUDE` names, relative to the including file.
     fn include(&mut self, keyword: &Keyword, h: &mut impl Handler) -> Result<(), Fail> {
-        keyword.check_params(&["INPUT"])?;
         let input = keyword.require("INPUT")?;
         let from = keyword.at.file as usize;
         let dir = self

@@ -57,6 +57,8 @@ pub(super) fn classify(ty: &str) -> Class {
         _ if ty.starts_with("GAP") => Unsupported("gap elements"),
         _ if ty.starts_with("R3D") || ty.starts_with("R2D") => Unsupported("rigid elements"),
         _ if numbered(ty, "DC") => Unsupported("heat transfer"),
+        _ if numbered(ty, "F") => Unsupported("fluid"),
+        "D" | "DCOUP3D" => Unsupported("fluid network or coupling"),
         _ if ty.starts_with("CPS") || ty.starts_with("CPE") || ty.starts_with("S") => {
             Unsupported("plane or shell")
         }

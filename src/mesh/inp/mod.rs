@@ -138,12 +138,8 @@ pub enum InpErrorKind {
         keyword: String,
         parameter: &'static str,
     },
-    #[error("*{keyword}: parameter {parameter} is not supported{hint}")]
-    UnsupportedParameter {
-        keyword: String,
-        parameter: String,
-        hint: &'static str,
-    },
+    #[error("*{0}: INPUT= (the data lines in another file) is not supported: put them in the file, or *INCLUDE them")]
+    DataElsewhere(String),
     #[error("*{keyword}: {parameter}={value} is not supported; {expected}")]
     BadParameter {
         keyword: &'static str,

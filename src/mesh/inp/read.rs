@@ -219,7 +219,7 @@ impl Raw {
     }
 
     fn node_keyword(&mut self, k: &Keyword) -> Result<Block, Fail> {
-        k.check_params(&["NSET", "SYSTEM"])?;
+        self.params(k, &["NSET", "SYSTEM"])?;
         if let Some(system) = k.value("SYSTEM").filter(|s| !s.eq_ignore_ascii_case("R")) {
             let kind = InpErrorKind::BadParameter {
                 keyword: "NODE",
@@ -234,7 +234,7 @@ impl Raw {
     }
 
     fn element_keyword(&mut self, k: &Keyword) -> Result<Block, Fail> {
-        k.check_params(&["TYPE", "ELSET"])?;
+        self.params(k, &["TYPE", "ELSET"])?;
         let ty = k.require("TYPE")?.to_uppercase();
         let elset = k.value("ELSET").map(str::to_string);
         let kind = match classify(&ty) {
@@ -282,7 +282,7 @@ impl Raw {
             SetKind::Node => "NSET",
             SetKind::Element => "ELSET",
         };
-        k.check_params(&[param, "GENERATE", "INTERNAL", "UNSORTED"])?;
+        self.params(k, &[param, "GENERATE", "INTERNAL", "UNSORTED"])?;
         let name = k.require(param)?.to_string();
         let def = self.set_def(kind, &name);
         let generate = k.has("GENERATE");
@@ -294,7 +294,7 @@ impl Raw {
     }
 
     fn surface_keyword(&mut self, k: &Keyword) -> Result<Block, Fail> {
-        k.check_params(&["NAME", "TYPE", "INTERNAL"])?;
+        self.params(k, &["NAME", "TYPE", "INTERNAL"])?;
         let name = k.require("NAME")?.to_string();
         let ty = k.value("TYPE").unwrap_or("ELEMENT").to_uppercase();
         match ty.as_str() {
@@ -328,7 +328,7 @@ impl Raw {
 
     fn node_line(&mut self, line: &DataLine, def: Option<usize>) -> Result<(), Fail> {
         let f = line.fields;
-        if !(2..=7).contains(&f.len()) {
+        if !(1..=7).contains(&f.len()) {
             let kind = InpErrorKind::FieldCount {
                 what: "a *NODE line",
                 expected: "id, x, y, z",
@@ -509,10 +509,25 @@ impl Raw {
     }
 
     fn skip(&mut self, k: &Keyword) -> Block {
-        if k.name != "HEADING" && self.seen.insert(k.name.clone()) {
-            self.skipped.push((k.name.clone(), k.at));
+        if k.name != "HEADING" {
+            self.note(k.name.clone(), k.at);
         }
         Block::Skip
+    }
+
+    /// Lists a keyword (or `KEYWORD, PARAMETER=`) not read, once.
+    fn note(&mut self, what: String, at: Loc) {
+        if self.seen.insert(what.clone()) {
+            self.skipped.push((what, at));
+        }
+    }
+
+    /// Notes the parameters of a keyword read that are not in `known`.
+    fn params(&mut self, k: &Keyword, known: &[&str]) -> Result<(), Fail> {
+        for p in k.unknown_params(known)? {
+            self.note(format!("{}, {p}=", k.name), k.at);
+        }
+        Ok(())
     }
 }
 

@@ -86,10 +86,11 @@ fn comments_blank_lines_and_skipped_keywords() {
          *MATERIAL, NAME=STEEL\n*ELASTIC\n210000, 0.3\n\
          *SOLID SECTION, ELSET=LEFT, MATERIAL=STEEL\n\
          *STEP\n*STATIC\n*BOUNDARY\nNALL, 1, 3\n*END STEP\n\
-         *STEP\n*STATIC\n*END STEP\n"
+         *STEP\n*STATIC\n*END STEP\n*NSET, NSET=X, FREQUENCY=100\n101\n"
     );
     let (mesh, report) = parse(&deck);
-    assert_eq!(mesh, parse(TWO_HEX).0);
+    assert_eq!(mesh.cells, parse(TWO_HEX).0.cells);
+    assert_eq!(mesh.node_set("X").unwrap(), [0]);
     let at = |k: &str| line_of(&deck, k);
     let expected: Vec<String> = [
         ("MATERIAL", at("*MATERIAL")),
@@ -99,6 +100,7 @@ fn comments_blank_lines_and_skipped_keywords() {
         ("STATIC", at("*STATIC")),
         ("BOUNDARY", at("*BOUNDARY")),
         ("END STEP", at("*END STEP")),
+        ("NSET, FREQUENCY=", at("*NSET, NSET=X")),
     ]
     .iter()
     .map(|(k, l)| format!("*{k} (line {l})"))
