@@ -4,10 +4,10 @@
 use std::collections::{BTreeMap, HashMap};
 
 use super::deck::{Fail, Loc};
+use super::error::InpErrorKind;
 use super::kind::{abaqus_faces, Kind};
 use super::read::{Raw, DEFAULT_BODY};
 use super::sets::{Face, Sets};
-use super::{InpErrorKind, InpReport, InpRequest};
 use crate::mesh::orient::orient_cells;
 use crate::mesh::topology::face_key;
 use crate::mesh::{FacetRef, Mesh, MeshError};
@@ -74,7 +74,22 @@ impl Numbering<'_> {
     }
 }
 
-pub(super) fn assemble(raw: &Raw, request: &InpRequest) -> Result<(Mesh, InpReport), Fail> {
+/// What assembling did besides the mesh.
+pub(super) struct Counts {
+    /// Cells that came fully inverted and were renumbered.
+    pub(super) reoriented: usize,
+    /// Nodes that no cell uses (dropped).
+    pub(super) unused_nodes: usize,
+}
+
+/// The mesh of what was read: `bodies` are the element sets that are the
+/// bodies (empty: each `*ELEMENT` line's set), `names` the spelling of the
+/// set names the caller uses.
+pub(super) fn assemble(
+    raw: &Raw,
+    bodies: &[String],
+    names: &[String],
+) -> Result<(Mesh, Counts), Fail> {
     let (cell_type, _, _) = raw
         .cell_type
         .ok_or_else(|| Fail::whole_file(InpErrorKind::NoVolumeCells))?;
@@ -94,7 +109,7 @@ pub(super) fn assemble(raw: &Raw, request: &InpRequest) -> Result<(Mesh, InpRepo
         .filter_map(|&n| num.new_node.get(n).copied().flatten())
         .collect();
     let sets = Sets::resolve(raw)?;
-    (mesh.bodies, mesh.cell_body) = bodies(&num, &sets, request)?;
+    (mesh.bodies, mesh.cell_body) = body_sets(&num, &sets, bodies)?;
     let reoriented = orient_cells(&mut mesh).map_err(|t| {
         let e = num.cells.get(t.cell).copied().unwrap_or_default();
         let kind = InpErrorKind::TangledCell {
@@ -104,11 +119,7 @@ pub(super) fn assemble(raw: &Raw, request: &InpRequest) -> Result<(Mesh, InpRepo
         };
         num.fail(e, kind)
     })?;
-    let spelling: HashMap<String, &String> = request
-        .names
-        .iter()
-        .map(|n| (n.to_uppercase(), n))
-        .collect();
+    let spelling: HashMap<String, &String> = names.iter().map(|n| (n.to_uppercase(), n)).collect();
     let name = |key: &str, first: &str| spelling.get(key).map_or(first, |s| s).to_string();
     let facets = facet_sets(&mesh, &num, &sets)?;
     for (key, (first, nodes)) in node_sets(&num, &sets) {
@@ -130,12 +141,11 @@ pub(super) fn assemble(raw: &Raw, request: &InpRequest) -> Result<(Mesh, InpRepo
         mesh.facet_sets.insert(name, list);
     }
     mesh.validate().map_err(|error| invalid(&num, error))?;
-    let report = InpReport {
+    let counts = Counts {
         reoriented,
         unused_nodes: raw.coords.len() - mesh.nodes.len(),
-        ..InpReport::default()
     };
-    Ok((mesh, report))
+    Ok((mesh, counts))
 }
 
 /// Element nodes as read-node indices; cells in file order; nodes that
@@ -189,18 +199,18 @@ fn numbering(raw: &Raw) -> Result<Numbering<'_>, Fail> {
     Ok(num)
 }
 
-/// Body names and each cell's body: the element sets the request names
-/// (in the order the file defines them), or else each `*ELEMENT` line's set.
-fn bodies(
+/// Body names and each cell's body: the element sets `bodies` names (in
+/// the order the file defines them), or else each `*ELEMENT` line's set.
+fn body_sets(
     num: &Numbering,
     sets: &Sets,
-    request: &InpRequest,
+    bodies: &[String],
 ) -> Result<(Vec<String>, Vec<u32>), Fail> {
-    if request.bodies.is_empty() {
+    if bodies.is_empty() {
         return Ok(element_line_bodies(num));
     }
     let mut chosen: Vec<(usize, &String, &[usize])> = Vec::new();
-    for name in &request.bodies {
+    for name in bodies {
         let key = name.to_uppercase();
         let set = sets
             .elements

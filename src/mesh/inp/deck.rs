@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{InpError, InpErrorKind};
+use super::error::{InpError, InpErrorKind};
 
 /// How deep `*INCLUDE` may nest: deeper is surely a mistake.
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -225,7 +225,7 @@ impl Reader {
             let path = path.display().to_string();
             Fail::at(keyword.at, InpErrorKind::Include { path, reason })
         };
-        let bytes = std::fs::read(&path).map_err(|e| failed(e.to_string()))?;
+        let bytes = read_file(&path).map_err(|e| failed(e.to_string()))?;
         let canonical = path.canonicalize().map_err(|e| failed(e.to_string()))?;
         if self.stack.contains(&canonical) {
             let chain: Vec<String> = self
@@ -249,6 +249,15 @@ impl Reader {
         self.stack.pop();
         read
     }
+}
+
+/// The bytes of a regular file: a device or a pipe (`/dev/zero`) could
+/// never end.
+pub(super) fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::other("not a regular file"));
+    }
+    std::fs::read(path)
 }
 
 /// `*NAME, P1=V1, FLAG`: the name in upper case with single spaces, the

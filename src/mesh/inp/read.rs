@@ -4,8 +4,8 @@
 use std::collections::{HashMap, HashSet};
 
 use super::deck::{shorten, unquote, DataLine, Fail, Handler, Keyword, Loc};
+use super::error::InpErrorKind;
 use super::kind::{classify, Class, Kind};
-use super::InpErrorKind;
 use crate::mesh::CellType;
 use crate::vec3::Vec3;
 

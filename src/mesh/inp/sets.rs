@@ -5,9 +5,9 @@
 use std::collections::{BTreeMap, HashMap};
 
 use super::deck::{Fail, Loc};
+use super::error::InpErrorKind;
 use super::kind::{abaqus_faces, Kind};
 use super::read::{Def, FaceLine, Member, Raw, SetKind, Target};
-use super::InpErrorKind;
 
 /// A set as resolved: its name as first written, and its members (indices
 /// into the read nodes or elements; repeats possible).

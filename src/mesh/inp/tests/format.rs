@@ -1,6 +1,6 @@
 //! The keyword format: continuation lines, case, comments, includes, ids.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::{line_of, node_at, parse, parse_err, parse_request, request, TWO_HEX};
 use crate::mesh::inp::{read_inp, InpErrorKind, InpRequest};
@@ -191,6 +191,18 @@ fn include_cycles_and_missing_includes_are_errors() {
         "{err}"
     );
     assert!(err.to_string().contains("nothere.inp"), "{err}");
+    // A device would never end: refused before reading.
+    std::fs::write(dir.join("d.inp"), "*INCLUDE, INPUT=/dev/zero\n").unwrap();
+    let err = read_inp(&dir.join("d.inp"), &InpRequest::default()).unwrap_err();
+    assert!(
+        err.to_string().contains("/dev/zero: not a regular file"),
+        "{err}"
+    );
+    let err = read_inp(Path::new("/dev/zero"), &InpRequest::default()).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "/dev/zero: cannot read the file: not a regular file"
+    );
 }
 
 #[test]
