@@ -16,7 +16,7 @@
 //!   numbered from 0 in file order; messages keep the file's ids.
 //! * `*ELEMENT, TYPE=..` (optionally `ELSET=`): C3D4 cells (tet4) or C3D8,
 //!   C3D8R, C3D8I cells (hex8; the program's full integration), one cell
-//!   type per file. Abaqus numbers both as [`CellType`] does; fully inverted
+//!   type per file. Abaqus numbers both as [`CellType`](crate::mesh::CellType) does; fully inverted
 //!   cells are renumbered and counted, tangled ones are an error. Triangles
 //!   and quadrilaterals (S3, S4, S4R, CPS3, CPS4, M3D3, ...: what meshers
 //!   write for boundary groups) must each be a boundary face of a cell, matched
@@ -39,7 +39,8 @@
 //!   set's node set of the same name.
 //! * Every other keyword (`*MATERIAL`, `*STEP`, `*BOUNDARY`, ...) is skipped
 //!   with its data lines and listed once in [`InpReport::note`]; `*HEADING`
-//!   silently. Parts and instances and the mesh generation keywords (`*NGEN`,
+//!   silently; so are the parameters of a keyword read that the reader does
+//!   not read (`*NSET, FREQUENCY=`). Parts and instances and the mesh generation keywords (`*NGEN`,
 //!   `*ELGEN`, ...) are errors: what they define would be missing.
 //!
 //! Every error is one line naming the file, the line and the element, node
@@ -80,8 +81,9 @@ pub struct InpReport {
     pub file: String,
     /// The files `*INCLUDE` read, in the order first read.
     pub included: Vec<PathBuf>,
-    /// Keywords skipped, each once, with where it first appears
-    /// (`*MATERIAL (line 120)`, `*STEP (steps.inp, line 3)`).
+    /// Keywords skipped and parameters not read, each once, with where it
+    /// first appears (`*MATERIAL (line 120)`, `*STEP (steps.inp, line 3)`,
+    /// `*NSET, FREQUENCY= (line 36)`).
     pub skipped: Vec<String>,
     /// Cells that came fully inverted and were renumbered.
     pub reoriented: usize,
