@@ -8,6 +8,7 @@ packages=(
   petsc-dev libopenmpi-dev openmpi-bin libmetis-dev libhdf5-openmpi-dev
   libclang-dev clang pkg-config hdf5-tools libopenblas0-serial
   python3-matplotlib python3-h5py fonts-dejavu-core
+  calculix-ccx-test
 )
 if [ "${1:-}" = "--peers" ]; then
   packages+=(gmsh calculix-ccx)

@@ -1,7 +1,9 @@
 //! A mesh from a published CalculiX contact example, read from its `.inp`
 //! and run with the example's physics written as a scene, against
 //! CalculiX's own answer on the deck (tests/data/inp/calculix/README.md).
-//! CalculiX is not needed: its figures are held here.
+//! The deck is CalculiX's own, as Debian's `calculix-ccx-test` installs it
+//! (`make deps` does); CalculiX itself is not needed: its figures are held
+//! here.
 mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_nodal};
@@ -69,11 +71,31 @@ const CCX_TOP_UZ: [(usize, f64); 25] = [
     (250, -3.774410E-04),
 ];
 
+/// Where Debian's `calculix-ccx-test` puts the example (gzipped).
+const DECK: &str = "/usr/share/doc/calculix-ccx-test/examples/test/friction1.inp.gz";
+
+/// The scene, its wrapper `.inp` and the example's deck, unpacked, in `dir`.
+fn friction1_in(dir: &Path) -> std::path::PathBuf {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/inp/calculix");
+    let deck = std::process::Command::new("gzip")
+        .args(["-dc", DECK])
+        .output()
+        .expect("gzip");
+    assert!(
+        deck.status.success(),
+        "cannot read {DECK}: install calculix-ccx-test (make deps)"
+    );
+    std::fs::write(dir.join("friction1-deck.inp"), deck.stdout).unwrap();
+    for f in ["friction1.inp", "friction1.toml"] {
+        std::fs::copy(data.join(f), dir.join(f)).unwrap();
+    }
+    dir.join("friction1.toml")
+}
+
 #[test]
 fn calculix_example_friction1_runs_to_calculix_s_answer() {
     let dir = scratch("inp-calculix-friction1");
-    let scene =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/inp/calculix/friction1.toml");
+    let scene = friction1_in(&dir);
     let (model, _) = contactlink::pipeline::load_model(scene.to_str().unwrap(), &[]).unwrap();
     // Node ids 1..250 in file order, every one on a cell: id n is node n − 1.
     assert_eq!(model.mesh.num_nodes(), 250);
