@@ -31,8 +31,9 @@ pub fn partition_cells(mesh: &Mesh, nparts: usize, balanced_sets: &[String]) -> 
             "{ncells} cells cannot be shared among {nparts} ranks; use fewer ranks or a finer mesh"
         )));
     }
-    let shared = mesh.cell_type.facet_type().nodes();
-    let (xadj, adjncy) = mesh.dual_graph(shared)?;
+    // Face adjacency: cells sharing a face (the corner key of
+    // `Mesh::faces_by_key`), for every cell type.
+    let (xadj, adjncy) = mesh.face_dual_graph();
     let to_idx = |v: usize| {
         metis::Idx::try_from(v)
             .map_err(|_| Error::Partition("mesh too large for METIS's index type".into()))

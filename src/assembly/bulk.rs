@@ -99,8 +99,7 @@ impl BulkAssembler {
     /// Adds the internal force f_int(u) of every local cell into `r_local`.
     pub fn add_internal_force(&self, u_local: &[f64], r_local: &mut [f64]) -> Result<()> {
         let n = self.npc();
-        let mut u = [[0.0; 3]; 8];
-        let mut r = [0.0; 24];
+        let (mut u, mut r) = (vec![[0.0; 3]; n], vec![0.0; 3 * n]);
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
             gather_nodal(u_local, nodes, &mut u[..n]);
@@ -115,9 +114,8 @@ impl BulkAssembler {
     /// Adds the consistent tangent of every local cell into `k` (not assembled).
     pub fn add_tangent(&self, u_local: &[f64], k: &mut dyn MatrixSink) -> Result<()> {
         let n = self.npc();
-        let mut u = [[0.0; 3]; 8];
-        let mut r = [0.0; 24];
-        let mut ke = [0.0; 24 * 24];
+        let (mut u, mut r) = (vec![[0.0; 3]; n], vec![0.0; 3 * n]);
+        let mut ke = vec![0.0; 9 * n * n];
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
             gather_nodal(u_local, nodes, &mut u[..n]);
@@ -141,14 +139,25 @@ impl BulkAssembler {
     /// `materials[b]` is its material. The blocks land on the tangent's
     /// pattern, so `m` may be a matrix built from [`Self::add_pattern`] or the
     /// tangent itself. A body of density 0 adds nothing.
-    pub fn add_mass(&self, density: &[f64], m: &mut dyn MatrixSink) -> Result<()> {
-        self.for_each_cell_mass(density, |dofs, me| m.add_block(dofs, dofs, me))
+    ///
+    /// `local_nodes` are the local mesh's coordinates: the types whose
+    /// default rule is too weak for `N_a N_b` (tet10, wedge15, pyramid5)
+    /// integrate their mass with [`QuadRule::mass_for_cell`] on a geometry
+    /// built here, once per run.
+    pub fn add_mass(
+        &self,
+        local_nodes: &[[f64; 3]],
+        density: &[f64],
+        m: &mut dyn MatrixSink,
+    ) -> Result<()> {
+        self.for_each_cell_mass(local_nodes, density, |dofs, me| m.add_block(dofs, dofs, me))
     }
 
     /// Calls `add(dofs, mass)` for every local cell of non-zero density;
     /// split from [`Self::add_mass`] so the sums can be checked without PETSc.
     fn for_each_cell_mass(
         &self,
+        local_nodes: &[[f64; 3]],
         density: &[f64],
         mut add: impl FnMut(&[GlobalDof], &[f64]) -> Result<()>,
     ) -> Result<()> {
@@ -156,8 +165,9 @@ impl BulkAssembler {
         // fail as well, or the others would wait for it in assembly.
         self.check_densities(density)?;
         let n = self.npc();
-        let mut me = [0.0; 24 * 24];
-        for (i, geom) in self.geometry.iter().enumerate() {
+        let mut me = vec![0.0; 9 * n * n];
+        let mass_rule = QuadRule::mass_for_cell(self.cell_type);
+        for (i, stiffness_geom) in self.geometry.iter().enumerate() {
             let body = self.body(i);
             let rho = *density.get(body).ok_or_else(|| {
                 self.cell_error(
@@ -172,6 +182,20 @@ impl BulkAssembler {
             if rho == 0.0 {
                 continue;
             }
+            let own;
+            let geom = match &mass_rule {
+                Some(rule) => {
+                    let x_ref: Vec<[f64; 3]> = self
+                        .nodes(i)
+                        .iter()
+                        .map(|&l| local_nodes[l.index()])
+                        .collect();
+                    own = ElementGeometry::new(self.cell_type, &x_ref, rule)
+                        .map_err(|e| self.cell_error(i, e))?;
+                    &own
+                }
+                None => stiffness_geom,
+            };
             fem::mass_matrix(geom, rho, &mut me[..9 * n * n]).map_err(|e| self.cell_error(i, e))?;
             add(self.dofs(i), &me[..9 * n * n])?;
         }
@@ -208,7 +232,7 @@ impl BulkAssembler {
     /// counting of cells on partition boundaries.
     pub fn strain_energy(&self, u_local: &[f64]) -> Result<f64> {
         let n = self.npc();
-        let mut u = [[0.0; 3]; 8];
+        let mut u = vec![[0.0; 3]; n];
         let mut energy = 0.0;
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
@@ -259,7 +283,7 @@ impl BulkAssembler {
     /// reference volume) scaled by `factor`, into the external force `f_local`.
     pub fn add_body_force(&self, b: &[[f64; 3]], factor: f64, f_local: &mut [f64]) -> Result<()> {
         let n = self.npc();
-        let mut fe = [0.0; 24];
+        let mut fe = vec![0.0; 3 * n];
         for (i, geom) in self.geometry.iter().enumerate() {
             let bb = b[self.body(i)];
             if bb == [0.0; 3] {
@@ -281,7 +305,7 @@ impl BulkAssembler {
         f_local: &mut [f64],
     ) -> Result<()> {
         let n = self.npc();
-        let mut fe = [0.0; 24];
+        let mut fe = vec![0.0; 3 * n];
         for (i, geom) in self.geometry.iter().enumerate() {
             let nodes = self.nodes(i);
             let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| local_nodes[l.index()]).collect();
@@ -302,12 +326,9 @@ impl BulkAssembler {
     }
 }
 
-/// The default rule: full Gauss integration for the element.
+/// The default rule: full integration for the element type.
 fn quadrature_rule(cell_type: CellType) -> QuadRule {
-    match cell_type {
-        CellType::Hex8 => QuadRule::hex_2x2x2(),
-        CellType::Tet4 => QuadRule::tet_1(),
-    }
+    QuadRule::default_for_cell(cell_type)
 }
 
 #[cfg(test)]
@@ -376,11 +397,18 @@ mod tests {
 
     /// Σ of every entry of every cell's mass block over all ranks, and the
     /// number of cells that contributed.
-    fn mass_sum(all: &[(DofMap, BulkAssembler)], density: &[f64]) -> Result<(f64, usize)> {
+    fn mass_sum(
+        mesh: &Mesh,
+        all: &[(DofMap, BulkAssembler)],
+        density: &[f64],
+    ) -> Result<(f64, usize)> {
         let mut total = 0.0;
         let mut cells = 0;
-        for (_, bulk) in all {
-            bulk.for_each_cell_mass(density, |dofs, me| {
+        for (dofs, bulk) in all {
+            let local_nodes: Vec<[f64; 3]> = (0..dofs.num_local_nodes())
+                .map(|l| mesh.nodes[dofs.natural(LocalNode::from_index(l)).0])
+                .collect();
+            bulk.for_each_cell_mass(&local_nodes, density, |dofs, me| {
                 assert_eq!(me.len(), dofs.len() * dofs.len());
                 total += me.iter().sum::<f64>();
                 cells += 1;
@@ -399,7 +427,8 @@ mod tests {
             let all = assemblers(&mesh, &materials(&mesh));
             let lower_cells = mesh.body_cells(mesh.body_id("lower").unwrap()).count();
             for (lower, upper) in [(2.0, 0.0), (0.0, 3.0), (2.0, 3.0)] {
-                let (total, cells) = mass_sum(&all, &body_density(&mesh, lower, upper)).unwrap();
+                let (total, cells) =
+                    mass_sum(&mesh, &all, &body_density(&mesh, lower, upper)).unwrap();
                 // Each of the three components carries the full mass.
                 let expected = 3.0 * volume * (lower + upper);
                 assert!(
@@ -428,7 +457,7 @@ mod tests {
             body_density(&mesh, f64::NAN, 1.0),
             body_density(&mesh, 1.0, f64::INFINITY),
         ] {
-            let err = mass_sum(&all, &density).unwrap_err();
+            let err = mass_sum(&mesh, &all, &density).unwrap_err();
             assert!(err.to_string().contains("density"), "{err}");
         }
     }

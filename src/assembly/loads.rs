@@ -4,12 +4,14 @@ use crate::amplitude::Amplitude;
 use crate::distribution::{LocalFacetSet, LocalMesh};
 use crate::dofs::{DofMap, GlobalDof, LocalNode};
 use crate::error::{Error, Result};
-use crate::fem::{self, FacetType};
+use crate::fem::{self, FacetType, MAX_FACET_NODES};
 use crate::model::FacetLoad;
 
 struct LocalFacet {
     /// Natural id of the cell the facet belongs to (for error messages).
     cell: usize,
+    /// Its type (a wedge's set may hold triangles and quadrilaterals).
+    facet_type: FacetType,
     nodes: Vec<LocalNode>,
     x_ref: Vec<[f64; 3]>,
     dofs: Vec<GlobalDof>,
@@ -29,8 +31,9 @@ impl LocalFacet {
 /// The facet loads this rank evaluates: those on facets of its own cells, so
 /// every facet is counted exactly once over all ranks.
 pub struct SurfaceLoads {
-    facet_type: FacetType,
     facets: Vec<LocalFacet>,
+    /// Most nodes of any of the facets: sizes the element buffers.
+    max_nodes: usize,
 }
 
 impl SurfaceLoads {
@@ -41,10 +44,10 @@ impl SurfaceLoads {
         dofs: &DofMap,
         loads: &[(&LocalFacetSet, FacetLoad, Amplitude)],
     ) -> Result<Self> {
-        let facet_type = mesh.cell_type.facet_type();
         let mut facets = Vec::new();
         for (set, load, amplitude) in loads {
             for f in &set.facets {
+                let facet_type = mesh.facet_type(f);
                 let nodes: Vec<LocalNode> = f.nodes[..facet_type.nodes()]
                     .iter()
                     .map(|&l| LocalNode::from_u32(l))
@@ -54,6 +57,7 @@ impl SurfaceLoads {
                 element_dofs(dofs, &nodes, &mut d);
                 facets.push(LocalFacet {
                     cell: f.cell,
+                    facet_type,
                     nodes,
                     x_ref,
                     dofs: d,
@@ -62,7 +66,8 @@ impl SurfaceLoads {
                 });
             }
         }
-        Ok(SurfaceLoads { facet_type, facets })
+        let max_nodes = facets.iter().map(|f| f.nodes.len()).max().unwrap_or(0);
+        Ok(SurfaceLoads { facets, max_nodes })
     }
 
     pub fn is_empty(&self) -> bool {
@@ -85,19 +90,19 @@ impl SurfaceLoads {
         scale: f64,
         f_local: &mut [f64],
     ) -> Result<()> {
-        let n = self.facet_type.nodes();
-        let mut u = [[0.0; 3]; 4];
-        let mut fe = [0.0; 12];
+        let mut u = [[0.0; 3]; MAX_FACET_NODES];
+        let mut fe = [0.0; 3 * MAX_FACET_NODES];
         for facet in &self.facets {
+            let n = facet.nodes.len();
             match facet.load {
                 FacetLoad::Traction(t) => {
-                    fem::dead_traction(self.facet_type, &facet.x_ref, t, &mut fe[..3 * n])
+                    fem::dead_traction(facet.facet_type, &facet.x_ref, t, &mut fe[..3 * n])
                         .map_err(|e| facet.error(e))?;
                 }
                 FacetLoad::Pressure(p) => {
                     gather_nodal(u_local, &facet.nodes, &mut u[..n]);
                     fem::follower_pressure(
-                        self.facet_type,
+                        facet.facet_type,
                         &facet.x_ref,
                         &u[..n],
                         p,
@@ -127,15 +132,16 @@ impl SurfaceLoads {
 
     /// Adds −a(factor)·∂f_ext/∂u of follower loads into the tangent `k`.
     pub fn add_tangent(&self, u_local: &[f64], factor: f64, k: &mut dyn MatrixSink) -> Result<()> {
-        let n = self.facet_type.nodes();
-        let mut u = [[0.0; 3]; 4];
-        let mut fe = [0.0; 12];
-        let mut ke = [0.0; 144];
+        let mut u = [[0.0; 3]; MAX_FACET_NODES];
+        let mut fe = [0.0; 3 * MAX_FACET_NODES];
+        // Sized by the largest facet loaded here: 144 entries for quad4.
+        let mut ke = vec![0.0; 9 * self.max_nodes * self.max_nodes];
         for facet in &self.facets {
+            let n = facet.nodes.len();
             if let FacetLoad::Pressure(p) = facet.load {
                 gather_nodal(u_local, &facet.nodes, &mut u[..n]);
                 fem::follower_pressure(
-                    self.facet_type,
+                    facet.facet_type,
                     &facet.x_ref,
                     &u[..n],
                     p,

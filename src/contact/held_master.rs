@@ -83,7 +83,7 @@ impl HeldMaster {
         let refs = mesh
             .facet_set(set)
             .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
-        let facet_type = mesh.cell_type.facet_type();
+        let facet_type = crate::contact::surfaces::contact_facet_type(mesh, set)?;
         let n = facet_type.nodes();
         let (mut own, mut own_local) = (Vec::new(), Vec::new());
         for f in &refs.facets {

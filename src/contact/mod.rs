@@ -25,6 +25,13 @@
 //!
 //! Nothing here calls the solver or PETSc: `solve` drives the Uzawa loop
 //! around SNES.
+//!
+//! Contact handles first-order facets (tri3, quad4) only: the scene refuses
+//! a pair whose facet sets hold second-order facets or mix facet types
+//! (`scene/contact.rs`), and the arrays and dual numbers here are sized by
+//! [`MAX_FACET_NODES`], not by `fem`'s, so they do not grow with the element
+//! library. [`facet_shape`] evaluates a facet's first-order shape
+//! functions.
 pub mod autodiff;
 pub mod fields;
 pub mod formulation;
@@ -39,6 +46,13 @@ pub mod projection;
 pub mod search;
 pub mod surfaces;
 
+pub use crate::fem::shape::linear_facet_shape as facet_shape;
 pub use formulation::{Census, SlipRate, Traits};
 pub use outcome::{PairForce, UzawaStats};
 pub use pair::ContactPair;
+
+/// Most nodes of a contact facet (quad4).
+pub const MAX_FACET_NODES: usize = 4;
+
+/// The first-order shape functions of a contact facet at one point.
+pub type FacetShape = crate::fem::shape::FacetShape<MAX_FACET_NODES>;

@@ -12,7 +12,7 @@ use super::master::MasterSide;
 use super::mortar::MortarPair;
 use super::outcome::UzawaStats;
 use super::penalty;
-use super::surfaces::SlaveSurface;
+use super::surfaces::{self, SlaveSurface};
 use crate::assembly::{HaloFactory, MatrixSink, PatternSink, RankExchange};
 use crate::distribution::{LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof};
@@ -50,7 +50,9 @@ impl ContactPair {
         halos: &dyn HaloFactory,
         ranks: &dyn RankExchange,
     ) -> Result<Self> {
-        let rule = spec.quadrature.rule(mesh.cell_type.facet_type());
+        let rule = spec
+            .quadrature
+            .rule(surfaces::contact_facet_type(mesh, &spec.slave)?);
         let slave = SlaveSurface::new(mesh, dofs, &spec.slave, slave_piece, &rule)?;
         let master = MasterSide::new(mesh, dofs, spec, ranks)?;
         let penalty = penalty::default_normal(spec.penalty, softest_youngs, slave.h);

@@ -17,8 +17,10 @@
 //! minimiser that would lie outside that box ends as a clamped answer with
 //! `converged = false`.
 
-use crate::fem::shape::{facet_shape, QUAD4_REF_NODES};
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::contact::facet_shape;
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::shape::QUAD4_REF_NODES;
+use crate::fem::FacetType;
 use crate::vec3::{add, cross, dot, norm, sub};
 
 /// Result of [`project`].
@@ -73,17 +75,17 @@ pub fn project(
 
 /// Reference coordinates of the facet centre (the default Newton start).
 pub fn reference_centre(facet: FacetType) -> [f64; 2] {
-    match facet {
-        FacetType::Quad4 => [0.0, 0.0],
+    match facet.linear() {
         FacetType::Tri3 => [1.0 / 3.0, 1.0 / 3.0],
+        _ => [0.0, 0.0],
     }
 }
 
 /// Largest violation of the reference facet's inequalities at `xi`.
 pub fn outside_distance(facet: FacetType, xi: [f64; 2]) -> f64 {
-    let violation = match facet {
-        FacetType::Quad4 => (xi[0].abs() - 1.0).max(xi[1].abs() - 1.0),
+    let violation = match facet.linear() {
         FacetType::Tri3 => (-xi[0]).max(-xi[1]).max(xi[0] + xi[1] - 1.0),
+        _ => (xi[0].abs() - 1.0).max(xi[1].abs() - 1.0),
     };
     violation.max(0.0)
 }
@@ -94,7 +96,7 @@ pub fn outside_distance(facet: FacetType, xi: [f64; 2]) -> f64 {
 /// the link kernel uses to evaluate at a dual-valued `ξ`.
 pub fn mixed_second_derivative(facet: FacetType) -> [f64; MAX_FACET_NODES] {
     let mut m = [0.0; MAX_FACET_NODES];
-    if facet == FacetType::Quad4 {
+    if facet.linear() == FacetType::Quad4 {
         for (mb, node) in m.iter_mut().zip(QUAD4_REF_NODES) {
             *mb = 0.25 * node[0] * node[1];
         }
@@ -106,9 +108,9 @@ pub fn mixed_second_derivative(facet: FacetType) -> [f64; MAX_FACET_NODES] {
 /// edge (quad `[-2, 2]²`, tri `[-1, 2]²`). A projection further out belongs
 /// to another facet, and the bilinear extension may fold there.
 fn search_box(facet: FacetType) -> (f64, f64) {
-    match facet {
-        FacetType::Quad4 => (-2.0, 2.0),
+    match facet.linear() {
         FacetType::Tri3 => (-1.0, 2.0),
+        _ => (-2.0, 2.0),
     }
 }
 

@@ -3,10 +3,11 @@
 //! Slave facets belong to the rank that owns their cell; that rank evaluates
 //! their links. The master facets a rank holds are `held_master`'s.
 use super::autodiff;
+use crate::contact::facet_shape;
 use crate::distribution::{LocalFacetSet, LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
-use crate::fem::{shape::facet_shape, FacetType, QuadRule};
+use crate::fem::{FacetType, QuadRule};
 
 /// A slave facet this rank evaluates.
 #[derive(Debug, Clone)]
@@ -46,6 +47,23 @@ pub struct SlaveSurface {
     pub h: f64,
 }
 
+/// The one first-order facet type of a contact facet set. The scene refuses
+/// other sets before set-up (`scene/contact.rs`); this keeps a model built
+/// in code from reaching the first-order kernels with them.
+pub fn contact_facet_type(mesh: &LocalMesh, set: &str) -> Result<FacetType> {
+    match mesh.set_facet_type(set) {
+        Some(t) if t.is_linear() => Ok(t),
+        Some(t) => Err(Error::scene(
+            "contact",
+            format!("facet set '{set}': second-order facets ({}) are not supported by contact yet", t.name()),
+        )),
+        None => Err(Error::scene(
+            "contact",
+            format!("facet set '{set}' mixes facet types or does not exist; contact needs one type (tri3 or quad4) per surface"),
+        )),
+    }
+}
+
 impl SlaveSurface {
     /// This rank's facets of `set` (those of its cells); `piece` carries
     /// the set-wide mean edge. A degenerate facet fails on the rank that
@@ -58,7 +76,7 @@ impl SlaveSurface {
         rule: &QuadRule,
     ) -> Result<Self> {
         let local_set = facet_set(mesh, set)?;
-        let facet_type = mesh.cell_type.facet_type();
+        let facet_type = contact_facet_type(mesh, set)?;
         let mut facets = Vec::new();
         let (mut qp_zeta, mut qp_weight) = (Vec::new(), Vec::new());
         for f in &local_set.facets {

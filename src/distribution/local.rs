@@ -3,7 +3,7 @@
 //! nodes and cells it writes, and the few surface-sized sets every rank needs
 //! whole. Cut on the rank that holds the mesh ([`super::Numbering::piece`]);
 //! nothing here is of the global node or cell count.
-use crate::fem::CellType;
+use crate::fem::{CellType, FacetType, MAX_FACET_NODES};
 use crate::mesh::{BoundingBox, FacetRef, Mesh};
 use std::collections::BTreeMap;
 
@@ -16,8 +16,9 @@ pub struct LocalFacet {
     pub cell: usize,
     /// Local face of that cell.
     pub face: u8,
-    /// Local node indices in outward order (`facet_type.nodes()` used).
-    pub nodes: [u32; 4],
+    /// Local node indices in outward order (the face type's node count
+    /// used).
+    pub nodes: [u32; MAX_FACET_NODES],
 }
 
 /// This rank's facets of one facet set.
@@ -58,8 +59,18 @@ pub struct SharedSet {
     pub cells: Vec<usize>,
     /// Local face of each facet's cell.
     pub faces: Vec<u8>,
-    /// Natural node ids, `facet_type.nodes()` per facet, outward order.
+    /// Natural node ids, each facet's own node count (its face type's) in
+    /// turn, outward order.
     pub nodes: Vec<usize>,
+}
+
+impl SharedSet {
+    /// The facet type of every facet of the set, in set order.
+    pub fn facet_types(&self, cell_type: CellType) -> impl Iterator<Item = FacetType> + '_ {
+        self.faces
+            .iter()
+            .map(move |&face| cell_type.face_type(usize::from(face)))
+    }
 }
 
 /// The natural-order block of nodes and cells a rank writes to the result
@@ -118,9 +129,23 @@ impl LocalMesh {
         self.facet_sets.keys().map(String::as_str).collect()
     }
 
+    /// The facet type of a local facet.
+    pub fn facet_type(&self, f: &LocalFacet) -> FacetType {
+        self.cell_type.face_type(usize::from(f.face))
+    }
+
+    /// The one facet type of every facet of set `name`; `None` for a set
+    /// that mixes types (a wedge's triangles and quadrilaterals) or that the
+    /// mesh lacks. An empty set has the type of the cells' first face.
+    pub fn set_facet_type(&self, name: &str) -> Option<FacetType> {
+        let mut types = self.shared.get(name)?.facet_types(self.cell_type);
+        let first = types.next().unwrap_or(self.cell_type.face_type(0));
+        types.all(|t| t == first).then_some(first)
+    }
+
     /// Reference coordinates of a local facet's nodes.
     pub fn facet_x_ref(&self, f: &LocalFacet) -> Vec<[f64; 3]> {
-        let n = self.cell_type.facet_type().nodes();
+        let n = self.facet_type(f).nodes();
         f.nodes[..n]
             .iter()
             .map(|&l| self.nodes[l as usize])
@@ -141,7 +166,7 @@ pub(super) fn local_facets(
         if !is_local(f.cell) {
             continue;
         }
-        let mut nodes = [0u32; 4];
+        let mut nodes = [0u32; MAX_FACET_NODES];
         // A facet whose cell is out of range was rejected by mesh validation;
         // it cannot be local, so this walk only sees valid ones.
         if let Ok(it) = mesh.facet_nodes_iter(f) {

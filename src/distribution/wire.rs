@@ -5,7 +5,7 @@ use super::local::{
 };
 use super::Piece;
 use crate::error::{Error, Result};
-use crate::fem::CellType;
+use crate::fem::{CellType, MAX_FACET_NODES};
 use crate::mesh::BoundingBox;
 
 pub(super) fn encode(p: &Piece) -> Vec<u64> {
@@ -31,10 +31,9 @@ pub(super) fn encode(p: &Piece) -> Vec<u64> {
 }
 
 fn put_mesh(w: &mut Vec<u64>, m: &LocalMesh) {
-    w.push(match m.cell_type {
-        CellType::Hex8 => 0,
-        CellType::Tet4 => 1,
-    });
+    // The position in `CellType::ALL` (hex8 0, tet4 1, ...).
+    let code = CellType::ALL.iter().position(|&c| c == m.cell_type);
+    w.push(code.unwrap_or(0) as u64);
     w.push(m.bodies.len() as u64);
     for b in &m.bodies {
         put_str(w, b);
@@ -136,10 +135,8 @@ pub(super) fn decode(words: &[u64]) -> Result<Piece> {
 }
 
 fn read_mesh(r: &mut Reader) -> Result<LocalMesh> {
-    let cell_type = match r.scalar()? {
-        0 => CellType::Hex8,
-        1 => CellType::Tet4,
-        _ => return Err(Error::Internal("mesh piece of an unknown cell type".into())),
+    let Some(&cell_type) = CellType::ALL.get(r.scalar()?) else {
+        return Err(Error::Internal("mesh piece of an unknown cell type".into()));
     };
     let n_bodies = r.scalar()?;
     let bodies = (0..n_bodies).map(|_| r.string()).collect::<Result<_>>()?;
@@ -166,12 +163,12 @@ fn read_mesh(r: &mut Reader) -> Result<LocalMesh> {
         let n = r.scalar()?;
         let mut facets = Vec::new();
         for _ in 0..n {
-            let v = r.fixed(7)?;
+            let v = r.fixed(3 + MAX_FACET_NODES)?;
             facets.push(LocalFacet {
                 set_index: v[0] as usize,
                 cell: v[1] as usize,
                 face: v[2] as u8,
-                nodes: [v[3] as u32, v[4] as u32, v[5] as u32, v[6] as u32],
+                nodes: std::array::from_fn(|k| v[3 + k] as u32),
             });
         }
         facet_sets.insert(name, LocalFacetSet { global_len, facets });

@@ -11,9 +11,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::material::Tangent;
 use super::shape::{self, HEX8_REF_NODES};
-use super::{
-    check_finite_points, check_len, CellType, FemError, Material, QuadRule, MAX_CELL_NODES,
-};
+use super::{check_finite_points, check_len, CellType, FemError, Material, QuadRule};
 
 /// Per-cell data precomputed from the reference coordinates.
 ///
@@ -44,18 +42,23 @@ impl ElementGeometry {
             n: Vec::with_capacity(rule.len() * nodes),
         };
         for (qp, (xi, weight)) in rule.points.iter().zip(&rule.weights).enumerate() {
-            let s = shape::cell_shape(cell_type, *xi);
-            let jac = reference_jacobian(x_ref, &s.dn[..nodes]);
+            // The reference gradients go where the physical ones will be and
+            // are mapped in place.
+            let base = geom.n.len();
+            geom.n.resize(base + nodes, 0.0);
+            geom.grad_n.resize(base + nodes, [0.0; 3]);
+            let grad = &mut geom.grad_n[base..];
+            shape::eval_cell(cell_type, *xi, &mut geom.n[base..], grad);
+            let jac = reference_jacobian(x_ref, grad);
             let det_j = jac.determinant();
             let inverted = FemError::InvertedElement { qp, det_j };
             if det_j.is_nan() || det_j <= 0.0 {
                 return Err(inverted);
             }
             let j_inv_t = jac.try_inverse().ok_or(inverted)?.transpose();
-            for (dn, n) in s.dn[..nodes].iter().zip(&s.n[..nodes]) {
+            for dn in grad.iter_mut() {
                 let g = j_inv_t * Vector3::from(*dn);
-                geom.grad_n.push([g.x, g.y, g.z]);
-                geom.n.push(*n);
+                *dn = [g.x, g.y, g.z];
             }
             geom.jxw.push(det_j * weight);
         }
@@ -115,9 +118,10 @@ fn check_hex_corners(cell_type: CellType, x_ref: &[[f64; 3]]) -> Result<(), FemE
         // A linear tet has one constant Jacobian, already checked.
         return Ok(());
     }
+    let (mut n, mut dn) = ([0.0; 8], [[0.0; 3]; 8]);
     for (corner, xi) in HEX8_REF_NODES.iter().enumerate() {
-        let s = shape::hex8(*xi);
-        let det_j = reference_jacobian(x_ref, &s.dn[..8]).determinant();
+        shape::eval_cell(CellType::Hex8, *xi, &mut n, &mut dn);
+        let det_j = reference_jacobian(x_ref, &dn).determinant();
         if det_j.is_nan() || det_j <= 0.0 {
             return Err(FemError::InvertedCorner { corner, det_j });
         }
@@ -159,17 +163,18 @@ fn add_stress_divergence(p: &Matrix3<f64>, grad: &[[f64; 3]], jxw: f64, r: &mut 
 }
 
 /// `k_{ai,bk} += jxw · ∂N_a/∂X_J A_{iJkL} ∂N_b/∂X_L`, contracted in two
-/// passes (first over J per node a, then over L per node pair) so the cost
-/// is O(n·81 + n²·27) instead of O(n²·81). With `upper_only` the blocks
-/// b < a are skipped and must be mirrored afterwards.
+/// passes per node a (first over J, then over L per node pair) so the cost
+/// is O(n·81 + n²·27) instead of O(n²·81), with one node's 27 contractions
+/// on the stack whatever the cell. With `upper_only` the blocks b < a are
+/// skipped and must be mirrored afterwards.
 fn add_material_tangent(a: &Tangent, grad: &[[f64; 3]], jxw: f64, k: &mut [f64], upper_only: bool) {
     let nodes = grad.len();
     let ndof = 3 * nodes;
-    // c[a][i][L][k] = jxw · Σ_J ∂N_a/∂X_J A_{iJkL}; stored with L outside k
-    // so the second pass reads three contiguous 3-vectors.
-    let mut c = [[[[0.0f64; 3]; 3]; 3]; MAX_CELL_NODES];
     let a = a.as_slice(); // column-major: A_{(r, col)} = a[col * 9 + r]
-    for (ca, ga) in c.iter_mut().zip(grad) {
+    for (node_a, ga) in grad.iter().enumerate() {
+        // ca[i][L][k] = jxw · Σ_J ∂N_a/∂X_J A_{iJkL}; stored with L outside
+        // k so the second pass reads three contiguous 3-vectors.
+        let mut ca = [[[0.0f64; 3]; 3]; 3];
         let g = [jxw * ga[0], jxw * ga[1], jxw * ga[2]];
         for (i, ca_i) in ca.iter_mut().enumerate() {
             for (kl, col) in a.chunks_exact(9).enumerate() {
@@ -177,8 +182,6 @@ fn add_material_tangent(a: &Tangent, grad: &[[f64; 3]], jxw: f64, k: &mut [f64],
                 ca_i[kl % 3][kl / 3] = g[0] * col[0] + g[1] * col[1] + g[2] * col[2];
             }
         }
-    }
-    for (node_a, ca) in c.iter().enumerate().take(nodes) {
         let first_b = if upper_only { node_a } else { 0 };
         for (node_b, gb) in grad.iter().enumerate().skip(first_b) {
             for (i, ca_i) in ca.iter().enumerate() {
@@ -393,17 +396,20 @@ fn add_weighted_load(n: &[f64], b: [f64; 3], jxw: f64, f: &mut [f64]) {
 /// Quadrature, chosen so the matrix is exact where it can be and never
 /// singular:
 ///
-/// - `Hex8` uses the geometry's own rule. 2×2×2 Gauss integrates `N_a N_b`
-///   exactly on a parallelepiped (constant `det J`); on a distorted hex the
-///   integrand also carries the non-constant `det J` and the result is
-///   approximate, but the total mass `Σ_ab M_ab = ρ V` stays exact because
-///   `Σ_a N_a = 1` reduces it to the volume integral. Rules with fewer than 8
-///   points are rejected: they give a rank-deficient matrix.
 /// - `Tet4` always uses the 4-point degree-2 rule, whatever rule built the
 ///   geometry: `N_a N_b` is quadratic and the default 1-point rule would
 ///   lump everything onto the centroid (rank 3). `det J` is constant on a
 ///   linear tet, so the volume from any rule carries over exactly and the
 ///   result is the closed form `ρ V (1 + δ_ab) / 20`.
+/// - Every other type uses the geometry's own rule, which must have at
+///   least as many points as the cell has nodes (fewer give a
+///   rank-deficient matrix: [`FemError::UnderintegratedMass`]). Build the
+///   geometry with [`QuadRule::mass_for_cell`] where that exists (tet10,
+///   wedge15, pyramid5), else with the default rule: both integrate
+///   `N_a N_b` exactly on an affine cell. On a distorted cell the integrand
+///   also carries the non-constant `det J` and the result is approximate,
+///   but the total mass `Σ_ab M_ab = ρ V` stays exact because `Σ_a N_a = 1`
+///   reduces it to the volume integral.
 pub fn mass_matrix(geom: &ElementGeometry, density: f64, m: &mut [f64]) -> Result<(), FemError> {
     geom.check()?;
     if !(density.is_finite() && density >= 0.0) {
@@ -413,7 +419,17 @@ pub fn mass_matrix(geom: &ElementGeometry, density: f64, m: &mut [f64]) -> Resul
     check_len("m", 9 * nodes * nodes, m.len())?;
     m.fill(0.0);
     match geom.cell_type {
-        CellType::Hex8 => {
+        CellType::Tet4 => {
+            let rule = QuadRule::tet_4();
+            let reference_volume: f64 = rule.weights.iter().sum();
+            let det_j = element_volume(geom) / reference_volume;
+            let (mut n, mut dn) = ([0.0; 4], [[0.0; 3]; 4]);
+            for (xi, w) in rule.points.iter().zip(&rule.weights) {
+                shape::eval_cell(CellType::Tet4, *xi, &mut n, &mut dn);
+                add_mass_at(&n, density * det_j * w, m);
+            }
+        }
+        _ => {
             if geom.n_qp() < nodes {
                 return Err(FemError::UnderintegratedMass {
                     cell: geom.cell_type.name(),
@@ -423,15 +439,6 @@ pub fn mass_matrix(geom: &ElementGeometry, density: f64, m: &mut [f64]) -> Resul
             }
             for (qp, &jxw) in geom.jxw.iter().enumerate() {
                 add_mass_at(geom.qp_n(qp), density * jxw, m);
-            }
-        }
-        CellType::Tet4 => {
-            let rule = QuadRule::tet_4();
-            let reference_volume: f64 = rule.weights.iter().sum();
-            let det_j = element_volume(geom) / reference_volume;
-            for (xi, w) in rule.points.iter().zip(&rule.weights) {
-                let s = shape::tet4(*xi);
-                add_mass_at(&s.n[..nodes], density * det_j * w, m);
             }
         }
     }

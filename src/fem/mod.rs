@@ -12,12 +12,14 @@
 //! - The 9×9 material tangent maps the flattened deformation gradient
 //!   `(iJ) ↦ 3i + J` (row-major), see `material`.
 
+mod cells;
 pub mod element;
 pub mod material;
 pub mod quadrature;
 pub mod shape;
 pub mod surface;
 
+pub use cells::{CellType, FacetType, GMSH_HEX20, GMSH_HEX27, GMSH_TET10, GMSH_WEDGE15};
 pub use element::{
     body_force, body_force_fn, deformation_gradient, element_volume, internal_force,
     internal_force_and_tangent, interpolate, linear_stiffness, mass_matrix, qp_positions,
@@ -29,115 +31,14 @@ pub use surface::{dead_traction, facet_area, facet_normal_at_centre, follower_pr
 
 use thiserror::Error;
 
-/// Largest node count of any supported cell; sizes the stack buffers of the
-/// element kernels so the Newton hot path never allocates.
-pub const MAX_CELL_NODES: usize = 8;
+/// Largest node count of any supported cell (hex27). Kernels size their
+/// buffers by the cell at hand, never by this, so first-order cells pay for
+/// nothing.
+pub const MAX_CELL_NODES: usize = 27;
 
-/// Largest node count of any supported facet.
-pub const MAX_FACET_NODES: usize = 4;
-
-/// Volume cell shapes.
-///
-/// Node numbering follows VTK (which for these two shapes agrees with
-/// Abaqus' C3D8 / C3D4):
-///
-/// - `Hex8`: reference cube `[-1, 1]³`; nodes 0..3 are the bottom face
-///   `ζ = -1` counter-clockwise seen from `+ζ`, starting at `(-1,-1,-1)`;
-///   nodes 4..7 are the top face `ζ = +1` in the same order.
-/// - `Tet4`: reference simplex, nodes at `(0,0,0)`, `(1,0,0)`, `(0,1,0)`,
-///   `(0,0,1)`; a positively oriented cell has
-///   `((x1−x0) × (x2−x0)) · (x3−x0) > 0`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CellType {
-    Hex8,
-    Tet4,
-}
-
-/// Surface facet shapes (boundary faces of the cells).
-///
-/// - `Quad4`: reference square `[-1, 1]²`, nodes counter-clockwise from
-///   `(-1,-1)`.
-/// - `Tri3`: reference triangle, nodes at `(0,0)`, `(1,0)`, `(0,1)`.
-///
-/// The right-hand normal `∂x/∂ξ₁ × ∂x/∂ξ₂` is the orientation of a facet; it
-/// has the direction of `(x1−x0) × (x2−x0)` for `Tri3` and of
-/// `(x2−x0) × (x3−x1)` for `Quad4`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FacetType {
-    Quad4,
-    Tri3,
-}
-
-const HEX8_FACES: [&[usize]; 6] = [
-    &[0, 4, 7, 3], // ξ = -1
-    &[1, 2, 6, 5], // ξ = +1
-    &[0, 1, 5, 4], // η = -1
-    &[2, 3, 7, 6], // η = +1
-    &[0, 3, 2, 1], // ζ = -1
-    &[4, 5, 6, 7], // ζ = +1
-];
-
-const TET4_FACES: [&[usize]; 4] = [
-    &[0, 2, 1], // opposite node 3
-    &[0, 1, 3], // opposite node 2
-    &[0, 3, 2], // opposite node 1
-    &[1, 2, 3], // opposite node 0
-];
-
-impl CellType {
-    pub const fn nodes(self) -> usize {
-        match self {
-            CellType::Hex8 => 8,
-            CellType::Tet4 => 4,
-        }
-    }
-
-    pub const fn facet_type(self) -> FacetType {
-        match self {
-            CellType::Hex8 => FacetType::Quad4,
-            CellType::Tet4 => FacetType::Tri3,
-        }
-    }
-
-    pub const fn name(self) -> &'static str {
-        match self {
-            CellType::Hex8 => "hex8",
-            CellType::Tet4 => "tet4",
-        }
-    }
-
-    /// Face node lists in local numbering, each ordered so the facet's
-    /// right-hand normal (see [`FacetType`]) points out of the cell, which is
-    /// what `surface` needs for pressure and what contact needs for gaps.
-    ///
-    /// - `Hex8`, face index: 0 `ξ=-1`, 1 `ξ=+1`, 2 `η=-1`, 3 `η=+1`,
-    ///   4 `ζ=-1`, 5 `ζ=+1`.
-    /// - `Tet4`, face `f` is the face opposite node `3 − f`: 0 opposite
-    ///   node 3 (`ζ=0`), 1 opposite node 2 (`η=0`), 2 opposite node 1
-    ///   (`ξ=0`), 3 opposite node 0 (the slanted face).
-    pub const fn local_faces(self) -> &'static [&'static [usize]] {
-        match self {
-            CellType::Hex8 => &HEX8_FACES,
-            CellType::Tet4 => &TET4_FACES,
-        }
-    }
-}
-
-impl FacetType {
-    pub const fn nodes(self) -> usize {
-        match self {
-            FacetType::Quad4 => 4,
-            FacetType::Tri3 => 3,
-        }
-    }
-
-    pub const fn name(self) -> &'static str {
-        match self {
-            FacetType::Quad4 => "quad4",
-            FacetType::Tri3 => "tri3",
-        }
-    }
-}
+/// Largest node count of any supported facet (quad9). Contact, which handles
+/// first-order facets only, has its own `contact::MAX_FACET_NODES`.
+pub const MAX_FACET_NODES: usize = 9;
 
 /// Errors of the element and facet kernels.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -279,6 +180,42 @@ pub(crate) mod test_util {
         ]
     }
 
+    /// The reference cell of `cell` mapped onto a unit-sized physical cell
+    /// (hexahedra: the unit cube; wedges: ζ ↦ (ζ + 1)/2; the others as
+    /// they are), every node where the map puts it.
+    pub fn unit_cell(cell: super::CellType) -> Vec<[f64; 3]> {
+        use super::CellType;
+        super::shape::cell_reference_nodes(cell)
+            .into_iter()
+            .map(|p| match cell.linear() {
+                CellType::Hex8 => p.map(|v| 0.5 * (v + 1.0)),
+                CellType::Wedge6 => [p[0], p[1], 0.5 * (p[2] + 1.0)],
+                _ => p,
+            })
+            .collect()
+    }
+
+    /// A distorted cell: the unit cell's corners moved by up to `amp`, each
+    /// higher node at the mean of its moved corners plus its own move of
+    /// up to `amp / 2` (curved edges and faces).
+    pub fn distorted_cell(cell: super::CellType, seed: u64, amp: f64) -> Vec<[f64; 3]> {
+        let mut rng = Lcg::new(seed);
+        let mut x = unit_cell(cell);
+        let corners = cell.corners();
+        perturb(&mut x[..corners], &mut rng, amp);
+        for (k, of) in cell.higher_nodes().iter().enumerate() {
+            let mut m = [0.0; 3];
+            for &a in of.iter() {
+                for i in 0..3 {
+                    m[i] += x[a][i] / of.len() as f64;
+                }
+            }
+            let d = rng.vec3(0.5 * amp);
+            x[corners + k] = [m[0] + d[0], m[1] + d[1], m[2] + d[2]];
+        }
+        x
+    }
+
     pub fn perturb(x: &mut [[f64; 3]], rng: &mut Lcg, amp: f64) {
         for p in x.iter_mut() {
             let d = rng.vec3(amp);
@@ -290,93 +227,4 @@ pub(crate) mod test_util {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::test_util::{hex8_unit, perturb, tet4_unit, Lcg};
-    use super::*;
-    use crate::vec3::{cross, dot, sub};
-
-    fn corner_normal(x: &[[f64; 3]]) -> [f64; 3] {
-        match x.len() {
-            3 => cross(sub(x[1], x[0]), sub(x[2], x[0])),
-            _ => cross(sub(x[2], x[0]), sub(x[3], x[1])),
-        }
-    }
-
-    fn centroid(x: &[[f64; 3]]) -> [f64; 3] {
-        let mut c = [0.0; 3];
-        for p in x {
-            for i in 0..3 {
-                c[i] += p[i] / x.len() as f64;
-            }
-        }
-        c
-    }
-
-    /// On a convex cell the outward normal of every face points away from the
-    /// cell centroid; checked on distorted (still convex) cells so a face
-    /// listed in the wrong orientation cannot pass by symmetry.
-    fn assert_faces_outward(cell: CellType, x: &[[f64; 3]]) {
-        let c = centroid(x);
-        for (f, face) in cell.local_faces().iter().enumerate() {
-            assert_eq!(face.len(), cell.facet_type().nodes());
-            let xf: Vec<[f64; 3]> = face.iter().map(|&a| x[a]).collect();
-            let n = corner_normal(&xf);
-            let out = sub(centroid(&xf), c);
-            assert!(dot(n, out) > 0.0, "{} face {f} points inward", cell.name());
-        }
-    }
-
-    #[test]
-    fn faces_point_outward() {
-        let mut rng = Lcg::new(7);
-        let mut hex = hex8_unit();
-        perturb(&mut hex, &mut rng, 0.1);
-        assert_faces_outward(CellType::Hex8, &hex);
-        let mut tet = tet4_unit();
-        perturb(&mut tet, &mut rng, 0.1);
-        assert_faces_outward(CellType::Tet4, &tet);
-    }
-
-    #[test]
-    fn faces_cover_each_node_consistently() {
-        // Every hex node lies on exactly 3 faces, every tet node on 3 faces,
-        // and the tet face f must not contain node 3 - f.
-        for cell in [CellType::Hex8, CellType::Tet4] {
-            let mut count = vec![0; cell.nodes()];
-            for face in cell.local_faces() {
-                for &a in face.iter() {
-                    count[a] += 1;
-                }
-            }
-            assert!(count.iter().all(|&c| c == 3), "{}: {count:?}", cell.name());
-        }
-        for (f, face) in CellType::Tet4.local_faces().iter().enumerate() {
-            assert!(!face.contains(&(3 - f)));
-        }
-    }
-
-    #[test]
-    fn hex_face_order_matches_reference_coordinates() {
-        use super::shape::HEX8_REF_NODES;
-        // (axis, sign) of face f: 0 ξ-, 1 ξ+, 2 η-, 3 η+, 4 ζ-, 5 ζ+.
-        for (f, face) in CellType::Hex8.local_faces().iter().enumerate() {
-            let axis = f / 2;
-            let sign = if f % 2 == 0 { -1.0 } else { 1.0 };
-            for &a in face.iter() {
-                assert_eq!(HEX8_REF_NODES[a][axis], sign, "face {f} node {a}");
-            }
-        }
-    }
-
-    #[test]
-    fn names_and_counts() {
-        assert_eq!(CellType::Hex8.name(), "hex8");
-        assert_eq!(CellType::Tet4.name(), "tet4");
-        assert_eq!(FacetType::Quad4.name(), "quad4");
-        assert_eq!(FacetType::Tri3.name(), "tri3");
-        assert_eq!(CellType::Hex8.facet_type(), FacetType::Quad4);
-        assert_eq!(CellType::Tet4.facet_type(), FacetType::Tri3);
-        assert_eq!(CellType::Hex8.nodes(), 8);
-        assert_eq!(FacetType::Tri3.nodes(), 3);
-    }
-}
+mod tests;

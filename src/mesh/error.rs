@@ -49,11 +49,29 @@ pub enum MeshError {
     #[error("body name `{name}` is used twice")]
     DuplicateBody { name: String },
 
-    /// A cell has a non-positive Jacobian determinant (hex: smallest of the
-    /// eight corner values of the trilinear map from [−1,1]³; tet: six times
-    /// the signed volume, the determinant of the map from the unit tet).
+    /// A cell has a non-positive Jacobian determinant (hex8: smallest of the
+    /// eight corner values of the trilinear map from [−1,1]³; tet4: six times
+    /// the signed volume, the determinant of the map from the unit tet; the
+    /// other types: smallest over the quadrature points of their default
+    /// rule).
     #[error("cell {cell} is inverted or degenerate: Jacobian determinant {det:e}")]
     InvertedCell { cell: usize, det: f64 },
+
+    /// A second-order cell's mid-edge (or face or centre) node lies far
+    /// from where its corners put it: more than a quarter of the corners'
+    /// span from their mean. Curved boundaries move a mid-edge node by far
+    /// less; a node this far off is a mix-up of node order.
+    #[error(
+        "cell {cell}: its node {node} (local node {local}) lies {offset:e} from the midpoint of the corners it sits between ({corners:?}), more than a quarter of their span {span:e}; check the node order of the cell"
+    )]
+    MidNodeOffEdge {
+        cell: usize,
+        node: usize,
+        local: usize,
+        corners: Vec<usize>,
+        offset: f64,
+        span: f64,
+    },
 
     /// No node or facet set with this name.
     #[error("no set named `{name}`")]

@@ -3,7 +3,8 @@
 
 use super::{CellType, FacetRef, Mesh, MeshError};
 // The reference hex's corners are its nodes (VTK order): ξ_i = ±1.
-use crate::fem::shape::HEX8_REF_NODES;
+use crate::fem::shape::{self, HEX8_REF_NODES};
+use crate::fem::QuadRule;
 
 // The 3-vector helpers live in `crate::vec3`; re-exported for the mesh
 // generators, which import them from here.
@@ -114,6 +115,77 @@ pub(crate) fn hex_volume(p: &[Vec3; 8]) -> f64 {
         .sum()
 }
 
+/// For each wedge corner, three neighbours whose edges form a right-handed
+/// frame in a valid wedge (two along its triangle, one along the prism).
+const WEDGE_CORNER_NEIGHBOURS: [[usize; 3]; 6] = [
+    [1, 2, 3],
+    [2, 0, 4],
+    [0, 1, 5],
+    [5, 4, 0],
+    [3, 5, 1],
+    [4, 3, 2],
+];
+
+/// For each pyramid base corner, its two base neighbours and the apex, a
+/// right-handed frame in a valid pyramid.
+const PYRAMID_CORNER_NEIGHBOURS: [[usize; 3]; 4] = [[1, 3, 4], [2, 0, 4], [3, 1, 4], [0, 2, 4]];
+
+/// Smallest corner triple product over the product of its edge lengths:
+/// 1 at a right-angled corner, ≤ 0 at an inverted one.
+fn corner_scaled_jacobian(p: &[Vec3], frames: &[[usize; 3]]) -> f64 {
+    frames
+        .iter()
+        .enumerate()
+        .map(|(k, [a, b, c])| {
+            let e = [sub(p[*a], p[k]), sub(p[*b], p[k]), sub(p[*c], p[k])];
+            let lengths = norm(e[0]) * norm(e[1]) * norm(e[2]);
+            if lengths > 0.0 {
+                triple(e[0], e[1], e[2]) / lengths
+            } else {
+                0.0
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// `det ∂X/∂ξ` of a cell of any type at reference point `xi`.
+fn jacobian_at(cell: CellType, p: &[Vec3], xi: Vec3) -> f64 {
+    let s = shape::cell_shape(cell, xi);
+    let mut columns = [[0.0; 3]; 3];
+    for (x, d) in p.iter().zip(&s.dn[..s.nodes]) {
+        for (column, dj) in columns.iter_mut().zip(d) {
+            *column = add(*column, scale(*x, *dj));
+        }
+    }
+    triple(columns[0], columns[1], columns[2])
+}
+
+/// The Jacobian determinants a cell is judged by: the corners of a hex8,
+/// the one of a tet4, and for the other types the quadrature points of
+/// the rule the solver integrates them with.
+pub(crate) fn cell_jacobians(cell: CellType, p: &[Vec3]) -> Vec<f64> {
+    match cell {
+        CellType::Hex8 => hex_corner_jacobians(&std::array::from_fn(|k| p[k])).to_vec(),
+        CellType::Tet4 => vec![tet_jacobian(&std::array::from_fn(|k| p[k]))],
+        _ => QuadRule::default_for_cell(cell)
+            .points
+            .iter()
+            .map(|xi| jacobian_at(cell, p, *xi))
+            .collect(),
+    }
+}
+
+/// Volume of a cell of any type: `Σ det J w` with a rule exact for det J
+/// of its type (the mass rule where the default is weaker).
+fn cell_volume_of(cell: CellType, p: &[Vec3]) -> f64 {
+    let rule = QuadRule::mass_for_cell(cell).unwrap_or_else(|| QuadRule::default_for_cell(cell));
+    rule.points
+        .iter()
+        .zip(&rule.weights)
+        .map(|(xi, w)| w * jacobian_at(cell, p, *xi))
+        .sum()
+}
+
 /// Vector area of a facet polygon (magnitude = area for a planar facet,
 /// direction = right-hand normal). For a quad the diagonal formula is exact
 /// for any four points, since a vector area depends only on the boundary.
@@ -125,19 +197,23 @@ pub(crate) fn polygon_vector_area(points: &[Vec3]) -> Vec3 {
     }
 }
 
-/// Corner coordinates of one cell, copied out so geometric kernels can work
-/// on fixed-size arrays.
-#[derive(Debug, Clone, Copy)]
+/// Node coordinates of one cell, copied out so the first-order geometric
+/// kernels can work on fixed-size arrays.
+#[derive(Debug, Clone)]
 pub(crate) enum CellPoints {
     Hex([Vec3; 8]),
     Tet([Vec3; 4]),
+    /// Every node of a cell of another type.
+    Other(CellType, Vec<Vec3>),
 }
 
 impl CellPoints {
+    /// The corners.
     pub(crate) fn as_slice(&self) -> &[Vec3] {
         match self {
             CellPoints::Hex(p) => p,
             CellPoints::Tet(p) => p,
+            CellPoints::Other(cell, p) => &p[..cell.corners()],
         }
     }
 }
@@ -208,14 +284,26 @@ impl Mesh {
                 }
                 CellPoints::Tet(p)
             }
+            other => {
+                let p = (0..other.nodes()).map(point).collect::<Result<_, _>>()?;
+                CellPoints::Other(other, p)
+            }
         })
     }
 
-    /// Volume of cell `c` (exact for trilinear hexes and tets).
+    /// Node coordinates of cell `c`, all of them.
+    pub(crate) fn cell_node_points(&self, c: usize) -> Result<Vec<Vec3>, MeshError> {
+        let ids = self.try_cell(c)?;
+        ids.iter().map(|&n| self.node_of_cell(c, n)).collect()
+    }
+
+    /// Volume of cell `c` (exact for every type: the rule integrates its
+    /// `det J` exactly).
     pub fn cell_volume(&self, c: usize) -> Result<f64, MeshError> {
         Ok(match self.cell_points(c)? {
             CellPoints::Hex(p) => hex_volume(&p),
             CellPoints::Tet(p) => tet_jacobian(&p) / 6.0,
+            CellPoints::Other(cell, p) => cell_volume_of(cell, &p),
         })
     }
 
@@ -227,15 +315,27 @@ impl Mesh {
                 .into_iter()
                 .fold(f64::INFINITY, f64::min),
             CellPoints::Tet(p) => tet_jacobian(&p),
+            CellPoints::Other(cell, p) => cell_jacobians(cell, &p)
+                .into_iter()
+                .fold(f64::INFINITY, f64::min),
         })
     }
 
     /// Scaled Jacobian of cell `c`: 1 for a box or regular tet, ≤ 0 when
-    /// inverted; a standard shape-quality measure (≳ 0.3 is usable).
+    /// inverted; a standard shape-quality measure (≳ 0.3 is usable). Cells
+    /// of second order are judged by their corners (their first-order kin);
+    /// wedges and pyramids by the right-handed frames at their corners
+    /// (1 at a right-angled corner).
     pub fn scaled_jacobian(&self, c: usize) -> Result<f64, MeshError> {
         Ok(match self.cell_points(c)? {
             CellPoints::Hex(p) => hex_scaled_jacobian(&p),
             CellPoints::Tet(p) => tet_scaled_jacobian(&p),
+            CellPoints::Other(cell, p) => match cell.linear() {
+                CellType::Hex8 => hex_scaled_jacobian(&std::array::from_fn(|k| p[k])),
+                CellType::Tet4 => tet_scaled_jacobian(&std::array::from_fn(|k| p[k])),
+                CellType::Wedge6 => corner_scaled_jacobian(&p, &WEDGE_CORNER_NEIGHBOURS),
+                _ => corner_scaled_jacobian(&p, &PYRAMID_CORNER_NEIGHBOURS),
+            },
         })
     }
 
@@ -257,7 +357,9 @@ impl Mesh {
 
     /// Corner coordinates of a facet, in outward order.
     fn facet_points(&self, f: &FacetRef) -> Result<Vec<Vec3>, MeshError> {
+        let corners = self.facet_type(f).corners();
         self.facet_nodes_iter(f)?
+            .take(corners)
             .map(|n| self.node_of_cell(f.cell, n))
             .collect()
     }
@@ -268,9 +370,21 @@ impl Mesh {
     }
 
     /// Outward vector area of a facet: direction = outward normal, length =
-    /// area (exact for planar facets).
+    /// area (exact for planar facets, and for curved second-order ones the
+    /// exact `∫ n dA` of their surface).
     pub fn facet_vector_area(&self, f: &FacetRef) -> Result<Vec3, MeshError> {
-        Ok(polygon_vector_area(&self.facet_points(f)?))
+        let facet = self.facet_type(f);
+        if facet.is_linear() {
+            return Ok(polygon_vector_area(&self.facet_points(f)?));
+        }
+        let x: Vec<Vec3> = self
+            .facet_nodes_iter(f)?
+            .map(|n| self.node_of_cell(f.cell, n))
+            .collect::<Result<_, _>>()?;
+        crate::fem::surface::facet_vector_area(facet, &x).map_err(|_| MeshError::InvalidFacet {
+            cell: f.cell,
+            face: f.face,
+        })
     }
 
     /// Outward unit normal of a facet (zero vector for a degenerate facet).

@@ -2,7 +2,8 @@
 //! standard benchmark geometries (graded box, Hertz cylinder and sphere,
 //! stacked blocks for the contact patch test).
 //!
-//! A [`Mesh`] holds one cell type, reference coordinates, flat connectivity,
+//! A [`Mesh`] holds one cell type (any of [`CellType`]), reference
+//! coordinates, flat connectivity,
 //! a body index per cell and named node and facet sets. Facets are stored as
 //! (cell, local face) pairs so their orientation is always the outward one of
 //! the owning cell, which is what the contact search needs for normals.
@@ -16,7 +17,9 @@ mod geometry;
 mod gmsh;
 mod inp;
 mod ops;
+mod order;
 mod orient;
+mod split;
 mod tets;
 mod topology;
 mod validate;
@@ -129,6 +132,25 @@ impl Mesh {
             .get(usize::from(f.face))
             .ok_or(invalid)?;
         Ok((cell, local))
+    }
+
+    /// The facet type of a facet: its cell's local face's.
+    pub fn facet_type(&self, f: &FacetRef) -> FacetType {
+        self.cell_type.face_type(usize::from(f.face))
+    }
+
+    /// The distinct facet types of a facet set, in the order first met (one
+    /// type unless the set holds a wedge's or pyramid's triangles and
+    /// quadrilaterals together).
+    pub fn facet_set_types(&self, name: &str) -> Result<Vec<FacetType>, MeshError> {
+        let mut types = Vec::new();
+        for f in self.facet_set(name)? {
+            let t = self.facet_type(f);
+            if !types.contains(&t) {
+                types.push(t);
+            }
+        }
+        Ok(types)
     }
 
     /// Global node ids of a facet, in outward order, without allocating.

@@ -2,8 +2,8 @@
 //! reversed to positive orientation, tangled ones refused. The Gmsh and the
 //! Abaqus readers both call this after building the connectivity.
 
-use super::geometry::{hex_corner_jacobians, tet_jacobian};
-use super::{CellType, Mesh};
+use super::geometry::cell_jacobians;
+use super::Mesh;
 
 /// A cell whose Jacobian determinants have mixed signs or a zero: neither
 /// orientation makes it valid.
@@ -15,22 +15,12 @@ pub(crate) struct Tangled {
     pub(crate) max: f64,
 }
 
-/// Renumbering that reverses a cell: tet swaps nodes 1 and 2; hex swaps the
-/// bottom and top quads (a reflection ζ → −ζ of the reference cube).
-fn reversal(cell_type: CellType) -> &'static [usize] {
-    match cell_type {
-        CellType::Tet4 => &[0, 2, 1, 3],
-        CellType::Hex8 => &[4, 5, 6, 7, 0, 1, 2, 3],
-    }
-}
-
-/// Jacobian determinants of a cell: the tet's one, the hex's eight corners.
-fn cell_jacobians(mesh: &Mesh, ids: &[usize]) -> Vec<f64> {
-    let p = |k: usize| mesh.nodes[ids[k]];
-    match mesh.cell_type {
-        CellType::Tet4 => vec![tet_jacobian(&std::array::from_fn(p))],
-        CellType::Hex8 => hex_corner_jacobians(&std::array::from_fn(p)).to_vec(),
-    }
+/// Jacobian determinants a cell is judged by ([`cell_jacobians`]: the
+/// tet4's one, the hex8's corners, the quadrature points of the other
+/// types).
+fn jacobians(mesh: &Mesh, ids: &[usize]) -> Vec<f64> {
+    let points: Vec<[f64; 3]> = ids.iter().map(|&n| mesh.nodes[n]).collect();
+    cell_jacobians(mesh.cell_type, &points)
 }
 
 /// Reverses the fully inverted cells (negative Jacobian everywhere) and
@@ -38,11 +28,12 @@ fn cell_jacobians(mesh: &Mesh, ids: &[usize]) -> Vec<f64> {
 /// range (the readers build the connectivity from their own node tables).
 pub(crate) fn orient_cells(mesh: &mut Mesh) -> Result<usize, Tangled> {
     let per = mesh.cell_type.nodes();
-    let perm = reversal(mesh.cell_type);
+    // A reflection of the reference cell (`CellType::mirror`).
+    let perm = mesh.cell_type.mirror();
     let mut reversed = 0;
     for c in 0..mesh.num_cells() {
         let ids: Vec<usize> = mesh.cell(c).to_vec();
-        let dets = cell_jacobians(mesh, &ids);
+        let dets = jacobians(mesh, &ids);
         let min = dets.iter().copied().fold(f64::INFINITY, f64::min);
         let max = dets.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         if min > 0.0 {

@@ -15,7 +15,7 @@
 //! diagonals are exactly the edges of tet (0, 2, 5, 7), which forces the
 //! classic 5-tet split (4 corners + 1 central tet).
 
-use super::{CellType, FacetRef, Mesh, MeshError};
+use super::{CellType, Mesh, MeshError};
 use crate::fem::shape::HEX8_REF_NODES;
 
 /// A rotation of the reference hex as `old = map[new]`.
@@ -145,18 +145,9 @@ impl Mesh {
     /// Bodies and node sets are kept; each facet of a facet set becomes the
     /// two outward tet faces covering it.
     pub fn hex_to_tets(&self) -> Result<Mesh, MeshError> {
-        if self.cell_type != CellType::Hex8 {
-            return Err(MeshError::CellTypeMismatch {
-                operation: "hex_to_tets",
-                expected: CellType::Hex8.name(),
-                found: self.cell_type.name(),
-            });
-        }
+        self.require(CellType::Hex8, "hex_to_tets")?;
         let rotations = hex_rotations();
-        let mut out = Mesh::empty(CellType::Tet4);
-        out.nodes = self.nodes.clone();
-        out.bodies = self.bodies.clone();
-        out.node_sets = self.node_sets.clone();
+        let mut out = self.children(CellType::Tet4);
         // first_child[c]..first_child[c + 1] are the tets of hex c.
         let mut first_child = Vec::with_capacity(self.num_cells() + 1);
         for (c, ids) in self.cells_iter().enumerate() {
@@ -168,40 +159,8 @@ impl Mesh {
             }
         }
         first_child.push(out.num_cells());
-        for (name, facets) in &self.facet_sets {
-            let mapped = self.map_facets_to_tets(name, facets, &out, &first_child)?;
-            out.facet_sets.insert(name.clone(), mapped);
-        }
+        out.facet_sets = self.children_facet_sets(&out, &first_child)?;
         Ok(out)
-    }
-
-    /// The tet faces of the children of each hex facet that lie on it.
-    fn map_facets_to_tets(
-        &self,
-        name: &str,
-        facets: &[FacetRef],
-        tets: &Mesh,
-        first_child: &[usize],
-    ) -> Result<Vec<FacetRef>, MeshError> {
-        let tet_faces = CellType::Tet4.local_faces();
-        let mut mapped = Vec::with_capacity(2 * facets.len());
-        for f in facets {
-            let quad = self
-                .facet_nodes(f)
-                .map_err(|e| super::name_facet_error(e, name))?;
-            for t in first_child[f.cell]..first_child[f.cell + 1] {
-                let tet = tets.cell(t);
-                for (face, local) in tet_faces.iter().enumerate() {
-                    if local.iter().all(|&l| quad.contains(&tet[l])) {
-                        mapped.push(FacetRef {
-                            cell: t,
-                            face: face as u8,
-                        });
-                    }
-                }
-            }
-        }
-        Ok(mapped)
     }
 }
 

@@ -4,8 +4,11 @@ use std::collections::HashMap;
 
 use super::{FacetRef, Mesh, MeshError};
 
-/// Orientation-free identity of a face: its node ids sorted, padded with
-/// `usize::MAX` for triangles. Two cells share a face iff their keys agree.
+/// Orientation-free identity of a face: its corner ids sorted, padded with
+/// `usize::MAX` for triangles. Two cells share a face iff their keys agree
+/// (the corners fix a face; a second-order face's other nodes follow).
+/// Callers pass the corners only ([`FacetType::corners`]); extra ids are
+/// ignored beyond the fourth.
 pub(crate) type FaceKey = [usize; 4];
 
 pub(crate) fn face_key(nodes: impl Iterator<Item = usize>) -> FaceKey {
@@ -24,10 +27,13 @@ impl Mesh {
     /// Every local face of every cell, grouped by face key.
     pub(crate) fn faces_by_key(&self) -> HashMap<FaceKey, Vec<FacetRef>> {
         let faces = self.cell_type.local_faces();
+        let corners: Vec<usize> = (0..faces.len())
+            .map(|f| self.cell_type.face_type(f).corners())
+            .collect();
         let mut map: HashMap<FaceKey, Vec<FacetRef>> = HashMap::new();
         for (cell, ids) in self.cells_iter().enumerate() {
             for (face, local) in faces.iter().enumerate() {
-                let key = face_key(local.iter().map(|&l| ids[l]));
+                let key = face_key(local[..corners[face]].iter().map(|&l| ids[l]));
                 // Face counts are 4 or 6, so the cast cannot truncate.
                 map.entry(key).or_default().push(FacetRef {
                     cell,
@@ -62,10 +68,11 @@ impl Mesh {
     /// Cell dual graph for graph partitioning: cells `a` and `b` are
     /// neighbours when they share at least `min_shared_nodes` nodes.
     ///
-    /// With `min_shared_nodes` equal to the facet node count (4 for hex, 3
-    /// for tet) this is face adjacency, built from a hash map of face keys in
-    /// O(cells). Other values use node→cell incidence, still without
-    /// comparing all pairs. Neighbour lists are sorted.
+    /// With `min_shared_nodes` equal to the facet node count of a cell type
+    /// with one facet type (4 for hex8, 3 for tet4, 6 for tet10, ...) this
+    /// is face adjacency, built from a hash map of face keys in O(cells).
+    /// Other values use node→cell incidence, still without comparing all
+    /// pairs. Neighbour lists are sorted.
     pub fn dual_graph(&self, min_shared_nodes: usize) -> Result<Csr, MeshError> {
         let per_cell = self.cell_type.nodes();
         if min_shared_nodes == 0 || min_shared_nodes > per_cell {
@@ -78,7 +85,8 @@ impl Mesh {
                 ),
             });
         }
-        let neighbours = if min_shared_nodes == self.cell_type.facet_type().nodes() {
+        let face_nodes = self.cell_type.single_facet_type().map(|f| f.nodes());
+        let neighbours = if Some(min_shared_nodes) == face_nodes {
             self.face_neighbours()
         } else {
             self.node_sharing_neighbours(min_shared_nodes)?

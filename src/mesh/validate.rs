@@ -4,6 +4,7 @@ use std::collections::HashSet;
 
 use super::topology::face_key;
 use super::{FacetRef, Mesh, MeshError};
+use crate::vec3::{add, norm, scale, sub};
 
 impl Mesh {
     /// Checks everything the solver relies on and reports the first problem:
@@ -11,7 +12,9 @@ impl Mesh {
     /// * the connectivity is a whole number of cells and every cell has a body,
     /// * node ids are in range and coordinates are finite,
     /// * every cell has a positive Jacobian (hex: at all 8 corners, which for
-    ///   a trilinear hex is the standard practical criterion; tet: volume),
+    ///   a trilinear hex is the standard practical criterion; tet: volume;
+    ///   the other types: at every quadrature point the solver uses), and
+    ///   every second-order node lies near where its corners put it,
     /// * node sets are sorted, unique and in range,
     /// * facet sets refer to existing faces and are consistently oriented.
     pub fn validate(&self) -> Result<(), MeshError> {
@@ -62,10 +65,46 @@ impl Mesh {
             }
         }
         for cell in 0..self.num_cells() {
+            self.check_higher_nodes(cell)?;
             let det = self.min_jacobian(cell)?;
             // NaN (from degenerate input) is rejected along with det ≤ 0.
             if det.is_nan() || det <= 0.0 {
                 return Err(MeshError::InvertedCell { cell, det });
+            }
+        }
+        Ok(())
+    }
+
+    /// Each higher node within a quarter of its corners' span of their
+    /// mean ([`MeshError::MidNodeOffEdge`]).
+    fn check_higher_nodes(&self, cell: usize) -> Result<(), MeshError> {
+        let higher = self.cell_type.higher_nodes();
+        if higher.is_empty() {
+            return Ok(());
+        }
+        let x = self.cell_node_points(cell)?;
+        let ids = self.cell(cell);
+        let corners = self.cell_type.corners();
+        for (k, of) in higher.iter().enumerate() {
+            let local = corners + k;
+            let mean = of
+                .iter()
+                .fold([0.0; 3], |m, &a| add(m, scale(x[a], 1.0 / of.len() as f64)));
+            let span = of
+                .iter()
+                .flat_map(|&a| of.iter().map(move |&b| (a, b)))
+                .map(|(a, b)| norm(sub(x[a], x[b])))
+                .fold(0.0, f64::max);
+            let offset = norm(sub(x[local], mean));
+            if offset.is_nan() || offset > 0.25 * span {
+                return Err(MeshError::MidNodeOffEdge {
+                    cell,
+                    node: ids[local],
+                    local,
+                    corners: of.iter().map(|&a| ids[a]).collect(),
+                    offset,
+                    span,
+                });
             }
         }
         Ok(())
@@ -142,6 +181,9 @@ impl Mesh {
             let nodes = self
                 .facet_nodes(f)
                 .map_err(|e| super::name_facet_error(e, name))?;
+            // The corners fix the face and its cycle: a second-order
+            // facet's other nodes lie on its corner edges and add nothing.
+            let nodes = &nodes[..self.facet_type(f).corners()];
             if !faces.insert(face_key(nodes.iter().copied())) {
                 return Err(MeshError::DuplicateFacet {
                     set: name.to_string(),

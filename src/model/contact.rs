@@ -159,11 +159,9 @@ impl SlaveQuadrature {
         match self {
             SlaveQuadrature::Nodal => QuadRule::nodal_for_facet(facet),
             SlaveQuadrature::Gauss => QuadRule::default_for_facet(facet),
-            SlaveQuadrature::Centroid => match facet {
-                FacetType::Quad4 => {
-                    QuadRule::quad_gauss(1).unwrap_or_else(|_| QuadRule::quad_2x2())
-                }
+            SlaveQuadrature::Centroid => match facet.linear() {
                 FacetType::Tri3 => QuadRule::tri_1(),
+                _ => QuadRule::quad_gauss(1).unwrap_or_else(|_| QuadRule::quad_2x2()),
             },
         }
     }

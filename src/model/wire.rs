@@ -176,10 +176,9 @@ pub fn encode(model: &Model, w: &mut Writer) -> Result<()> {
         ));
     }
     w.str(name);
-    w.usize(match mesh.cell_type {
-        CellType::Hex8 => 0,
-        CellType::Tet4 => 1,
-    });
+    // The position in `CellType::ALL` (hex8 0, tet4 1, ...).
+    let code = CellType::ALL.iter().position(|&c| c == mesh.cell_type);
+    w.usize(code.unwrap_or(0));
     w.usize(materials.len());
     for m in materials {
         let (tag, youngs, poisson) = match *m {
@@ -262,11 +261,10 @@ pub fn encode(model: &Model, w: &mut Writer) -> Result<()> {
 pub fn decode(r: &mut Reader) -> Result<Model> {
     let bad = |what: &str, v: usize| Error::Internal(format!("the broadcast model has {what} {v}"));
     let name = r.str()?;
-    let cell_type = match r.usize()? {
-        0 => CellType::Hex8,
-        1 => CellType::Tet4,
-        t => return Err(bad("cell type", t)),
-    };
+    let code = r.usize()?;
+    let cell_type = *CellType::ALL
+        .get(code)
+        .ok_or_else(|| bad("cell type", code))?;
     let materials = r.list(3, |r| {
         let (tag, youngs, poisson) = (r.usize()?, r.f64()?, r.f64()?);
         match tag {

@@ -43,7 +43,6 @@ impl Fingerprint {
 pub(super) fn header_fingerprint(mesh: &MeshHeader) -> u64 {
     let mut f = Fingerprint::new();
     f.str(mesh.cell_type);
-    f.str(mesh.facet_type);
     for (rows, cols) in [
         (mesh.nodes.global_rows, mesh.nodes.cols),
         (mesh.cells.global_rows, mesh.cells.cols),
@@ -64,6 +63,7 @@ pub(super) fn header_fingerprint(mesh: &MeshHeader) -> u64 {
     f.usize(mesh.facet_sets.len());
     for (name, fs) in mesh.facet_sets {
         f.str(name);
+        f.str(&fs.facet_type);
         f.usize(fs.k);
         f.i64s(&fs.nodes);
         f.i64s(&fs.cell);

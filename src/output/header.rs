@@ -4,21 +4,19 @@ use std::path::Path;
 
 use super::collective::to_h5_string;
 use super::xdmf::{self, MeshDesc};
-use super::{check_name, facet_nodes, layout, CellKind, MeshHeader, OutputError};
+use super::{check_name, facet_nodes, layout, MeshHeader, OutputError, MIXED_FACETS};
+use crate::fem::{CellType, MAX_FACET_NODES};
 
 /// What the XDMF writer needs, after all local checks of the header.
 pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc, OutputError> {
     let invalid = |object: &str, reason: String| Err(OutputError::invalid(path, object, reason));
-    let Some(kind) = CellKind::parse(mesh.cell_type) else {
+    let Some(kind) = CellType::from_name(mesh.cell_type) else {
         return invalid(
             layout::MESH_CELLS,
-            format!("cell_type '{}' is not hex8 or tet4", mesh.cell_type),
-        );
-    };
-    let Some(facet_k) = facet_nodes(mesh.facet_type) else {
-        return invalid(
-            layout::MESH_FACET_SETS,
-            format!("facet_type '{}' is not quad4 or tri3", mesh.facet_type),
+            format!(
+                "cell_type '{}' is not a supported cell type",
+                mesh.cell_type
+            ),
         );
     };
     let n_nodes = mesh.nodes.global_rows;
@@ -104,12 +102,22 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
         let object = layout::facet_set(name);
         check_name(path, &object, name)?;
         let f = fs.cell.len();
+        let facet_k = match facet_nodes(&fs.facet_type) {
+            Some(k) => k,
+            None if fs.facet_type == MIXED_FACETS && fs.k <= MAX_FACET_NODES => fs.k,
+            None => {
+                return invalid(
+                    &object,
+                    format!("facet type '{}' is not supported", fs.facet_type),
+                )
+            }
+        };
         if fs.k != facet_k {
             return invalid(
                 &object,
                 format!(
                     "k = {}, but {} facets have {facet_k} nodes",
-                    fs.k, mesh.facet_type
+                    fs.k, fs.facet_type
                 ),
             );
         }
@@ -125,10 +133,11 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
                 ),
             );
         }
+        let padding = |id: i64| id == -1 && fs.facet_type == MIXED_FACETS;
         if let Some(bad) = fs
             .nodes
             .iter()
-            .find(|&&id| usize::try_from(id).map_or(true, |i| i >= n_nodes))
+            .find(|&&id| !padding(id) && usize::try_from(id).map_or(true, |i| i >= n_nodes))
         {
             return invalid(&object, format!("node id {bad} is outside 0..{n_nodes}"));
         }
@@ -142,7 +151,7 @@ pub(super) fn validate_header(path: &Path, mesh: &MeshHeader) -> Result<MeshDesc
     }
     Ok(MeshDesc {
         h5_name,
-        cell_kind: kind,
+        cell_type: kind,
         n_nodes,
         n_cells,
     })

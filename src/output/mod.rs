@@ -9,13 +9,20 @@
 //!
 //! ```text
 //! /mesh/nodes                      (N,3) f64  reference coordinates
-//! /mesh/cells                      (M,k) i64  connectivity; attr cell_type ("hex8" | "tet4")
+//! /mesh/cells                      (M,k) i64  connectivity in VTK node order (see
+//!                                             `fem::CellType::vtk_order`: ours but for
+//!                                             wedges); attr cell_type ("hex8" | "tet4" |
+//!                                             "tet10" | "hex20" | "hex27" | "wedge6" |
+//!                                             "wedge15" | "pyramid5")
 //! /mesh/partition                  (M,)  i32  owning rank of each cell
 //! /mesh/cell_body                  (M,)  i32  body index of each cell;
 //!                                             attr bodies = 1-D string array (body names)
 //! /mesh/node_sets/<name>           (n,)  i64  node ids
-//! /mesh/facet_sets/<name>/         group; attr cell_type ("quad4" | "tri3")
-//!     nodes                        (F,k) i64  facet node connectivity
+//! /mesh/facet_sets/<name>/         group; attr cell_type ("quad4" | "tri3" | "tri6" |
+//!                                  "quad8" | "quad9", or "mixed" for a set of a wedge's
+//!                                  or pyramid's triangles and quadrilaterals)
+//!     nodes                        (F,k) i64  facet node connectivity (our facet order;
+//!                                             "mixed": k the largest, rows padded with −1)
 //!     cell                         (F,)  i64  cell owning each facet
 //!     face                         (F,)  i8   local face number of the facet in that cell
 //! /steps/<NNNNNN>/                 attrs: time f64, load_factor f64,
@@ -143,13 +150,12 @@ impl<'a, T> BlockRows<'a, T> {
 /// else must be identical on every rank (rank 0's copy is what gets written).
 #[derive(Debug, Clone, Copy)]
 pub struct MeshHeader<'a> {
-    /// "hex8" or "tet4".
+    /// A cell type's name (`fem::CellType::name`).
     pub cell_type: &'a str,
-    /// "quad4" or "tri3"; the type of every facet set.
-    pub facet_type: &'a str,
     /// (N,3) reference coordinates.
     pub nodes: BlockRows<'a, f64>,
-    /// (M,k) connectivity, 0-based global node ids, VTK node order (XDMF uses it as is).
+    /// (M,k) connectivity, 0-based global node ids, VTK node order (XDMF uses it as is;
+    /// `fem::CellType::vtk_order`).
     pub cells: BlockRows<'a, i64>,
     /// (M,1) owning rank of each cell.
     pub partition: BlockRows<'a, i32>,
@@ -163,7 +169,9 @@ pub struct MeshHeader<'a> {
 /// One facet set: `F = cell.len()` facets of `k` nodes each.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct FacetSetOut {
-    /// F*k node ids, row-major.
+    /// A facet type's name (`fem::FacetType::name`), or [`MIXED_FACETS`].
+    pub facet_type: String,
+    /// F*k node ids, row-major; a mixed set's shorter rows end in −1.
     pub nodes: Vec<i64>,
     pub k: usize,
     /// Global cell id owning each facet.
@@ -268,45 +276,14 @@ impl OutputError {
 
 pub use layout::step_group_name;
 
-/// Element kinds this module can describe to XDMF; the string is the
-/// `cell_type` attribute value.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum CellKind {
-    Hex8,
-    Tet4,
-}
+/// The `cell_type` of a facet set that holds facets of several types.
+pub const MIXED_FACETS: &str = "mixed";
 
-impl CellKind {
-    pub(crate) fn parse(s: &str) -> Option<Self> {
-        match s {
-            "hex8" => Some(Self::Hex8),
-            "tet4" => Some(Self::Tet4),
-            _ => None,
-        }
-    }
-
-    pub(crate) fn nodes(self) -> usize {
-        match self {
-            Self::Hex8 => 8,
-            Self::Tet4 => 4,
-        }
-    }
-
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            Self::Hex8 => "hex8",
-            Self::Tet4 => "tet4",
-        }
-    }
-}
-
-/// Number of nodes of a facet type, or `None` if the type is not supported.
+/// Number of nodes per row of a facet set of this type: the type's, or
+/// `None` for an unknown name (a mixed set's rows are as long as its
+/// largest facet's, which the set itself says).
 pub(crate) fn facet_nodes(facet_type: &str) -> Option<usize> {
-    match facet_type {
-        "quad4" => Some(4),
-        "tri3" => Some(3),
-        _ => None,
-    }
+    crate::fem::FacetType::from_name(facet_type).map(|f| f.nodes())
 }
 
 /// Checks that `name` can be one HDF5 link name (one path component).

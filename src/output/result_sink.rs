@@ -4,10 +4,11 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo};
+use super::{layout, BlockRows, FacetSetOut, MeshHeader, ResultFile, StepInfo, MIXED_FACETS};
 use crate::distribution::LocalMesh;
 use crate::dofs::even_block;
 use crate::error::Result;
+use crate::fem::FacetType;
 use crate::hertz::{HertzCheck, HertzKind};
 use crate::petsc::Vector;
 use crate::runtime::Runtime;
@@ -208,13 +209,19 @@ pub fn create_result_file(
     let cell_block = even_block(local.global_cells, rank, size);
     let nodes: Vec<f64> = local.block.nodes.iter().flatten().copied().collect();
     let npc = local.cell_type.nodes();
-    let cells: Vec<i64> = local.block.cells.iter().map(|&v| v as i64).collect();
+    // VTK's node order, which XDMF readers take as it is.
+    let order = local.cell_type.vtk_order();
+    let cells: Vec<i64> = local
+        .block
+        .cells
+        .chunks_exact(npc)
+        .flat_map(|c| order.iter().map(move |&k| c[k] as i64))
+        .collect();
     let partition: Vec<i32> = sim.partition_block().to_vec();
     let cell_body: Vec<i32> = local.block.cell_body.iter().map(|&b| b as i32).collect();
     let facet_sets = facet_sets_out(local);
     let header = MeshHeader {
         cell_type: local.cell_type.name(),
-        facet_type: local.cell_type.facet_type().name(),
         nodes: BlockRows {
             global_rows: local.global_nodes,
             start: node_block.start,
@@ -294,14 +301,37 @@ fn write_hertz_setup(file: &mut ResultFile, h: &HertzCheck) -> Result<()> {
     Ok(())
 }
 
-/// Every facet set whole, as every rank received it with its piece.
+/// Every facet set whole, as every rank received it with its piece. A set
+/// of one facet type is written as it is; a set of a wedge's or pyramid's
+/// triangles and quadrilaterals as [`MIXED_FACETS`], its rows padded.
 fn facet_sets_out(mesh: &LocalMesh) -> BTreeMap<String, FacetSetOut> {
-    let k = mesh.cell_type.facet_type().nodes();
     mesh.shared
         .iter()
         .map(|(name, set)| {
+            let types: Vec<FacetType> = set.facet_types(mesh.cell_type).collect();
+            let k = types
+                .iter()
+                .map(|t| t.nodes())
+                .max()
+                .unwrap_or_else(|| mesh.cell_type.face_type(0).nodes());
+            let first = types
+                .first()
+                .copied()
+                .unwrap_or(mesh.cell_type.face_type(0));
+            let facet_type = if types.iter().all(|&t| t == first) {
+                first.name().to_string()
+            } else {
+                MIXED_FACETS.to_string()
+            };
+            let mut nodes = Vec::with_capacity(k * types.len());
+            let mut rest = set.nodes.iter();
+            for t in &types {
+                nodes.extend(rest.by_ref().take(t.nodes()).map(|&v| v as i64));
+                nodes.extend(std::iter::repeat_n(-1, k - t.nodes()));
+            }
             let out = FacetSetOut {
-                nodes: set.nodes.iter().map(|&v| v as i64).collect(),
+                facet_type,
+                nodes,
                 k,
                 cell: set.cells.iter().map(|&c| c as i64).collect(),
                 face: set.faces.iter().map(|&f| f as i8).collect(),

@@ -55,13 +55,13 @@ fn block_rows_helpers() {
 }
 
 #[test]
-fn cell_kinds() {
-    assert_eq!(CellKind::parse("hex8").map(CellKind::nodes), Some(8));
-    assert_eq!(CellKind::parse("tet4").map(CellKind::nodes), Some(4));
-    assert_eq!(CellKind::parse("hex20"), None);
+fn facet_kinds() {
     assert_eq!(facet_nodes("quad4"), Some(4));
     assert_eq!(facet_nodes("tri3"), Some(3));
-    assert_eq!(facet_nodes("tri6"), None);
+    assert_eq!(facet_nodes("tri6"), Some(6));
+    assert_eq!(facet_nodes("quad9"), Some(9));
+    assert_eq!(facet_nodes(MIXED_FACETS), None);
+    assert_eq!(facet_nodes("tri10"), None);
 }
 
 #[test]

@@ -142,7 +142,7 @@ impl ResultFile {
                 &cells,
                 layout::MESH_CELLS,
                 layout::CELL_TYPE_ATTR,
-                self.mesh.cell_kind.name(),
+                self.mesh.cell_type.name(),
             )?;
             let body = gmesh
                 .dataset(layout::CELL_BODY)
@@ -185,7 +185,7 @@ impl ResultFile {
             c.write_root(&g, &object, layout::FACET_NODES, &[f, fs.k], &fs.nodes)?;
             c.write_root(&g, &object, layout::FACET_CELL, &[f], &fs.cell)?;
             c.write_root(&g, &object, layout::FACET_FACE, &[f], &fs.face)?;
-            let a = attr_string(p, &g, &object, layout::CELL_TYPE_ATTR, mesh.facet_type);
+            let a = attr_string(p, &g, &object, layout::CELL_TYPE_ATTR, &fs.facet_type);
             c.agree(&object, a)?;
         }
         Ok(())

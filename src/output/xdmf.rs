@@ -25,14 +25,15 @@ use std::io;
 use std::os::unix::fs::FileExt as _;
 use std::path::{Path, PathBuf};
 
-use super::{layout, CellKind};
+use super::layout;
+use crate::fem::CellType;
 
 /// The mesh part of the sidecar: what every grid references.
 #[derive(Debug, Clone)]
 pub(crate) struct MeshDesc {
     /// File name of the HDF5 file (no directory), as written into DataItems.
     pub h5_name: String,
-    pub cell_kind: CellKind,
+    pub cell_type: CellType,
     pub n_nodes: usize,
     pub n_cells: usize,
 }
@@ -118,13 +119,26 @@ impl Sidecar {
     }
 }
 
+/// XDMF's topology name of a cell type. ParaView's XDMF reader maps each to
+/// the VTK cell of the same shape and takes the connectivity as it is, so
+/// `/mesh/cells` holds VTK's node order.
+fn topology(cell: CellType) -> &'static str {
+    match cell {
+        CellType::Hex8 => "Hexahedron",
+        CellType::Tet4 => "Tetrahedron",
+        CellType::Tet10 => "Tetrahedron_10",
+        CellType::Hex20 => "Hexahedron_20",
+        CellType::Hex27 => "Hexahedron_27",
+        CellType::Wedge6 => "Wedge",
+        CellType::Wedge15 => "Wedge_15",
+        CellType::Pyramid5 => "Pyramid",
+    }
+}
+
 fn render_step(s: &mut String, mesh: &MeshDesc, step: &StepDesc) {
     let h5 = escape(&mesh.h5_name);
     let group = escape(&step.group);
-    let (topo, k) = match mesh.cell_kind {
-        CellKind::Hex8 => ("Hexahedron", CellKind::Hex8.nodes()),
-        CellKind::Tet4 => ("Tetrahedron", CellKind::Tet4.nodes()),
-    };
+    let (topo, k) = (topology(mesh.cell_type), mesh.cell_type.nodes());
     // `write!` into a String cannot fail; the results are ignored on purpose
     // (`let _`) so that no error path or panic exists here.
     let _ = writeln!(s, "      <Grid Name=\"step_{group}\" GridType=\"Uniform\">");
@@ -254,7 +268,7 @@ mod tests {
     fn mesh() -> MeshDesc {
         MeshDesc {
             h5_name: "out.h5".into(),
-            cell_kind: CellKind::Hex8,
+            cell_type: CellType::Hex8,
             n_nodes: 12,
             n_cells: 2,
         }

@@ -6,7 +6,7 @@ use super::limits;
 use super::lines::Seg;
 use super::parse::{Bad, Checked};
 use super::sections::{ContactSection, HertzSection};
-use crate::fem::Material;
+use crate::fem::{FacetType, Material};
 use crate::hertz::{HertzCheck, HertzKind};
 use crate::mesh::Mesh;
 use crate::model::{
@@ -19,10 +19,34 @@ use crate::model::{
 /// meet: the Uzawa loop then stalls just above its tolerance (sphere-block:
 /// 361 Newton iterations and 7 cutbacks with Gauss points, 85 with one point
 /// per facet, 36 and none at the nodes).
-pub(super) fn default_quadrature(mesh: &Mesh) -> SlaveQuadrature {
-    match mesh.cell_type.facet_type() {
-        crate::fem::FacetType::Quad4 => SlaveQuadrature::Gauss,
-        crate::fem::FacetType::Tri3 => SlaveQuadrature::Nodal,
+pub(super) fn default_quadrature(facet: FacetType) -> SlaveQuadrature {
+    match facet.linear() {
+        FacetType::Quad4 => SlaveQuadrature::Gauss,
+        _ => SlaveQuadrature::Nodal,
+    }
+}
+
+/// The one facet type of a contact surface: contact handles first-order
+/// facets (tri3, quad4) only, one type per surface. Any other set is this
+/// pair's scene error, before set-up.
+fn contact_facet_type(mesh: &Mesh, set: &str, name: &str) -> Result<FacetType, String> {
+    let types = mesh.facet_set_types(set).map_err(|e| e.to_string())?;
+    if let Some(t) = types.iter().find(|t| !t.is_linear()) {
+        return Err(format!(
+            "contact pair '{name}': second-order facets ({}) are not supported by contact yet; \
+             set '{set}' holds them. Mesh the contact bodies with first-order cells \
+             (tet4, hex8, wedge6, pyramid5)",
+            t.name()
+        ));
+    }
+    match types.as_slice() {
+        [] => Ok(mesh.cell_type.face_type(0)),
+        [one] => Ok(*one),
+        [a, b, ..] => Err(format!(
+            "contact pair '{name}': set '{set}' mixes {} and {} facets; contact needs one facet type per surface",
+            a.name(),
+            b.name()
+        )),
     }
 }
 
@@ -32,10 +56,16 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
     let at = format!("[[contact]] '{name}'");
     check_facet_set(mesh, &c.slave, &format!("{at} slave"))
         .map_err(|m| Bad::at(&key("slave"), m))?;
+    let facet = contact_facet_type(mesh, &c.slave, &name).map_err(|m| Bad::at(&key("slave"), m))?;
     let master = match (&c.master, &c.rigid) {
         (Some(m), None) => {
             check_facet_set(mesh, m, &format!("{at} master"))
                 .map_err(|e| Bad::at(&key("master"), e))?;
+            let master_facet =
+                contact_facet_type(mesh, m, &name).map_err(|e| Bad::at(&key("master"), e))?;
+            if master_facet != facet {
+                return Err(Bad::at(&key("master"), format!("contact pair '{name}': the slave facets are {} and the master facets {}; contact needs one facet type on both surfaces", facet.name(), master_facet.name())));
+            }
             if m == &c.slave {
                 return Err(Bad::at(&key("master"), format!("{at}: slave and master are the same facet set '{m}'; a surface cannot contact itself here")));
             }
@@ -84,9 +114,9 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
     }
     spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))
         .map_err(|m| Bad::at(&key("motion_amplitude"), m))?;
-    spec.formulation = formulation(mesh, c, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
+    spec.formulation = formulation(facet, c, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
     spec.quadrature = match c.quadrature.as_deref() {
-        None => default_quadrature(mesh),
+        None => default_quadrature(facet),
         Some("gauss") => SlaveQuadrature::Gauss,
         Some("nodal") => SlaveQuadrature::Nodal,
         Some("centroid") => SlaveQuadrature::Centroid,
@@ -172,7 +202,7 @@ pub(super) fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 /// Without the key a pair is a mortar pair, unless it sets `quadrature`,
 /// which only places links' points: then it asked for links.
 pub(super) fn formulation(
-    mesh: &Mesh,
+    facet: FacetType,
     c: &ContactSection,
     at: &str,
 ) -> std::result::Result<Formulation, String> {
@@ -187,7 +217,6 @@ pub(super) fn formulation(
             ))
         }
     };
-    let facet = mesh.cell_type.facet_type();
     if !f.supports(facet) {
         return Err(format!(
             "{at}: formulation \"mortar\" does not support {} facets",

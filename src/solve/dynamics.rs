@@ -79,7 +79,7 @@ impl TimeStepper {
         let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM)?;
         bulk.add_pattern(&mut pattern)?;
         let mut mass = pattern.build()?;
-        bulk.add_mass(&spec.density, &mut mass)?;
+        bulk.add_mass(&mesh.nodes, &spec.density, &mut mass)?;
         mass.assemble()?;
         let mut u_n = Vector::new_mpi(dofs.num_owned_dofs())?;
         u_n.set_block_size(DIM)?;

@@ -67,7 +67,7 @@ impl LinksPair {
     /// Collective (the multipliers' halos).
     pub fn new(s: &PairSetup, slave: SlaveSurface, master: MasterSide) -> Result<Self> {
         let spec = s.spec;
-        let rule = spec.quadrature.rule(s.mesh.cell_type.facet_type());
+        let rule = spec.quadrature.rule(slave.facet_type);
         let friction_spec = spec.active_friction();
         let multipliers = Multipliers::new(
             s.dofs,

@@ -13,11 +13,12 @@
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use crate::assembly::{Halo, HaloFactory};
+use crate::contact::facet_shape;
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::Result;
-use crate::fem::{shape::facet_shape, QuadRule};
+use crate::fem::QuadRule;
 
 /// A quadrature point contribution to a node this rank owns: the point's slot
 /// in the local (owned + ghost) layout and its weight N_a(ζ) w.

@@ -29,7 +29,7 @@ impl Bilinear {
     pub(super) fn of<T: Scalar>(facet: FacetType, nodes: &[[T; 2]]) -> Self {
         let v = |i: usize| [nodes[i][0].re(), nodes[i][1].re()];
         let mut m = [[0.0; 2]; 4];
-        match facet {
+        match facet.linear() {
             // N_a = ¼ (1 + ξ_a ζ₁)(1 + η_a ζ₂).
             FacetType::Quad4 => {
                 for (i, node) in crate::fem::shape::QUAD4_REF_NODES.iter().enumerate() {
@@ -40,7 +40,7 @@ impl Bilinear {
                     }
                 }
             }
-            FacetType::Tri3 => {
+            _ => {
                 let (v0, v1, v2) = (v(0), v(1), v(2));
                 m = [v0, sub(v1, v0), sub(v2, v0), [0.0, 0.0]];
             }
@@ -149,7 +149,7 @@ mod tests {
             let map = Bilinear::of::<f64>(facet, &nodes);
             let corners: Vec<Vec2> = match facet {
                 FacetType::Quad4 => crate::fem::shape::QUAD4_REF_NODES.to_vec(),
-                FacetType::Tri3 => vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+                _ => vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
             };
             for (corner, node) in corners.iter().zip(&nodes) {
                 let x = map.at(*corner);

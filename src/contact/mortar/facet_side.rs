@@ -12,9 +12,9 @@ use super::rows::{signature, Rows};
 use super::system::{self, Interface, NodeState, Segment};
 use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Dual;
+use crate::contact::MAX_FACET_NODES;
 use crate::error::Result;
 use crate::fem::surface::facet_normal_at_centre;
-use crate::fem::MAX_FACET_NODES;
 
 /// One evaluation of the pair (values only; the tangent takes its
 /// derivatives segment by segment): segments, node states and (with

@@ -11,7 +11,8 @@
 //! everywhere.
 use super::bilinear::Bilinear;
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::FacetType;
 
 /// A 2-vector in the auxiliary plane.
 pub type Vec2<T> = [T; 2];
@@ -40,7 +41,7 @@ impl<T: Scalar> Plane<T> {
     /// degenerate facet (no normal at its centre).
     pub fn of_facet(facet: FacetType, x: &[Vec3<T>]) -> Option<Self> {
         let centre = crate::contact::projection::reference_centre(facet);
-        let s = crate::fem::shape::facet_shape(facet, centre);
+        let s = crate::contact::facet_shape(facet, centre);
         let zero = autodiff::constant3::<T>([0.0; 3]);
         let (mut origin, mut t1, mut t2) = (zero, zero, zero);
         for (a, xa) in x.iter().enumerate().take(facet.nodes()) {
@@ -331,7 +332,8 @@ pub const EXACTLY_AFFINE_TOL: f64 = 1e-13;
 pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACET_NODES] {
     let one = T::from_f64(1.0);
     let zero = T::from_f64(0.0);
-    match facet {
+    // Contact facets are first order; `linear` names their reference shape.
+    match facet.linear() {
         FacetType::Quad4 => {
             let mut n = [zero; MAX_FACET_NODES];
             for (na, node) in n.iter_mut().zip(crate::fem::shape::QUAD4_REF_NODES) {
@@ -339,7 +341,7 @@ pub fn shape_values<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [T; MAX_FACE
             }
             n
         }
-        FacetType::Tri3 => [one - zeta[0] - zeta[1], zeta[0], zeta[1], zero],
+        _ => [one - zeta[0] - zeta[1], zeta[0], zeta[1], zero],
     }
 }
 
@@ -447,7 +449,7 @@ fn implicit_step<T: Scalar>(
 pub fn shape_gradients<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [[T; 2]; MAX_FACET_NODES] {
     let zero = T::from_f64(0.0);
     let mut dn = [[zero; 2]; MAX_FACET_NODES];
-    match facet {
+    match facet.linear() {
         FacetType::Quad4 => {
             for (d, node) in dn.iter_mut().zip(crate::fem::shape::QUAD4_REF_NODES) {
                 *d = [
@@ -456,7 +458,7 @@ pub fn shape_gradients<T: Scalar>(facet: FacetType, zeta: &Vec2<T>) -> [[T; 2]; 
                 ];
             }
         }
-        FacetType::Tri3 => {
+        _ => {
             let (one, m) = (T::from_f64(1.0), T::from_f64(-1.0));
             dn[0] = [m, m];
             dn[1] = [one, zero];

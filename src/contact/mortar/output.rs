@@ -5,9 +5,9 @@ use super::friction::Rate;
 use super::master::Master;
 use super::pair::MortarPair;
 use super::system::NodeState;
+use crate::contact::facet_shape;
 use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;
-use crate::fem::shape::facet_shape;
 
 /// Per assembled facet row: `(slot, Σ_k D_jk, Σ_k D_jk ν)` (a rigid
 /// master: `Σ_k c_jk` for the last), the weights and force directions the

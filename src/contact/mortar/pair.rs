@@ -18,9 +18,10 @@ use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::outcome::UzawaStats;
 use crate::contact::surfaces::SlaveSurface;
+use crate::contact::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::fem::FacetType;
 
 /// What a cut-back step restores: λ_j and λT_j of the last converged step.
 #[derive(Debug, Clone)]

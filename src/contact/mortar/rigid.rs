@@ -26,8 +26,9 @@
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
 use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState};
 use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
-use crate::fem::shape::facet_shape;
-use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+use crate::contact::facet_shape;
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::{FacetType, QuadRule};
 use crate::model::RigidSurface;
 
 /// Variables of one slave facet: node `a` at `3a + i`.
@@ -67,7 +68,7 @@ pub struct RigidFacet<T> {
 
 /// The rule over a whole slave facet for the rigid integrals.
 pub fn facet_rule(facet: FacetType, rules: &MortarRules) -> Rule {
-    match facet {
+    match facet.linear() {
         FacetType::Quad4 => {
             let q = QuadRule::quad_4x4();
             q.points
@@ -76,7 +77,7 @@ pub fn facet_rule(facet: FacetType, rules: &MortarRules) -> Rule {
                 .map(|(p, w)| ([p[0], p[1]], *w))
                 .collect()
         }
-        FacetType::Tri3 => rules.triangle.clone(),
+        _ => rules.triangle.clone(),
     }
 }
 

@@ -53,7 +53,7 @@ fn patch(
             let q = [id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)];
             match facet_type {
                 Quad4 => facets.push(q),
-                Tri3 => facets.extend([[q[0], q[1], q[2], 0], [q[0], q[2], q[3], 0]]),
+                _ => facets.extend([[q[0], q[1], q[2], 0], [q[0], q[2], q[3], 0]]),
             }
         }
     }

@@ -10,9 +10,9 @@
 use super::friction::NodeFriction;
 use super::system::{NodalData, NodeDof, NodeState, Segment};
 use crate::assembly::MatrixSink;
+use crate::contact::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
-use crate::fem::MAX_FACET_NODES;
 
 /// A pair of at most this many DOFs (on a rank) sums its tangent in a
 /// dense matrix over them (4.5 MB at most): a small pair's tangent is

@@ -22,8 +22,9 @@
 //! of the segments' sum (`system::covered_facets`).
 use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::fem::shape::{facet_shape, FacetShape};
-use crate::fem::{FacetType, QuadRule, MAX_FACET_NODES};
+use crate::contact::MAX_FACET_NODES;
+use crate::contact::{facet_shape, FacetShape};
+use crate::fem::{FacetType, QuadRule};
 
 /// A quadrature rule as (point, weight) pairs.
 pub type Rule = Vec<([f64; 2], f64)>;
@@ -118,9 +119,9 @@ impl Default for MortarRules {
 
 impl MortarRules {
     pub fn facet(&self, facet: FacetType) -> &Rule {
-        match facet {
-            FacetType::Quad4 => &self.quad_facet,
+        match facet.linear() {
             FacetType::Tri3 => &self.tri_facet,
+            _ => &self.quad_facet,
         }
     }
 
@@ -358,9 +359,9 @@ fn reference_jacobian<T: Scalar>(facet: FacetType, x_ref: &[[f64; 3]], zeta: &[T
 /// zero for a triangle or a parallelogram, whose area element `J₀` is then
 /// constant.
 pub(super) fn reference_distortion(facet: FacetType, x: &[[f64; 3]]) -> f64 {
-    match facet {
+    match facet.linear() {
         FacetType::Tri3 => 0.0,
-        FacetType::Quad4 => {
+        _ => {
             let combine = |w: [f64; 4]| -> [f64; 3] {
                 [0, 1, 2].map(|i| 0.25 * (0..4).map(|a| w[a] * x[a][i]).sum::<f64>())
             };

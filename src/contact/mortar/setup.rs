@@ -11,10 +11,11 @@ use super::tangential::PairFriction;
 use crate::assembly::RankExchange;
 use crate::contact::master::MasterSide;
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
+use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
-use crate::fem::{shape::facet_shape, QuadRule, MAX_FACET_NODES};
+use crate::fem::QuadRule;
 use crate::model::{FrictionSpec, MasterSpec, PairSpec};
 
 fn facet_row(nodes: &[u32]) -> [u32; MAX_FACET_NODES] {
@@ -53,7 +54,7 @@ impl MortarPair {
         (search_distance, reach): (f64, f64),
         friction: Option<FrictionSpec>,
     ) -> Result<Self> {
-        let facet_type = mesh.cell_type.facet_type();
+        let facet_type = slave.facet_type;
         let nf = facet_type.nodes();
         let master_set = match &spec.master {
             MasterSpec::Surface { set } => Some(set.as_str()),

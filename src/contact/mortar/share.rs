@@ -33,10 +33,11 @@ use super::master::Master;
 use super::pair::MortarPair;
 use crate::assembly::RankExchange;
 use crate::contact::held_master::{self, MasterFacet, RECORD};
+use crate::contact::surfaces::contact_facet_type;
+use crate::contact::MAX_FACET_NODES;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
-use crate::fem::MAX_FACET_NODES;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// What a rank holds of the slave side, and the owned nodes of the pair.
@@ -54,7 +55,7 @@ fn own_records(mesh: &LocalMesh, dofs: &DofMap, set: &str) -> Result<Vec<MasterF
     let refs = mesh
         .facet_set(set)
         .ok_or_else(|| Error::scene("contact", format!("facet set '{set}' does not exist")))?;
-    let n = mesh.cell_type.facet_type().nodes();
+    let n = contact_facet_type(mesh, set)?.nodes();
     Ok(refs
         .facets
         .iter()
@@ -114,7 +115,7 @@ pub(super) fn slave_share(
     master: Option<&str>,
     ranks: &dyn RankExchange,
 ) -> Result<SlaveShare> {
-    let nf = mesh.cell_type.facet_type().nodes();
+    let nf = contact_facet_type(mesh, slave)?.nodes();
     let own = own_records(mesh, dofs, slave)?;
     let owners = Owners::new(dofs, ranks);
     let (me, size) = (ranks.rank(), ranks.size());

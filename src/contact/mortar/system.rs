@@ -19,7 +19,8 @@ use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
 use crate::contact::autodiff::{Dual, Scalar, Seed, Vec3};
 use crate::contact::penalty::contact_pressure;
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::FacetType;
 
 /// Variables of one segment: slave nodes at `3a + i`, master nodes at
 /// `12 + 3b + i` (fixed slots, whatever the facet types).

@@ -211,7 +211,7 @@ fn dual_basis_is_biorthogonal_and_sums_to_one() {
         let n = facet.nodes();
         let (mut dm, mut d) = ([[0.0; 4]; 4], [0.0; 4]);
         for (zeta, w) in rules.facet(facet) {
-            let s = crate::fem::shape::facet_shape(facet, *zeta);
+            let s = crate::contact::facet_shape(facet, *zeta);
             let t = |c: usize| -> [f64; 3] {
                 [0, 1, 2].map(|i| (0..n).map(|k| s.dn[k][c] * x[k][i]).sum())
             };
@@ -320,7 +320,7 @@ fn patch(
             let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
             let mut list = match facet {
                 Quad4 => vec![q],
-                Tri3 => vec![[q[0], q[1], q[2], 0], [q[0], q[2], q[3], 0]],
+                _ => vec![[q[0], q[1], q[2], 0], [q[0], q[2], q[3], 0]],
             };
             if master {
                 for f in &mut list {

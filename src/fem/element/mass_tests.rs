@@ -20,7 +20,7 @@ fn mass_cases() -> Vec<(&'static str, ElementGeometry, f64)> {
     let twisted = twisted_hex();
     let twisted_volume = element_volume(&geometry(CellType::Hex8, &twisted));
     let hex3 = QuadRule::hex_3x3x3();
-    vec![
+    let mut cases = vec![
         ("unit hex8", geometry(CellType::Hex8, &hex8_unit()), 1.0),
         (
             "twisted hex8",
@@ -47,7 +47,21 @@ fn mass_cases() -> Vec<(&'static str, ElementGeometry, f64)> {
             ElementGeometry::new(CellType::Tet4, &tet, &QuadRule::tet_4()).unwrap(),
             tet_volume,
         ),
-    ]
+    ];
+    // The other types, distorted (curved where second order), each with
+    // the rule the assembly builds its mass with.
+    for cell in CellType::ALL {
+        if matches!(cell, CellType::Hex8 | CellType::Tet4) {
+            continue;
+        }
+        let x = distorted(cell, 22);
+        let rule =
+            QuadRule::mass_for_cell(cell).unwrap_or_else(|| QuadRule::default_for_cell(cell));
+        let geom = ElementGeometry::new(cell, &x, &rule).unwrap();
+        let volume = element_volume(&geom);
+        cases.push((cell.name(), geom, volume));
+    }
+    cases
 }
 
 #[test]

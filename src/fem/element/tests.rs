@@ -2,7 +2,9 @@
 //! patch tests, body forces, bad input (the mass matrix: mass_tests.rs).
 
 use super::super::surface::follower_pressure;
-use super::super::test_util::{hex8_unit, perturb, rel_err, tet4_unit, Lcg};
+use super::super::test_util::{
+    distorted_cell, hex8_unit, perturb, rel_err, tet4_unit, unit_cell, Lcg,
+};
 use super::*;
 use nalgebra::Rotation3;
 
@@ -21,14 +23,44 @@ pub(super) fn materials() -> [Material; 2] {
     ]
 }
 
+/// A distorted cell of any type: first-order cells with every node moved,
+/// second-order ones with curved edges and faces too.
 pub(super) fn distorted(cell: CellType, seed: u64) -> Vec<[f64; 3]> {
+    match cell {
+        CellType::Hex8 | CellType::Tet4 => {
+            let mut rng = Lcg::new(seed);
+            let mut x = unit_cell(cell);
+            perturb(&mut x, &mut rng, 0.15);
+            x
+        }
+        _ => distorted_cell(cell, seed, 0.1),
+    }
+}
+
+/// A random affine image of the unit cell (straight edges, flat faces):
+/// where the element must be exact.
+pub(super) fn affine(cell: CellType, seed: u64) -> (Vec<[f64; 3]>, Matrix3<f64>) {
     let mut rng = Lcg::new(seed);
-    let mut x = match cell {
-        CellType::Hex8 => hex8_unit().to_vec(),
-        CellType::Tet4 => tet4_unit().to_vec(),
-    };
-    perturb(&mut x, &mut rng, 0.15);
-    x
+    let a = Matrix3::identity() + Matrix3::from_fn(|_, _| 0.2 * rng.next());
+    let c = Vector3::from(rng.vec3(1.0));
+    let x = unit_cell(cell)
+        .iter()
+        .map(|p| {
+            let q = a * Vector3::from(*p) + c;
+            [q.x, q.y, q.z]
+        })
+        .collect();
+    (x, a)
+}
+
+/// Reference volume of each type's unit cell ([`unit_cell`]).
+pub(super) fn unit_volume(cell: CellType) -> f64 {
+    match cell.linear() {
+        CellType::Hex8 => 1.0,
+        CellType::Tet4 => 1.0 / 6.0,
+        CellType::Wedge6 => 0.5,
+        _ => 4.0 / 3.0,
+    }
 }
 
 fn random_u(nodes: usize, seed: u64, amp: f64) -> Vec<[f64; 3]> {
@@ -54,7 +86,7 @@ fn shifted(u: &[[f64; 3]], dof: usize, h: f64) -> Vec<[f64; 3]> {
 
 #[test]
 fn internal_force_is_gradient_of_energy() {
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         for mat in materials() {
             let x = distorted(cell, 5);
             let geom = geometry(cell, &x);
@@ -76,7 +108,7 @@ fn internal_force_is_gradient_of_energy() {
 
 #[test]
 fn tangent_is_derivative_of_internal_force() {
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         for mat in materials() {
             let x = distorted(cell, 7);
             let geom = geometry(cell, &x);
@@ -120,7 +152,7 @@ fn tangent_on_higher_order_rule_matches_finite_differences() {
 
 #[test]
 fn linear_stiffness_is_tangent_at_rest_and_constant_for_linear() {
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         let x = distorted(cell, 9);
         let geom = geometry(cell, &x);
         let ndof = 3 * cell.nodes();
@@ -155,7 +187,7 @@ fn max_abs(v: &[f64]) -> f64 {
 
 #[test]
 fn rigid_translation_is_stress_free() {
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         let geom = geometry(cell, &distorted(cell, 11));
         let u = vec![[0.4, -0.7, 1.3]; cell.nodes()];
         for mat in materials() {
@@ -169,7 +201,7 @@ fn rigid_translation_is_stress_free() {
 fn finite_rigid_rotation_is_stress_free_for_neo_hookean() {
     let rot = Rotation3::from_euler_angles(0.9, -0.4, 1.7);
     let [lin, nh] = materials();
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         let x = distorted(cell, 12);
         let geom = geometry(cell, &x);
         let u: Vec<[f64; 3]> = x
@@ -192,11 +224,12 @@ fn finite_rigid_rotation_is_stress_free_for_neo_hookean() {
 /// ∫N n dA).
 fn boundary_vector_areas(cell: CellType, x: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let mut g = vec![[0.0; 3]; cell.nodes()];
-    for face in cell.local_faces() {
+    for (face_index, face) in cell.local_faces().iter().enumerate() {
         let xf: Vec<[f64; 3]> = face.iter().map(|&a| x[a]).collect();
         let zero = vec![[0.0; 3]; face.len()];
         let mut f = vec![0.0; 3 * face.len()];
-        follower_pressure(cell.facet_type(), &xf, &zero, -1.0, &mut f, None).unwrap();
+        let facet = cell.face_type(face_index);
+        follower_pressure(facet, &xf, &zero, -1.0, &mut f, None).unwrap();
         for (local, &a) in face.iter().enumerate() {
             for i in 0..3 {
                 g[a][i] += f[3 * local + i];
@@ -222,10 +255,19 @@ fn linear_patch_constant_stress_and_boundary_traction() {
     let g = Matrix3::from_fn(|_, _| 0.01 * rng.next());
     let c = Vector3::new(0.2, -0.1, 0.05);
     let exact_p = lin.first_piola(&(Matrix3::identity() + g)).unwrap();
-    for (cell, x) in [
+    let mut cases = vec![
         (CellType::Hex8, twisted_hex()),
         (CellType::Tet4, distorted(CellType::Tet4, 14)),
-    ] {
+    ];
+    // Second-order cells, wedges and pyramids on affine images: there the
+    // cofactor of J is constant and both integrals are exact.
+    cases.extend(
+        CellType::ALL
+            .into_iter()
+            .filter(|c| !matches!(c, CellType::Hex8 | CellType::Tet4))
+            .map(|c| (c, affine(c, 14).0)),
+    );
+    for (cell, x) in cases {
         let geom = geometry(cell, &x);
         let u: Vec<[f64; 3]> = x
             .iter()
@@ -306,6 +348,86 @@ fn volumes_are_exact() {
     }
 }
 
+/// Every type on a distorted (for the second-order types curved) cell: the
+/// volume equals ⅓ ∫ X·n dA over its faces, which the facet rules integrate
+/// exactly; with a volume rule exact for det J (the default, or the mass
+/// rule where det J has a higher degree than the default integrates: tet10,
+/// wedge15). The unit cells have their known volumes.
+#[test]
+fn volumes_of_distorted_cells_match_the_divergence_theorem() {
+    for cell in CellType::ALL {
+        let x = distorted(cell, 31);
+        let rule = match cell {
+            CellType::Tet10 | CellType::Wedge15 => QuadRule::mass_for_cell(cell).unwrap(),
+            _ => QuadRule::default_for_cell(cell),
+        };
+        let v = element_volume(&ElementGeometry::new(cell, &x, &rule).unwrap());
+        let by_surface: f64 = boundary_vector_areas(cell, &x)
+            .iter()
+            .zip(&x)
+            .map(|(g, p)| (g[0] * p[0] + g[1] * p[1] + g[2] * p[2]) / 3.0)
+            .sum();
+        println!("{}: volume {v} vs {by_surface}", cell.name());
+        assert!(
+            (v - by_surface).abs() < 1e-13,
+            "{}: {v} vs {by_surface}",
+            cell.name()
+        );
+        assert!(
+            (v - unit_volume(cell)).abs() > 1e-4,
+            "{}: not distorted",
+            cell.name()
+        );
+        let v0 = element_volume(&geometry(cell, &super::super::test_util::unit_cell(cell)));
+        assert!((v0 - unit_volume(cell)).abs() < 1e-14, "{}", cell.name());
+    }
+}
+
+/// ∫ N_a b dV sums to b V for every type, and the nodal share of an affine
+/// cell is the same for every rule at least as exact as N_a's degree.
+#[test]
+fn body_force_totals_are_b_times_volume() {
+    let b = [1.0, -2.0, 3.0];
+    for cell in CellType::ALL {
+        let x = distorted(cell, 32);
+        let geom = geometry(cell, &x);
+        let v = element_volume(&geom);
+        let mut f = vec![0.0; 3 * cell.nodes()];
+        body_force(&geom, b, &mut f).unwrap();
+        for i in 0..3 {
+            let tot: f64 = f.chunks_exact(3).map(|fa| fa[i]).sum();
+            assert!((tot - b[i] * v).abs() < 1e-13, "{} {i}", cell.name());
+        }
+        let (xa, _) = affine(cell, 33);
+        let mut f1 = vec![0.0; 3 * cell.nodes()];
+        let mut f2 = vec![0.0; 3 * cell.nodes()];
+        body_force(&geometry(cell, &xa), b, &mut f1).unwrap();
+        let rich =
+            QuadRule::mass_for_cell(cell).unwrap_or_else(|| QuadRule::default_for_cell(cell));
+        body_force(&ElementGeometry::new(cell, &xa, &rich).unwrap(), b, &mut f2).unwrap();
+        if cell != CellType::Tet4 {
+            assert!(rel_err(&f1, &f2) < 1e-13, "{}", cell.name());
+        }
+    }
+}
+
+/// A mirror image of any cell is inverted at every quadrature point.
+#[test]
+fn mirrored_cells_of_every_type_are_inverted() {
+    for cell in CellType::ALL {
+        let x: Vec<[f64; 3]> = super::super::test_util::unit_cell(cell)
+            .iter()
+            .map(|p| [-p[0], p[1], p[2]])
+            .collect();
+        let err = ElementGeometry::new(cell, &x, &QuadRule::default_for_cell(cell)).unwrap_err();
+        assert!(
+            matches!(err, FemError::InvertedElement { qp: 0, det_j } if det_j < 0.0),
+            "{}: {err:?}",
+            cell.name()
+        );
+    }
+}
+
 #[test]
 fn body_force_is_consistent() {
     let tet = distorted(CellType::Tet4, 16);
@@ -336,7 +458,7 @@ fn body_force_is_consistent() {
 
 #[test]
 fn interpolation_reproduces_linear_fields() {
-    for cell in [CellType::Hex8, CellType::Tet4] {
+    for cell in CellType::ALL {
         let x = distorted(cell, 19);
         let geom = geometry(cell, &x);
         let pts = qp_positions(&geom, &x).unwrap();

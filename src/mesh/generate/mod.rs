@@ -76,15 +76,24 @@ pub(crate) fn check_size(
     dims: &[[usize; 3]],
     cell_type: CellType,
 ) -> Result<(), MeshError> {
-    let per_hex = match cell_type {
-        CellType::Hex8 => 1,
-        CellType::Tet4 => 6,
+    let per_hex = match cell_type.linear() {
+        CellType::Tet4 | CellType::Pyramid5 => 6,
+        CellType::Wedge6 => 2,
+        _ => 1,
+    };
+    // Second-order nodes at most multiply the points by 8 (hex27: (2n+1)³;
+    // tet10 adds its face and body diagonals' mid-nodes to fewer), the
+    // pyramids' centres by 2.
+    let node_factor = match (cell_type.order(), cell_type) {
+        (2, _) => 8,
+        (_, CellType::Pyramid5) => 2,
+        _ => 1,
     };
     let product = |d: [usize; 3]| d.iter().fold(1usize, |a, &n| a.saturating_mul(n));
     let sum =
         |f: &dyn Fn([usize; 3]) -> usize| dims.iter().fold(0usize, |a, &d| a.saturating_add(f(d)));
     let cells = sum(&|d| product(d).saturating_mul(per_hex));
-    let nodes = sum(&|d| product(d.map(|n| n.saturating_add(1))));
+    let nodes = sum(&|d| product(d.map(|n| n.saturating_add(1)))).saturating_mul(node_factor);
     if cells <= MAX_CELLS && nodes <= MAX_NODES {
         return Ok(());
     }
@@ -108,12 +117,13 @@ pub(crate) fn size_field(level: u32) -> &'static str {
     }
 }
 
-/// Splits into tets when asked, then checks the result, so every generator
-/// hands out only meshes that pass [`Mesh::validate`].
+/// Converts the generated hexes to the asked cell type ([`Mesh::hex_to`]:
+/// tets, wedges, pyramids, second-order nodes), then checks the result, so
+/// every generator hands out only meshes that pass [`Mesh::validate`].
 pub(crate) fn finalize(mesh: Mesh, cell_type: CellType) -> Result<Mesh, MeshError> {
     let mesh = match cell_type {
         CellType::Hex8 => mesh,
-        CellType::Tet4 => mesh.hex_to_tets()?,
+        other => mesh.hex_to(other)?,
     };
     mesh.validate()?;
     Ok(mesh)

@@ -196,13 +196,14 @@ impl SetBuilder<'_> {
             for (i, group) in self.grouped(kind) {
                 let element = list.tags[i];
                 let at = list.locations[i];
-                if kind.nodes() != mesh.cell_type.facet_type().nodes() {
+                let faces = mesh.cell_type.single_facet_type();
+                if let Some(expected) = faces.filter(|f| f.nodes() != kind.nodes()) {
                     let kind = GmshErrorKind::FacetTypeMismatch {
                         element,
                         group,
                         found: kind.name(),
                         cells: mesh.cell_type.name(),
-                        expected: mesh.cell_type.facet_type().name(),
+                        expected: expected.name(),
                     };
                     return Err(self.ctx.error(at, kind));
                 }

@@ -5,9 +5,9 @@ use super::friction::{friction_traction, slip_increment};
 use super::input::{dof_count, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory};
 use super::kinematics::{kinematics, tangential, Frame, Kinematics};
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
+use crate::contact::facet_shape;
 use crate::contact::penalty::trial_pressure;
-use crate::fem::shape::facet_shape;
-use crate::fem::MAX_FACET_NODES;
+use crate::contact::MAX_FACET_NODES;
 
 /// The contact forces of one link (normal, plus friction when the input has
 /// it), handed to `emit(dof, value)` once per DOF. Slave node `a` gets

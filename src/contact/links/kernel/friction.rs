@@ -5,7 +5,7 @@
 use super::input::{Friction, LinkInput, SlipHistory};
 use super::kinematics::{tangential, Frame, Kinematics};
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::fem::shape::facet_shape;
+use crate::contact::facet_shape;
 
 /// `Σ N_a (v̄_a + dv_dx (x_a − x̄_a))`: the integrator's velocity, affine in
 /// the positions, interpolated with shape values `n`.

@@ -6,7 +6,8 @@
 use thiserror::Error;
 
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::FacetType;
 use crate::model::RigidSurface;
 
 /// The master as one link's kernel sees it: the current nodes of its master

@@ -4,9 +4,10 @@
 
 use super::input::{LinkInput, LinkMaster};
 use crate::contact::autodiff::{self, Scalar, Vec3};
+use crate::contact::facet_shape;
 use crate::contact::projection::mixed_second_derivative;
-use crate::fem::shape::facet_shape;
-use crate::fem::{FacetType, MAX_FACET_NODES};
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::FacetType;
 
 /// `x¹ = Σ N¹_a(ζ) x¹_a`.
 pub(super) fn slave_point<T: Scalar>(facet: FacetType, zeta: [f64; 2], x: &[Vec3<T>]) -> Vec3<T> {

@@ -172,9 +172,9 @@ fn asymmetry(k: &[f64], n: usize) -> f64 {
 }
 
 fn random_zeta(facet: FacetType, rng: &mut Lcg) -> [f64; 2] {
-    match facet {
+    match facet.linear() {
         FacetType::Quad4 => [0.9 * rng.next(), 0.9 * rng.next()],
-        FacetType::Tri3 => {
+        _ => {
             let (a, b) = (0.5 * (rng.next() + 1.0), 0.5 * (rng.next() + 1.0));
             if a + b < 1.0 {
                 [a, b]
@@ -194,18 +194,18 @@ fn perturbed(base: &[[f64; 2]], z: f64, amp: f64, rng: &mut Lcg) -> Vec<[f64; 3]
 /// Slave facet around z = z0, oriented with its outward normal −z (its
 /// body is above), arbitrarily deformed.
 fn slave_nodes(facet: FacetType, z0: f64, rng: &mut Lcg) -> Vec<[f64; 3]> {
-    let base: &[[f64; 2]] = match facet {
+    let base: &[[f64; 2]] = match facet.linear() {
         FacetType::Quad4 => &[[-0.4, -0.4], [-0.4, 0.4], [0.4, 0.4], [0.4, -0.4]],
-        FacetType::Tri3 => &[[-0.4, -0.4], [-0.2, 0.4], [0.4, -0.1]],
+        _ => &[[-0.4, -0.4], [-0.2, 0.4], [0.4, -0.1]],
     };
     perturbed(base, z0, 0.08, rng)
 }
 
 /// Warped master facet around z = 0, outward normal +z.
 fn master_nodes(facet: FacetType, rng: &mut Lcg) -> Vec<[f64; 3]> {
-    let base: &[[f64; 2]] = match facet {
+    let base: &[[f64; 2]] = match facet.linear() {
         FacetType::Quad4 => &[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
-        FacetType::Tri3 => &[[-1.0, -1.0], [1.6, -0.8], [-0.6, 1.6]],
+        _ => &[[-1.0, -1.0], [1.6, -0.8], [-0.6, 1.6]],
     };
     let mut x = perturbed(base, 0.0, 0.1, rng);
     for p in &mut x {
