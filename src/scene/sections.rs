@@ -56,6 +56,7 @@ pub struct GmshSection {
     pub file: String,
 }
 
+<<<<<<< HEAD
 /// An Abaqus/CalculiX `.inp` file (its mesh; the physics is the scene's);
 /// a relative `file` is relative to the scene file's directory, as for Gmsh.
 #[derive(Debug, Deserialize)]
@@ -64,12 +65,22 @@ pub struct InpSection {
     pub file: String,
 }
 
+=======
+/// A generator's `cell_type`: the hexes it builds, split or given
+/// second-order nodes ([`crate::mesh::Mesh::hex_to`]).
+>>>>>>> d6b72e8 (mesh/gmsh: second-order, wedge and pyramid elements read in our node order; manufactured-solution rates and the element types run on 1, 2, 3 ranks)
 #[derive(Debug, Deserialize, Clone, Copy, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum CellTypeName {
     #[default]
     Hex8,
     Tet4,
+    Tet10,
+    Hex20,
+    Hex27,
+    Wedge6,
+    Wedge15,
+    Pyramid5,
 }
 
 impl From<CellTypeName> for CellType {
@@ -77,6 +88,12 @@ impl From<CellTypeName> for CellType {
         match c {
             CellTypeName::Hex8 => CellType::Hex8,
             CellTypeName::Tet4 => CellType::Tet4,
+            CellTypeName::Tet10 => CellType::Tet10,
+            CellTypeName::Hex20 => CellType::Hex20,
+            CellTypeName::Hex27 => CellType::Hex27,
+            CellTypeName::Wedge6 => CellType::Wedge6,
+            CellTypeName::Wedge15 => CellType::Wedge15,
+            CellTypeName::Pyramid5 => CellType::Pyramid5,
         }
     }
 }

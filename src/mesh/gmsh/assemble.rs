@@ -7,7 +7,7 @@ use super::kind::Kind;
 use super::sections::{ElementList, Raw};
 use super::{GmshError, GmshErrorKind, GmshReport, Location};
 use crate::mesh::topology::face_key;
-use crate::mesh::{CellType, FacetRef, Mesh};
+use crate::mesh::{FacetRef, FacetType, Mesh};
 
 /// File name for errors found after parsing.
 pub(super) struct Ctx<'a> {
@@ -33,8 +33,8 @@ pub(super) fn assemble(raw: Raw, ctx: &Ctx) -> Result<(Mesh, GmshReport), GmshEr
         .volume_kind
         .ok_or_else(|| ctx.whole_file(GmshErrorKind::NoVolumeCells))?;
     let cell_type = match kind {
-        Kind::Hex => CellType::Hex8,
-        _ => CellType::Tet4,
+        Kind::Cell(c) => c,
+        _ => return Err(ctx.whole_file(GmshErrorKind::NoVolumeCells)),
     };
     let volumes = raw.list(kind);
     let (bodies, cell_body) = assign_bodies(&raw, volumes, ctx)?;
@@ -47,8 +47,17 @@ pub(super) fn assemble(raw: Raw, ctx: &Ctx) -> Result<(Mesh, GmshReport), GmshEr
         .filter(|(_, id)| id.is_some())
         .map(|(x, _)| *x)
         .collect();
-    // Every volume node is used, so the lookups all succeed.
-    mesh.cells = volumes.nodes.iter().filter_map(|&n| new_id[n]).collect();
+    // Every volume node is used, so the lookups all succeed; Gmsh's node
+    // order becomes ours.
+    let per = cell_type.nodes();
+    mesh.cells = match kind.to_ours() {
+        None => volumes.nodes.iter().filter_map(|&n| new_id[n]).collect(),
+        Some(order) => volumes
+            .nodes
+            .chunks_exact(per)
+            .flat_map(|e| order.iter().filter_map(|&k| new_id[e[k]]))
+            .collect(),
+    };
     mesh.cell_body = cell_body;
     mesh.bodies = bodies;
     let reoriented = orient_cells(&mut mesh, volumes, ctx)?;
@@ -191,28 +200,30 @@ impl SetBuilder<'_> {
     fn facet_sets(&self, mesh: &mut Mesh) -> Result<(), GmshError> {
         let boundary = mesh.boundary_faces_by_key();
         let mut facet_sets: BTreeMap<String, Vec<FacetRef>> = BTreeMap::new();
-        for kind in [Kind::Tri, Kind::Quad] {
+        for facet_type in FacetType::ALL {
+            let kind = Kind::Facet(facet_type);
             let list = self.raw.list(kind);
             for (i, group) in self.grouped(kind) {
                 let element = list.tags[i];
                 let at = list.locations[i];
-                let faces = mesh.cell_type.single_facet_type();
-                if let Some(expected) = faces.filter(|f| f.nodes() != kind.nodes()) {
+                let nodes = self.element_nodes(list, i, kind.nodes(), &group)?;
+                let corners = &nodes[..facet_type.corners()];
+                let facet = boundary.get(&face_key(corners.iter().copied()));
+                let Some(&facet) = facet else {
+                    let kind = GmshErrorKind::FacetNotOnCell { element, group };
+                    return Err(self.ctx.error(at, kind));
+                };
+                let expected = mesh.facet_type(&facet);
+                if expected != facet_type {
                     let kind = GmshErrorKind::FacetTypeMismatch {
                         element,
                         group,
-                        found: kind.name(),
+                        found: facet_type.name(),
                         cells: mesh.cell_type.name(),
                         expected: expected.name(),
                     };
                     return Err(self.ctx.error(at, kind));
                 }
-                let nodes = self.element_nodes(list, i, kind.nodes(), &group)?;
-                let facet = boundary.get(&face_key(nodes.iter().copied()));
-                let Some(&facet) = facet else {
-                    let kind = GmshErrorKind::FacetNotOnCell { element, group };
-                    return Err(self.ctx.error(at, kind));
-                };
                 insert_nodes(&mut mesh.node_sets, &group, &nodes);
                 facet_sets.entry(group).or_default().push(facet);
             }
@@ -227,7 +238,7 @@ impl SetBuilder<'_> {
     }
 
     fn node_sets(&self, mesh: &mut Mesh) -> Result<(), GmshError> {
-        for kind in [Kind::Point, Kind::Line] {
+        for kind in [Kind::Point, Kind::Line, Kind::Line3] {
             let list = self.raw.list(kind);
             for (i, group) in self.grouped(kind) {
                 let nodes = self.element_nodes(list, i, kind.nodes(), &group)?;

@@ -2,18 +2,27 @@
 //!
 //! What becomes what:
 //!
-//! * Volume elements: tet4 (Gmsh type 4) or hex8 (type 5), one type per file
-//!   (the solver holds one cell type per mesh). Gmsh numbers both like VTK,
-//!   which is the node order of [`CellType`], so connectivity is taken as is;
-//!   cells that come fully inverted are renumbered and counted in
+//! * Volume elements of one type per file (the solver holds one cell type
+//!   per mesh): tet4 (Gmsh type 4), tet10 (11), hex8 (5), hex20 (17), hex27
+//!   (12), prism6 (6, our wedge6), prism15 (18, wedge15), pyramid5 (7).
+//!   Gmsh's node order is ours ([`CellType`]) except for the mid-edge nodes
+//!   of tet10, hex20, hex27, prism15 and hex27's face centres, which are
+//!   renumbered (`crate::fem::GMSH_TET10` and its kin). Cells that come
+//!   fully inverted are renumbered ([`CellType::mirror`]) and counted in
 //!   [`GmshReport::reoriented`], tangled ones are an error.
+//! * Second-order meshes (`gmsh -order 2`) place their mid-edge nodes on the
+//!   curved geometry; a node far off its edge is an error of the mesh
+//!   ([`crate::mesh::MeshError::MidNodeOffEdge`]). Prism18 (the complete
+//!   quadratic prism) is not read: `Mesh.SecondOrderIncomplete = 1` makes
+//!   Gmsh write prism15 (and hex20 instead of hex27).
 //! * Each 3D physical group is one body named by its physical name. Without
 //!   any 3D physical group, each volume entity is a body `volume<tag>`.
-//! * Each 2D physical group is a facet set (its tri3/quad4 elements matched
+//! * Each 2D physical group is a facet set (its tri3/quad4 (tri6, quad8,
+//!   quad9 in a second-order mesh) elements matched
 //!   to boundary faces of the cells, so facets carry the outward orientation
 //!   of their cell whatever Gmsh's surface orientation) and a node set of the
 //!   same name.
-//! * 0D and 1D physical groups (points, line2) are node sets.
+//! * 0D and 1D physical groups (points, line2, line3) are node sets.
 //!
 //! Physical names are used verbatim as set and body names. The solver's
 //! convention is `<body>.<face>` (`block.top`, `sphere.curved`), so name the
@@ -121,13 +130,13 @@ pub enum GmshErrorKind {
     DuplicateNode { node: u64 },
     #[error("element {element} refers to node {node} which is not in $Nodes")]
     UnknownNode { element: u64, node: u64 },
-    #[error("element {element} has type {gmsh_type} ({name}), which is not supported: use tet4 (4) or hex8 (5) volumes, tri3 (2)/quad4 (3) surfaces, points (15) and line2 (1) for node sets (first order: gmsh -order 1)")]
+    #[error("element {element} has type {gmsh_type} ({name}), which is not supported: use tet4 (4), tet10 (11), hex8 (5), hex20 (17), hex27 (12), prism6 (6), prism15 (18) or pyramid5 (7) volumes, tri3 (2), quad4 (3), tri6 (9), quad8 (16) or quad9 (10) surfaces, points (15) and line2 (1) or line3 (8) for node sets (at most second order; prism15 rather than prism18: Mesh.SecondOrderIncomplete = 1)")]
     UnsupportedElement {
         element: u64,
         gmsh_type: i32,
         name: &'static str,
     },
-    #[error("element {element} is a {found} but earlier volume elements are {first}: the solver needs one cell type per mesh (mesh all volumes with tets, or all with hexes)")]
+    #[error("element {element} is a {found} but earlier volume elements are {first}: the solver needs one cell type per mesh (mesh all volumes with one type, e.g. all tets or all hexes, of one order)")]
     MixedCellTypes {
         element: u64,
         first: &'static str,

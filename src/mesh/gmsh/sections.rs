@@ -35,7 +35,7 @@ pub(super) struct Raw {
     pub(super) coords: Vec<Vec3>,
     pub(super) nodes_read: bool,
     /// One list per [`Kind`], indexed by `Kind::index`.
-    pub(super) elements: [ElementList; 6],
+    pub(super) elements: [ElementList; Kind::ALL.len()],
     pub(super) volume_kind: Option<Kind>,
     pub(super) skipped: Vec<String>,
 }
@@ -312,7 +312,7 @@ fn read_element_block(c: &mut Cursor, raw: &mut Raw) -> Result<(), GmshError> {
     let Some(kind) = Kind::from_gmsh(gmsh_type) else {
         return reject_block(c, n, gmsh_type);
     };
-    let mut ids = [0usize; 8];
+    let mut ids = [0usize; crate::fem::MAX_CELL_NODES];
     for _ in 0..n {
         let at = c.start();
         let tag = c.size("an element tag")?;

@@ -213,6 +213,52 @@ fn kinds_are_consistent() {
     for k in Kind::ALL {
         assert_eq!(Kind::ALL[k.index()], k);
     }
-    assert_eq!(Kind::Tet.nodes(), CellType::Tet4.nodes());
-    assert_eq!(Kind::Hex.nodes(), CellType::Hex8.nodes());
+    for c in CellType::ALL {
+        assert!(Kind::ALL.contains(&Kind::Cell(c)), "{}", c.name());
+        assert_eq!(Kind::Cell(c).nodes(), c.nodes());
+    }
+    for f in crate::mesh::FacetType::ALL {
+        assert!(Kind::ALL.contains(&Kind::Facet(f)), "{}", f.name());
+    }
+    assert_eq!(Kind::from_gmsh(18), Some(Kind::Cell(CellType::Wedge15)));
+    assert_eq!(Kind::from_gmsh(13), None);
+}
+
+/// One pyramid (Gmsh type 7): base counter-clockwise seen from the apex,
+/// our order; given the other way round it is reversed and counted.
+const PYRAMID: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Nodes
+1 5 1 5
+3 1 0 5
+1
+2
+3
+4
+5
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0.5 0.5 1
+$EndNodes
+$Elements
+1 1 1 1
+3 1 7 1
+1 1 2 3 4 5
+$EndElements
+";
+
+#[test]
+fn reads_a_pyramid_and_reverses_a_mirrored_one() {
+    let (mesh, report) = parse(PYRAMID).unwrap();
+    assert_eq!(mesh.cell_type, CellType::Pyramid5);
+    assert_eq!(mesh.cells, vec![0, 1, 2, 3, 4]);
+    assert_eq!(report.reoriented, 0);
+    assert!((mesh.cell_volume(0).unwrap() - 1.0 / 3.0).abs() < 1e-15);
+    let text = PYRAMID.replace("1 1 2 3 4 5\n", "1 1 4 3 2 5\n");
+    let (flipped, report) = parse(&text).unwrap();
+    assert_eq!(report.reoriented, 1);
+    assert!((flipped.cell_volume(0).unwrap() - 1.0 / 3.0).abs() < 1e-15);
 }

@@ -4,6 +4,7 @@ mod basics;
 mod cells;
 mod generators;
 mod hertz;
+mod orders;
 mod tets;
 
 use std::collections::{BTreeSet, HashMap};
