@@ -272,13 +272,20 @@ pub fn second_order_elements_converge_at_their_order(rt: &Runtime) -> Result<(),
         let rate = |a: f64, b: f64| (a / b).log2();
         let l2: Vec<f64> = errors.windows(2).map(|w| rate(w[0].0, w[1].0)).collect();
         let en: Vec<f64> = errors.windows(2).map(|w| rate(w[0].1, w[1].1)).collect();
-        let fmt = |v: &[f64], f: &dyn Fn(&f64) -> String| v.iter().map(f).collect::<Vec<_>>().join(", ");
+        let fmt =
+            |v: &[f64], f: &dyn Fn(&f64) -> String| v.iter().map(f).collect::<Vec<_>>().join(", ");
         println!(
             "  {}: L2 errors [{}] rates [{}]; energy errors [{}] rates [{}]",
             cell.name(),
-            fmt(&errors.iter().map(|e| e.0).collect::<Vec<_>>(), &|e| format!("{e:.3e}")),
+            fmt(
+                &errors.iter().map(|e| e.0).collect::<Vec<_>>(),
+                &|e| format!("{e:.3e}")
+            ),
             fmt(&l2, &|r| format!("{r:.3}")),
-            fmt(&errors.iter().map(|e| e.1).collect::<Vec<_>>(), &|e| format!("{e:.3e}")),
+            fmt(
+                &errors.iter().map(|e| e.1).collect::<Vec<_>>(),
+                &|e| format!("{e:.3e}")
+            ),
             fmt(&en, &|r| format!("{r:.3}")),
         );
         let near = |r: &f64, p: f64| (r - p).abs() <= 0.15;

@@ -76,9 +76,20 @@ fn every_new_cell_type_runs_alike_on_one_two_and_three_ranks() {
         let mut displacement = Vec::new();
         for n in [1, 2, 3] {
             let out = dir.join(format!("{}-{n}.h5", cell.name()));
-            let args = ["run", path.to_str().unwrap(), "-q", "-o", out.to_str().unwrap()];
+            let args = [
+                "run",
+                path.to_str().unwrap(),
+                "-q",
+                "-o",
+                out.to_str().unwrap(),
+            ];
             let o = if n == 1 { run(&args) } else { mpirun(n, &args) };
-            assert!(o.status.success(), "{} on {n} ranks: {}", cell.name(), text(&o));
+            assert!(
+                o.status.success(),
+                "{} on {n} ranks: {}",
+                cell.name(),
+                text(&o)
+            );
             let step = *list_steps(&out).unwrap().last().unwrap();
             let (u, _, _) = read_nodal(&out, step, layout::DISPLACEMENT).unwrap();
             displacement.push(u);
@@ -100,7 +111,12 @@ fn every_new_cell_type_runs_alike_on_one_two_and_three_ranks() {
         }
         for (k, u) in displacement.iter().enumerate().skip(1) {
             let d = relative_difference(&displacement[0], u);
-            assert!(d < 1e-10, "{}: {} ranks differ by {d:e}", cell.name(), k + 1);
+            assert!(
+                d < 1e-10,
+                "{}: {} ranks differ by {d:e}",
+                cell.name(),
+                k + 1
+            );
         }
     }
 }
@@ -128,7 +144,11 @@ fn check_file(h5: &Path, cell: CellType) {
         _ => unreachable!(),
     };
     let needle = format!("TopologyType=\"{topology}\"");
-    assert!(xmf.contains(&needle), "{}: {needle} not in the sidecar", cell.name());
+    assert!(
+        xmf.contains(&needle),
+        "{}: {needle} not in the sidecar",
+        cell.name()
+    );
     assert!(xmf.contains(&format!("NodesPerElement=\"{}\"", cell.nodes())));
     if cell.linear() == CellType::Wedge6 {
         let (x, _) = read_dataset::<f64>(h5, layout::MESH_NODES).unwrap();
@@ -143,6 +163,9 @@ fn check_file(h5: &Path, cell: CellType) {
             a[2] * b[0] - a[0] * b[2],
             a[0] * b[1] - a[1] * b[0],
         ];
-        assert!(n[0] * c[0] + n[1] * c[1] + n[2] * c[2] < 0.0, "not VTK's wedge");
+        assert!(
+            n[0] * c[0] + n[1] * c[1] + n[2] * c[2] < 0.0,
+            "not VTK's wedge"
+        );
     }
 }

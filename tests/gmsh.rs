@@ -110,11 +110,11 @@ fn assert_higher_nodes_in_place(mesh: &Mesh) {
     for ids in mesh.cells_iter() {
         for (k, of) in cell.higher_nodes().iter().enumerate() {
             let x = mesh.nodes[ids[cell.corners() + k]];
-            for i in 0..3 {
-                let mean: f64 = of.iter().map(|&a| mesh.nodes[ids[a]][i]).sum::<f64>()
-                    / of.len() as f64;
+            for (i, xi) in x.iter().enumerate() {
+                let mean: f64 =
+                    of.iter().map(|&a| mesh.nodes[ids[a]][i]).sum::<f64>() / of.len() as f64;
                 assert!(
-                    (x[i] - mean).abs() < 1e-9,
+                    (xi - mean).abs() < 1e-9,
                     "{}: node {} is not between {of:?}",
                     cell.name(),
                     cell.corners() + k
@@ -177,8 +177,16 @@ fn prisms_are_read_as_wedges() {
         assert_higher_nodes_in_place(&mesh);
         let v = mesh.body_volume(0).unwrap();
         assert!((v - 2.0).abs() < 1e-12, "{name}: volume {v}");
-        let tri = if cell == CellType::Wedge6 { FacetType::Tri3 } else { FacetType::Tri6 };
-        let quad = if cell == CellType::Wedge6 { FacetType::Quad4 } else { FacetType::Quad8 };
+        let tri = if cell == CellType::Wedge6 {
+            FacetType::Tri3
+        } else {
+            FacetType::Tri6
+        };
+        let quad = if cell == CellType::Wedge6 {
+            FacetType::Quad4
+        } else {
+            FacetType::Quad8
+        };
         assert_eq!(mesh.facet_set_types("block.top").unwrap(), [tri]);
         assert_eq!(mesh.facet_set_types("block.xmin").unwrap(), [quad]);
         assert_normals(&mesh, "block.top", [0.0, 0.0, 1.0]);

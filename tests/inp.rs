@@ -420,10 +420,10 @@ const CUBE: &str = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n\
 #[test]
 fn bad_inp_files_fail_check_in_one_line_naming_file_and_line() {
     check_fails(
-        "inp-bad-c3d10",
-        &format!("{CUBE}*ELEMENT, TYPE=C3D10, ELSET=B\n"),
+        "inp-bad-c3d27",
+        &format!("{CUBE}*ELEMENT, TYPE=C3D27, ELSET=B\n"),
         &["B"],
-        &["part.inp, line 10: C3D10 elements are not supported yet"],
+        &["part.inp, line 10: C3D27 elements are not supported"],
     );
     check_fails(
         "inp-bad-coordinate",

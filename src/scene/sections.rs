@@ -56,7 +56,6 @@ pub struct GmshSection {
     pub file: String,
 }
 
-<<<<<<< HEAD
 /// An Abaqus/CalculiX `.inp` file (its mesh; the physics is the scene's);
 /// a relative `file` is relative to the scene file's directory, as for Gmsh.
 #[derive(Debug, Deserialize)]
@@ -65,10 +64,8 @@ pub struct InpSection {
     pub file: String,
 }
 
-=======
 /// A generator's `cell_type`: the hexes it builds, split or given
 /// second-order nodes ([`crate::mesh::Mesh::hex_to`]).
->>>>>>> d6b72e8 (mesh/gmsh: second-order, wedge and pyramid elements read in our node order; manufactured-solution rates and the element types run on 1, 2, 3 ranks)
 #[derive(Debug, Deserialize, Clone, Copy, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum CellTypeName {

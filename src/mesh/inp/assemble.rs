@@ -316,30 +316,32 @@ fn facet_sets(
     let boundary = mesh.boundary_faces_by_key();
     let kinds = &num.raw.elements.kinds;
     let mut facet_of: Vec<Option<FacetRef>> = vec![None; kinds.len()];
-    let expected = mesh.cell_type.facet_type();
     for (e, kind) in kinds.iter().enumerate() {
-        let Kind::Facet(n) = *kind else {
+        let Kind::Facet(found) = *kind else {
             continue;
         };
         let (ty, set) = num.type_and_set(e);
         let element = num.id(e);
-        if n != expected.nodes() {
-            let kind = InpErrorKind::FacetTypeMismatch {
-                ty,
-                element,
-                set,
-                found: n,
-                cells: mesh.cell_type,
-            };
-            return Err(num.fail(e, kind));
-        }
-        let facet = num
-            .mesh_nodes(e)
-            .and_then(|nodes| boundary.get(&face_key(nodes.into_iter())));
+        let facet = num.mesh_nodes(e).and_then(|nodes| {
+            let corners = nodes.get(..found.corners())?;
+            boundary.get(&face_key(corners.iter().copied()))
+        });
         let Some(&facet) = facet else {
             let kind = InpErrorKind::FacetNotOnCell { ty, element, set };
             return Err(num.fail(e, kind));
         };
+        let expected = mesh.facet_type(&facet);
+        if found != expected {
+            let kind = InpErrorKind::FacetTypeMismatch {
+                ty,
+                element,
+                set,
+                found,
+                cells: mesh.cell_type,
+                expected,
+            };
+            return Err(num.fail(e, kind));
+        }
         facet_of[e] = Some(facet);
     }
     let mut out: BTreeMap<String, (String, Vec<FacetRef>)> = BTreeMap::new();
@@ -378,11 +380,12 @@ fn local_face(mesh: &Mesh, num: &Numbering, surface: &str, (e, k): Face) -> Resu
     let found = cell.zip(nodes).zip(local).and_then(|((c, nodes), local)| {
         let key = face_key(local.iter().filter_map(|&l| nodes.get(l).copied()));
         let ids = mesh.try_cell(c).ok()?;
-        let faces = mesh.cell_type.local_faces();
-        // The local face tables index within the cell's nodes.
-        let face = faces
-            .iter()
-            .position(|f| face_key(f.iter().map(|&l| ids[l])) == key)?;
+        let cell_type = mesh.cell_type;
+        // The local face tables index within the cell's nodes, corners first.
+        let face = (0..cell_type.local_faces().len()).position(|f| {
+            let corners = &cell_type.local_faces()[f][..cell_type.face_type(f).corners()];
+            face_key(corners.iter().map(|&l| ids[l])) == key
+        })?;
         Some(FacetRef {
             cell: c,
             face: u8::try_from(face).ok()?,

@@ -4,7 +4,7 @@
 use thiserror::Error;
 
 use super::kind;
-use crate::mesh::{CellType, MeshError};
+use crate::mesh::{CellType, FacetType, MeshError};
 
 /// An error of the reader: the file, the line when there is one, and what.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -71,17 +71,17 @@ pub enum InpErrorKind {
     },
     #[error("element {element} refers to node {node}, which no *NODE line defines")]
     UnknownNode { element: u64, node: u64 },
-    #[error("{ty} elements are not supported yet: this program reads first-order C3D4 and C3D8 (C3D8R, C3D8I) cells")]
-    NotYet { ty: String },
-    #[error("{ty} elements ({what}) in element set {set} are not supported: the mesh is volumes of C3D4 or C3D8 cells, triangles or quadrilaterals on their faces, and sets")]
+    #[error("{ty} elements are not supported: this program reads C3D4, C3D10, C3D6, C3D15, C3D8 (C3D8R, C3D8I) and C3D20 (C3D20R) cells")]
+    OtherVolume { ty: String },
+    #[error("{ty} elements ({what}) in element set {set} are not supported: the mesh is volumes of C3D4, C3D10, C3D6, C3D15, C3D8 or C3D20 cells, triangles or quadrilaterals on their faces, and sets")]
     Unsupported {
         ty: String,
         what: &'static str,
         set: String,
     },
-    #[error("element type {0} is not known to this reader (it reads C3D4, C3D8, C3D8R, C3D8I and the triangles and quadrilaterals S3, S4, S4R, CPS3, CPS4, CPE3, CPE4, M3D3, M3D4, SFM3D3, SFM3D4 on their faces)")]
+    #[error("element type {0} is not known to this reader (it reads C3D4, C3D10, C3D6, C3D15, C3D8, C3D8R, C3D8I, C3D20, C3D20R and the triangles and quadrilaterals S3, S4, S4R, S6, S8, S8R, CPS3, CPS4, CPS6, CPS8, CPE3, CPE4, M3D3, M3D4, M3D9, SFM3D3, SFM3D4 and kin on their faces)")]
     UnknownType(String),
-    #[error("element {element} is a {found} cell but element {first} (line {first_line}) is a {first_type}: a mesh holds one cell type today (mesh all volumes with tetrahedra, or all with hexahedra)")]
+    #[error("element {element} is a {found} cell but element {first} (line {first_line}) is a {first_type}: a mesh holds one cell type today (mesh all volumes with one type of one order)")]
     MixedCellTypes {
         element: u64,
         found: &'static str,
@@ -89,7 +89,9 @@ pub enum InpErrorKind {
         first_line: usize,
         first_type: &'static str,
     },
-    #[error("no 3D elements (C3D4 or C3D8): the file holds no volume mesh")]
+    #[error(
+        "no 3D elements (C3D4, C3D10, C3D6, C3D15, C3D8, C3D20): the file holds no volume mesh"
+    )]
     NoVolumeCells,
     #[error("{kind} {name} is not defined above this line")]
     UnknownSet { kind: &'static str, name: String },
@@ -112,7 +114,7 @@ pub enum InpErrorKind {
         element: u64,
         ty: String,
     },
-    #[error("surface {surface}: element {element} is a {ty}, not a 3D element: *SURFACE faces are faces of C3D4 or C3D8 elements")]
+    #[error("surface {surface}: element {element} is a {ty}, not a 3D element: *SURFACE faces are faces of 3D elements")]
     FaceOfNonCell {
         surface: String,
         element: u64,
@@ -126,13 +128,14 @@ pub enum InpErrorKind {
         element: u64,
         set: String,
     },
-    #[error("{ty} element {element} of element set {set} has {found} nodes, but the faces of {} cells are {}", cells.name(), cells.facet_type().name())]
+    #[error("{ty} element {element} of element set {set} is a {}, but the face of the {} cell it lies on is a {}", found.name(), cells.name(), expected.name())]
     FacetTypeMismatch {
         ty: String,
         element: u64,
         set: String,
-        found: usize,
+        found: FacetType,
         cells: CellType,
+        expected: FacetType,
     },
     #[error("no element set {name} of 3D elements for the body {name} (element sets of 3D elements: {known})")]
     UnknownBodySet { name: String, known: String },

@@ -1,22 +1,22 @@
 //! The Abaqus element types: what the reader makes of each, and the face
 //! numbering S1..S6 of the 3D ones.
 
-use crate::mesh::CellType;
+use crate::mesh::{CellType, FacetType};
 
 /// What an element read becomes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kind {
     /// A volume cell of the mesh.
     Cell(CellType),
-    /// A triangle (3) or quadrilateral (4) that must be a face of a cell.
-    Facet(usize),
+    /// A surface element that must be a face of a cell.
+    Facet(FacetType),
 }
 
 impl Kind {
     pub(super) fn nodes(self) -> usize {
         match self {
             Kind::Cell(c) => c.nodes(),
-            Kind::Facet(n) => n,
+            Kind::Facet(f) => f.nodes(),
         }
     }
 }
@@ -25,11 +25,8 @@ impl Kind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Class {
     Read(Kind),
-    /// A type the program will read once it has the cells (second-order and
-    /// other 3D shapes, and the second-order facets on their faces).
-    NotYet {
-        volume: bool,
-    },
+    /// A 3D type the program does not have the cell of (C3D27, C3D13, ...).
+    OtherVolume,
     /// A type that is no volume or face: beams, trusses, springs, ...
     Unsupported(&'static str),
     Unknown,
@@ -40,14 +37,21 @@ pub(super) fn classify(ty: &str) -> Class {
     use Class::*;
     match ty {
         "C3D4" => Read(Kind::Cell(CellType::Tet4)),
+        "C3D10" => Read(Kind::Cell(CellType::Tet10)),
+        "C3D6" => Read(Kind::Cell(CellType::Wedge6)),
+        "C3D15" => Read(Kind::Cell(CellType::Wedge15)),
         "C3D8" | "C3D8R" | "C3D8I" => Read(Kind::Cell(CellType::Hex8)),
-        "S3" | "S3R" | "STRI3" | "CPS3" | "CPE3" | "M3D3" | "SFM3D3" => Read(Kind::Facet(3)),
+        "C3D20" | "C3D20R" => Read(Kind::Cell(CellType::Hex20)),
+        "S3" | "S3R" | "STRI3" | "CPS3" | "CPE3" | "M3D3" | "SFM3D3" => {
+            Read(Kind::Facet(FacetType::Tri3))
+        }
         "S4" | "S4R" | "S4R5" | "CPS4" | "CPS4R" | "CPE4" | "CPE4R" | "M3D4" | "M3D4R"
-        | "SFM3D4" | "SFM3D4R" => Read(Kind::Facet(4)),
-        "S6" | "S8" | "S8R" | "S8R5" | "S9R5" | "STRI65" | "CPS6" | "CPS8" | "CPS8R" | "CPE6"
-        | "CPE8" | "CPE8R" | "M3D6" | "M3D8" | "M3D8R" | "M3D9" | "SFM3D6" | "SFM3D8"
-        | "SFM3D8R" => NotYet { volume: false },
-        _ if ty.starts_with("C3D") => NotYet { volume: true },
+        | "SFM3D4" | "SFM3D4R" => Read(Kind::Facet(FacetType::Quad4)),
+        "S6" | "STRI65" | "CPS6" | "CPE6" | "M3D6" | "SFM3D6" => Read(Kind::Facet(FacetType::Tri6)),
+        "S8" | "S8R" | "S8R5" | "CPS8" | "CPS8R" | "CPE8" | "CPE8R" | "M3D8" | "M3D8R"
+        | "SFM3D8" | "SFM3D8R" => Read(Kind::Facet(FacetType::Quad8)),
+        "S9R5" | "M3D9" => Read(Kind::Facet(FacetType::Quad9)),
+        _ if ty.starts_with("C3D") => OtherVolume,
         _ if numbered(ty, "B") => Unsupported("beams"),
         _ if numbered(ty, "T") => Unsupported("trusses"),
         _ if ty.starts_with("CAX") || ty.starts_with("CGAX") => Unsupported("axisymmetric"),
@@ -73,11 +77,13 @@ fn numbered(ty: &str, letter: &str) -> bool {
         .is_some_and(|c| c.is_ascii_digit())
 }
 
-/// The faces S1, S2, ... of an Abaqus 3D element as local node indices (from
-/// 0), as the Abaqus and CalculiX manuals number them. Their orientation is
-/// not used: a face is found among [`CellType::local_faces`] by its nodes.
+/// The faces S1, S2, ... of an Abaqus 3D element as the local indices of
+/// their corners (from 0), as the Abaqus and CalculiX manuals number them;
+/// a second-order element's faces are its linear kin's. Their orientation
+/// is not used: a face is found among [`CellType::local_faces`] by its
+/// corners.
 pub(super) fn abaqus_faces(cell: CellType) -> &'static [&'static [usize]] {
-    match cell {
+    match cell.linear() {
         CellType::Hex8 => &[
             &[0, 1, 2, 3],
             &[4, 7, 6, 5],
@@ -87,6 +93,15 @@ pub(super) fn abaqus_faces(cell: CellType) -> &'static [&'static [usize]] {
             &[3, 7, 4, 0],
         ],
         CellType::Tet4 => &[&[0, 1, 2], &[0, 3, 1], &[1, 3, 2], &[2, 3, 0]],
+        CellType::Wedge6 => &[
+            &[0, 1, 2],
+            &[3, 5, 4],
+            &[0, 3, 4, 1],
+            &[1, 4, 5, 2],
+            &[2, 5, 3, 0],
+        ],
+        // No Abaqus type is read as a pyramid.
+        _ => &[],
     }
 }
 

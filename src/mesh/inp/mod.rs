@@ -14,14 +14,17 @@
 //! * `*NODE` (optionally `NSET=`): nodes with arbitrary positive ids, sparse
 //!   and in any order. Nodes that no 3D element uses are dropped, the rest
 //!   numbered from 0 in file order; messages keep the file's ids.
-//! * `*ELEMENT, TYPE=..` (optionally `ELSET=`): C3D4 cells (tet4) or C3D8,
-//!   C3D8R, C3D8I cells (hex8; the program's full integration), one cell
-//!   type per file. Abaqus numbers both as [`CellType`](crate::mesh::CellType) does; fully inverted
-//!   cells are renumbered and counted, tangled ones are an error. Triangles
-//!   and quadrilaterals (S3, S4, S4R, CPS3, CPS4, M3D3, ...: what meshers
-//!   write for boundary groups) must each be a boundary face of a cell, matched
-//!   by their nodes. Second-order and other 3D types, beams, trusses, springs
-//!   and unknown types are one error naming the type, file and line.
+//! * `*ELEMENT, TYPE=..` (optionally `ELSET=`): C3D4 (tet4), C3D10 (tet10),
+//!   C3D6 (wedge6), C3D15 (wedge15), C3D8, C3D8R, C3D8I (hex8) and C3D20,
+//!   C3D20R (hex20) cells, integrated by the program's rules for the cell
+//!   (R and I name Abaqus' variants, not ours), one cell type per file.
+//!   Abaqus numbers them as [`CellType`](crate::mesh::CellType) does; fully
+//!   inverted cells are renumbered and counted, tangled ones are an error.
+//!   Triangles and quadrilaterals of first and second order (S3, S4, S6,
+//!   S8, CPS3, CPS6, M3D9, ...: what meshers write for boundary groups) must
+//!   each be a boundary face of a cell, matched by their corners and of the
+//!   face's type. Other 3D types (C3D27, ...), beams, trusses, springs and
+//!   unknown types are one error naming the type, file and line.
 //! * Bodies are element sets: the sets the scene's `[[body]]` names give (a
 //!   3D element in none of them, or in two, is an error naming it); without
 //!   names, each `ELSET=` of the `*ELEMENT` lines of 3D elements (`EALL` for
@@ -32,7 +35,9 @@
 //! * `*SURFACE, TYPE=ELEMENT` (the default): lines `element or set, S1..S6`,
 //!   faces numbered as Abaqus does (C3D8: S1 = 1-2-3-4, S2 = 5-8-7-6, S3 =
 //!   1-5-6-2, S4 = 2-6-7-3, S5 = 3-7-8-4, S6 = 4-8-5-1; C3D4: S1 = 1-2-3,
-//!   S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1), a facet set and a node set.
+//!   S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1; C3D6: S1 = 1-2-3, S2 = 4-6-5, S3 =
+//!   1-4-5-2, S4 = 2-5-6-3, S5 = 3-6-4-1; second-order types as their
+//!   corners), a facet set and a node set.
 //!   `*SURFACE, TYPE=NODE`: a node set.
 //! * A set name used inside a list must be defined above it (as CalculiX
 //!   reads); a set named twice collects both. A node set wins over a facet

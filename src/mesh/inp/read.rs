@@ -239,9 +239,9 @@ impl Raw {
         let elset = k.value("ELSET").map(str::to_string);
         let kind = match classify(&ty) {
             Class::Read(kind) => kind,
-            Class::NotYet { volume } => {
-                let fail = Fail::at(k.at, InpErrorKind::NotYet { ty });
-                return self.defer(fail, volume);
+            Class::OtherVolume => {
+                let fail = Fail::at(k.at, InpErrorKind::OtherVolume { ty });
+                return self.defer(fail, true);
             }
             Class::Unsupported(what) => {
                 let set = elset.unwrap_or_else(|| "(none)".into());

@@ -40,7 +40,11 @@ fn every_type_fills_the_box_with_the_expected_cells_and_nodes() {
     for cell_type in CellType::ALL {
         let mesh = unit_box(cell_type, n);
         mesh.validate().unwrap();
-        assert!(rel_err(body_volume(&mesh, "block"), 3.0) < 1e-12, "{}", cell_type.name());
+        assert!(
+            rel_err(body_volume(&mesh, "block"), 3.0) < 1e-12,
+            "{}",
+            cell_type.name()
+        );
         let (cells, nodes) = match cell_type {
             CellType::Hex8 => (hexes, corners),
             CellType::Hex20 => (hexes, corners + edges),
@@ -69,7 +73,11 @@ fn every_type_fills_the_box_with_the_expected_cells_and_nodes() {
             assert_eq!(nodes, on.as_slice(), "{} {set}", cell_type.name());
         }
         let quality = mesh.min_scaled_jacobian().unwrap();
-        assert!(quality > 0.0 && quality <= 1.0 + 1e-12, "{} {quality}", cell_type.name());
+        assert!(
+            quality > 0.0 && quality <= 1.0 + 1e-12,
+            "{} {quality}",
+            cell_type.name()
+        );
         let bb = mesh.bounding_box().unwrap();
         assert_eq!((bb.min, bb.max), ([0.0; 3], [1.0, 2.0, 1.5]));
     }
@@ -78,12 +86,24 @@ fn every_type_fills_the_box_with_the_expected_cells_and_nodes() {
 #[test]
 fn wedges_have_triangles_on_zeta_sides_and_pyramids_quads_outside() {
     let wedge = unit_box(CellType::Wedge6, [2, 2, 2]);
-    assert_eq!(wedge.facet_set_types("block.zmax").unwrap(), [FacetType::Tri3]);
-    assert_eq!(wedge.facet_set_types("block.xmin").unwrap(), [FacetType::Quad4]);
+    assert_eq!(
+        wedge.facet_set_types("block.zmax").unwrap(),
+        [FacetType::Tri3]
+    );
+    assert_eq!(
+        wedge.facet_set_types("block.xmin").unwrap(),
+        [FacetType::Quad4]
+    );
     assert_eq!(wedge.facet_set("block.zmax").unwrap().len(), 8);
     let wedge15 = unit_box(CellType::Wedge15, [2, 2, 2]);
-    assert_eq!(wedge15.facet_set_types("block.zmin").unwrap(), [FacetType::Tri6]);
-    assert_eq!(wedge15.facet_set_types("block.ymin").unwrap(), [FacetType::Quad8]);
+    assert_eq!(
+        wedge15.facet_set_types("block.zmin").unwrap(),
+        [FacetType::Tri6]
+    );
+    assert_eq!(
+        wedge15.facet_set_types("block.ymin").unwrap(),
+        [FacetType::Quad8]
+    );
     let pyramid = unit_box(CellType::Pyramid5, [2, 2, 2]);
     for side in ["xmin", "zmax"] {
         let set = format!("block.{side}");
@@ -91,7 +111,9 @@ fn wedges_have_triangles_on_zeta_sides_and_pyramids_quads_outside() {
         assert_eq!(pyramid.facet_set(&set).unwrap().len(), 4);
     }
     assert_eq!(
-        unit_box(CellType::Hex27, [1, 1, 1]).facet_set_types("block.top").unwrap(),
+        unit_box(CellType::Hex27, [1, 1, 1])
+            .facet_set_types("block.top")
+            .unwrap(),
         [FacetType::Quad9]
     );
 }
@@ -100,7 +122,12 @@ fn wedges_have_triangles_on_zeta_sides_and_pyramids_quads_outside() {
 /// are shared: each cell's mid-edge node is its neighbour's.
 #[test]
 fn higher_nodes_sit_at_their_corners_mean_and_are_shared() {
-    for cell_type in [CellType::Tet10, CellType::Hex20, CellType::Hex27, CellType::Wedge15] {
+    for cell_type in [
+        CellType::Tet10,
+        CellType::Hex20,
+        CellType::Hex27,
+        CellType::Wedge15,
+    ] {
         let mesh = unit_box(cell_type, [2, 2, 1]);
         let mut by_key = std::collections::HashMap::new();
         for ids in mesh.cells_iter() {
@@ -108,8 +135,8 @@ fn higher_nodes_sit_at_their_corners_mean_and_are_shared() {
                 let node = ids[cell_type.corners() + k];
                 let mut mean = [0.0; 3];
                 for &a in of.iter() {
-                    for i in 0..3 {
-                        mean[i] += mesh.nodes[ids[a]][i] / of.len() as f64;
+                    for (m, x) in mean.iter_mut().zip(mesh.nodes[ids[a]]) {
+                        *m += x / of.len() as f64;
                     }
                 }
                 assert!((0..3).all(|i| (mesh.nodes[node][i] - mean[i]).abs() < 1e-14));
@@ -125,7 +152,12 @@ fn higher_nodes_sit_at_their_corners_mean_and_are_shared() {
 
 #[test]
 fn stacked_blocks_and_hertz_meshes_of_second_order() {
-    for cell_type in [CellType::Tet10, CellType::Hex20, CellType::Wedge6, CellType::Pyramid5] {
+    for cell_type in [
+        CellType::Tet10,
+        CellType::Hex20,
+        CellType::Wedge6,
+        CellType::Pyramid5,
+    ] {
         let mesh = stacked_blocks(&StackedSpec {
             cell_type,
             ..Default::default()
@@ -160,7 +192,9 @@ fn bad_second_order_cells_are_named() {
     // Further than a quarter of the box's longest diagonal (2.7).
     mesh.nodes[node][0] += 1.0;
     match mesh.validate().unwrap_err() {
-        MeshError::MidNodeOffEdge { cell: c, node: n, .. } => {
+        MeshError::MidNodeOffEdge {
+            cell: c, node: n, ..
+        } => {
             assert!(n == node && mesh.cell(c).contains(&node));
         }
         other => panic!("{other}"),
@@ -171,7 +205,10 @@ fn bad_second_order_cells_are_named() {
         mesh.cells[20 + k] = ids[from];
     }
     let err = mesh.validate().unwrap_err();
-    assert!(matches!(err, MeshError::InvertedCell { cell: 1, .. }), "{err}");
+    assert!(
+        matches!(err, MeshError::InvertedCell { cell: 1, .. }),
+        "{err}"
+    );
     assert!(err.to_string().contains("cell 1"));
 }
 

@@ -94,33 +94,32 @@ fn bad_keyword_lines_name_their_line() {
 #[test]
 fn unsupported_types_are_one_error_naming_type_file_and_line() {
     let deck =
-        "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=C3D10, ELSET=V\n1, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10\n";
+        "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=C3D27, ELSET=V\n1, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10\n";
     let err = parse_err(deck);
     assert_eq!(
         err.to_string(),
-        "t.inp, line 3: C3D10 elements are not supported yet: this program reads first-order C3D4 and C3D8 (C3D8R, C3D8I) cells"
+        "t.inp, line 3: C3D27 elements are not supported: this program reads C3D4, C3D10, C3D6, C3D15, C3D8 (C3D8R, C3D8I) and C3D20 (C3D20R) cells"
     );
-    for ty in ["C3D20R", "C3D20", "C3D6", "C3D15", "c3d5"] {
+    for ty in ["C3D13", "c3d5", "C3D20H", "C3D10T"] {
         let deck = format!("*ELEMENT, TYPE={ty}\n");
         let kind = err_at(&deck, "*ELEMENT");
-        assert!(
-            kind.starts_with(&format!(
-                "{} elements are not supported yet",
-                ty.to_uppercase()
-            )),
-            "{kind}"
-        );
+        let expected = format!("{} elements are not supported", ty.to_uppercase());
+        assert!(kind.starts_with(&expected), "{kind}");
     }
-    // A second-order mesh reports its volumes, not the facets before them.
-    let deck = "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=CPS6, ELSET=S\n1, 1, 1, 1, 1, 1, 1\n*ELEMENT, TYPE=C3D10, ELSET=V\n";
-    assert!(err_at(deck, "*ELEMENT, TYPE=C3D10").starts_with("C3D10 elements"));
+    // An unread volume type is reported, not the facets before it.
+    let deck = "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=CPS6, ELSET=S\n1, 1, 1, 1, 1, 1, 1\n*ELEMENT, TYPE=C3D27, ELSET=V\n";
+    assert!(err_at(deck, "*ELEMENT, TYPE=C3D27").starts_with("C3D27 elements"));
+    // A second-order facet on a first-order cell's face.
     let deck = format!("{ONE_TET}*ELEMENT, TYPE=CPS6, ELSET=S\n2, 1, 2, 3, 1, 2, 3\n");
-    assert!(err_at(&deck, "*ELEMENT, TYPE=CPS6").starts_with("CPS6 elements are not supported yet"));
+    assert_eq!(
+        err_at(&deck, "2, 1, 2, 3, 1, 2, 3"),
+        "CPS6 element 2 of element set S is a tri6, but the face of the tet4 cell it lies on is a tri3"
+    );
     // Beams and trusses name the set they are in.
     let deck = format!("{ONE_TET}*ELEMENT, TYPE=B31, ELSET=FRAME\n2, 1, 2\n");
     assert_eq!(
         err_at(&deck, "*ELEMENT, TYPE=B31"),
-        "B31 elements (beams) in element set FRAME are not supported: the mesh is volumes of C3D4 or C3D8 cells, triangles or quadrilaterals on their faces, and sets"
+        "B31 elements (beams) in element set FRAME are not supported: the mesh is volumes of C3D4, C3D10, C3D6, C3D15, C3D8 or C3D20 cells, triangles or quadrilaterals on their faces, and sets"
     );
     let deck = format!("{ONE_TET}*ELEMENT, TYPE=T3D2\n2, 1, 2\n");
     assert!(err_at(&deck, "*ELEMENT, TYPE=T3D2").contains("(trusses) in element set (none)"));
@@ -145,7 +144,7 @@ fn files_without_cells_and_unknown_bodies_are_errors() {
     let err = parse_err("*NODE\n1, 0, 0, 0\n*MATERIAL, NAME=A\n");
     assert_eq!(
         err.to_string(),
-        "t.inp: no 3D elements (C3D4 or C3D8): the file holds no volume mesh"
+        "t.inp: no 3D elements (C3D4, C3D10, C3D6, C3D15, C3D8, C3D20): the file holds no volume mesh"
     );
     let err = parse_err("");
     assert_eq!(err.kind, InpErrorKind::NoVolumeCells);
