@@ -45,8 +45,10 @@ pub(super) fn mechanics<'a>(
         dirichlet,
     } = parts;
     // Nothing is ever added to K (no contact, inertia or follower load):
-    // the Jacobian is K itself, no second matrix.
-    let constant = contact.is_empty() && model.dynamics.is_none() && !loads.has_follower();
+    // the Jacobian is K itself, no second matrix. A pressure set may lie on
+    // some ranks only, and the choice decides collective calls: agreed.
+    let follower = parallel::any_rank(&SimpleCommunicator::world(), loads.has_follower());
+    let constant = contact.is_empty() && model.dynamics.is_none() && !follower;
     let keep = match (model.solver.reuse.linear_stiffness, constant) {
         (false, _) => KeepStiffness::No,
         // The first contact search builds the Jacobian its own pattern, so

@@ -133,7 +133,7 @@ fn mixed_hex_and_tet_cells_are_one_error() {
     assert_eq!(
         err_at(&deck, "50, 101"),
         format!(
-            "element 50 is a tet4 cell but element 20 (line {}) is a hex8: a mesh holds one cell type today (mesh all volumes with tetrahedra, or all with hexahedra)",
+            "element 50 is a tet4 cell but element 20 (line {}) is a hex8: a mesh holds one cell type today (mesh all volumes with one type of one order)",
             line_of(&deck, "20, 101")
         )
     );

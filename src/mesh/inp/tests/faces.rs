@@ -204,12 +204,12 @@ fn surface_elements_off_the_cells_are_errors_naming_type_and_line() {
         err.kind.to_string(),
         "S3 element 9 of element set SHELL is no boundary face of a 3D element (matched by its nodes): shells and membranes are not supported"
     );
-    // A quadrilateral on a tet mesh.
+    // A quadrilateral on a tet mesh: no face has its four corners.
     let deck = format!("{ONE_TET}*ELEMENT, TYPE=CPS4, ELSET=Q\n9, 1, 2, 3, 4\n");
     let err = parse_err(&deck);
     assert!(
         err.to_string()
-            .contains("has 4 nodes, but the faces of tet4 cells are tri3"),
+            .contains("CPS4 element 9 of element set Q is no boundary face of a 3D element"),
         "{err}"
     );
 }
