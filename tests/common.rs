@@ -225,3 +225,23 @@ pub fn assert_file_holds(h5: &Path, csv_listed: &[usize]) {
         );
     }
 }
+
+/// A copy of `full` holding only its first `keep` steps: what a run killed
+/// after step `keep` leaves behind.
+pub fn cut_after(full: &Path, keep: usize, name: &str) -> PathBuf {
+    use contactlink::output::{layout, list_steps};
+    let cut = full.with_file_name(name);
+    std::fs::copy(full, &cut).expect("copy result file");
+    let file = hdf5::File::open_rw(&cut).expect("open copy");
+    let steps = file.group(layout::STEPS_NAME).expect("/steps");
+    for step in list_steps(full)
+        .expect("steps")
+        .into_iter()
+        .filter(|&s| s > keep)
+    {
+        steps
+            .unlink(&layout::step_group_name(step))
+            .expect("unlink step");
+    }
+    cut
+}

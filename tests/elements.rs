@@ -3,7 +3,9 @@
 //! pressure on its top, a dead traction on one side and a body force, run
 //! by the binary on 1, 2 and 3 ranks (direct solver). The reactions balance
 //! the loads, the ranks agree to 1e-10, and the result file holds the cells
-//! with their width, type and VTK's node order for the XDMF sidecar.
+//! with their width, type and VTK's node order for the XDMF sidecar. Each
+//! type passes `check`, and a Neo-Hookean run cut after its first step and
+//! continued with `--restart` on 2 and 3 ranks ends where the whole run ends.
 mod common;
 use common::*;
 use contactlink::fem::CellType;
@@ -167,5 +169,95 @@ fn check_file(h5: &Path, cell: CellType) {
             n[0] * c[0] + n[1] * c[1] + n[2] * c[2] < 0.0,
             "not VTK's wedge"
         );
+    }
+}
+
+/// A Neo-Hookean box of `cell`s under a growing follower pressure and a
+/// side traction, three steps.
+fn stepped_scene(cell: CellType) -> String {
+    format!(
+        r#"
+[mesh]
+generator = "box"
+body = "block"
+size = [1.0, 1.0, 2.0]
+divisions = [2, 2, 3]
+cell_type = "{}"
+
+[[body]]
+name = "block"
+material = "neo-hookean"
+youngs = 100.0
+poisson = 0.3
+
+[[dirichlet]]
+set = "block.zmin"
+
+[[pressure]]
+set = "block.top"
+value = 8.0
+
+[[traction]]
+set = "block.xmax"
+vector = [0.0, 3.0, 0.0]
+
+[steps]
+count = 3
+"#,
+        cell.name()
+    )
+}
+
+/// `check` reads every type, and a run of each cut after its first step
+/// and continued with `--restart` on 2 and 3 ranks ends where the whole
+/// 1-rank run ends.
+#[test]
+fn every_new_cell_type_is_checked_and_restarts_on_two_and_three_ranks() {
+    let dir = scratch("elements-restart");
+    for cell in [
+        CellType::Tet10,
+        CellType::Hex20,
+        CellType::Hex27,
+        CellType::Wedge6,
+        CellType::Wedge15,
+        CellType::Pyramid5,
+    ] {
+        let name = cell.name();
+        let path = write(&dir, &format!("{name}-steps.toml"), &stepped_scene(cell));
+        let scene = path.to_str().unwrap();
+        let o = run(&["check", scene]);
+        assert!(o.status.success(), "check {name}: {}", text(&o));
+        let full = dir.join(format!("{name}-full.h5"));
+        let o = run(&["run", scene, "-q", "-o", full.to_str().unwrap()]);
+        assert!(o.status.success(), "{name}: {}", text(&o));
+        let cut = cut_after(&full, 1, &format!("{name}-cut.h5"));
+        let last = *list_steps(&full).unwrap().last().unwrap();
+        assert_eq!(last, 3, "{name}");
+        let (u_full, _, _) = read_nodal(&full, last, layout::DISPLACEMENT).unwrap();
+        assert!(
+            u_full.iter().any(|v| v.abs() > 1e-3),
+            "{name}: nothing moved"
+        );
+        for n in [2, 3] {
+            let cont = dir.join(format!("{name}-cont-{n}.h5"));
+            let args = [
+                "run",
+                scene,
+                "-q",
+                "-o",
+                cont.to_str().unwrap(),
+                "--restart",
+                cut.to_str().unwrap(),
+            ];
+            let o = mpirun(n, &args);
+            assert!(
+                o.status.success(),
+                "{name} restarted on {n} ranks: {}",
+                text(&o)
+            );
+            let (u, _, _) = read_nodal(&cont, last, layout::DISPLACEMENT).unwrap();
+            let d = relative_difference(&u_full, &u);
+            assert!(d < 1e-9, "{name}: restarted on {n} ranks differs by {d:e}");
+        }
     }
 }

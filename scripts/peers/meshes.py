@@ -70,22 +70,25 @@ def read_msh(path):
 
 
 def read_result_mesh(path):
-    """Nodes, hexes, facet sets and node sets of a contactlink result file's
-    /mesh group (hex8 cells; tags are the 0-based rows plus one)."""
-    import h5py  # python3-h5py: only the sphere case needs it
+    """Nodes, cells, facet sets and node sets of a contactlink result file's
+    /mesh group (hex8, hex20, tet4 or tet10 cells, in VTK's node order, which
+    is CalculiX's for these; tags are the 0-based rows plus one; facets
+    carry their corners first)."""
+    import h5py  # python3-h5py: only the cases built from a result file need it
 
     with h5py.File(path, "r") as f:
         m = f["mesh"]
-        if m["cells"].attrs["cell_type"] != "hex8":
-            raise ValueError(f"{path}: cells are {m['cells'].attrs['cell_type']}, not hex8")
+        kind = m["cells"].attrs["cell_type"]
+        if kind not in ("hex8", "hex20", "tet4", "tet10"):
+            raise ValueError(f"{path}: cells are {kind}, not hex8, hex20, tet4 or tet10")
         xyz = m["nodes"][()]
         cells = m["cells"][()]
         body_of = m["cell_body"][()]
         bodies = [str(b) for b in m["cell_body"].attrs["bodies"]]
         nodes = {k + 1: tuple(float(c) for c in p) for k, p in enumerate(xyz)}
-        hexes = [(k + 1, bodies[body_of[k]], [int(t) + 1 for t in c])
+        cells = [(k + 1, bodies[body_of[k]], [int(t) + 1 for t in c])
                  for k, c in enumerate(cells)]
-        facets = {name: [[int(t) + 1 for t in q] for q in g["nodes"][()]]
+        facets = {name: [[int(t) + 1 for t in q if t >= 0] for q in g["nodes"][()]]
                   for name, g in m["facet_sets"].items()}
         node_sets = {name: [int(t) + 1 for t in d[()]] for name, d in m["node_sets"].items()}
-    return nodes, hexes, facets, node_sets
+    return nodes, cells, facets, node_sets

@@ -128,5 +128,32 @@ class Fit(unittest.TestCase):
         self.assertAlmostEqual(math.pi * b * p0 / 2.0, 43.0, places=10)
 
 
+class TetDeck(unittest.TestCase):
+    def test_tet10_cells_are_c3d10_and_faces_found_by_corners(self):
+        # One tet10 (corners 1..4, mid-edge nodes 5..10 in C3D10 order) and a
+        # mirrored copy (corners 1 and 2 swapped) that the writer reverses.
+        corners = {1: (0.0, 0.0, 0.0), 2: (1.0, 0.0, 0.0), 3: (0.0, 1.0, 0.0), 4: (0.0, 0.0, 1.0)}
+        edges = [(1, 2), (2, 3), (3, 1), (1, 4), (2, 4), (3, 4)]
+        nodes = dict(corners)
+        for k, (a, b) in enumerate(edges):
+            nodes[5 + k] = tuple((corners[a][c] + corners[b][c]) / 2 for c in range(3))
+        good = list(range(1, 11))
+        bad = [good[k] for k in [0, 2, 1, 3, 6, 5, 4, 7, 9, 8]]
+        cells = [(1, "block", good), (2, "ball", bad)]
+        bottom = [1, 2, 3, 5, 6, 7]  # the z = 0 face: S1, tri6
+        lines = ccx.deck_lines("tets", nodes, cells, ["block", "ball"], {"N": [1]},
+                               {"S": [bottom], "M": [bottom]}, [], [], "N",
+                               pair=("S", "M", 1.0))
+        self.assertEqual(after(lines, "*ELEMENT, TYPE=C3D10, ELSET=EBLOCK"),
+                         ["1, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10"])
+        self.assertEqual(after(lines, "*ELEMENT, TYPE=C3D10, ELSET=EBALL"),
+                         ["2, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10"])
+        self.assertEqual(after(lines, "*SURFACE, NAME=S, TYPE=ELEMENT"), ["2, S1"])
+        with self.assertRaises(ValueError):
+            ccx.deck_lines("tets", nodes, cells, ["block", "ball"], {"N": [1]},
+                           {"S": [[1, 2, 5, 6, 7, 8]], "M": [[2, 3, 4]]}, [], [], "N",
+                           pair=("S", "M", 1.0))
+
+
 if __name__ == "__main__":
     unittest.main()
