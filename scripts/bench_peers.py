@@ -419,7 +419,7 @@ def write_table(a, prov, case, title, repeats, rows):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="line,sphere,tet10",
+    ap.add_argument("--cases", default="line,sphere",
                     help="comma-separated: line, sphere, tet10")
     ap.add_argument("--sizes", default="5,10,20,40", help="line: h_c = b / each")
     ap.add_argument("--sphere-sizes", default="0.5,0.35", help="sphere: h_c, each")
