@@ -6,7 +6,7 @@
 use contactlink::assembly::BulkAssembler;
 use contactlink::assembly::PatternBuilder;
 use contactlink::dofs::{DofMap, DIM};
-use contactlink::fem::Material;
+use contactlink::fem::{Integration, Material};
 use contactlink::mesh::generate::{self, BoxSpec};
 use contactlink::model::FacetLoad;
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
@@ -55,6 +55,7 @@ fn model(n: usize) -> Model {
             youngs: 1000.0,
             poisson: 0.3,
         }],
+        integration: vec![Integration::Full],
         dirichlet: vec![DirichletSpec::uniform(
             "block.bottom",
             bottom,
@@ -95,7 +96,8 @@ fn main() {
         rt.world().process_at_rank(0).broadcast_into(&mut part[..]);
         let wanted = contactlink::distribution::Wanted::default();
         let (dofs, local) = DofMap::with_mesh(&m.mesh, &part, rt.rank(), rt.size(), &wanted);
-        let bulk = BulkAssembler::new(&local, &dofs, m.materials.clone()).expect("bulk");
+        let bulk = BulkAssembler::new(&local, &dofs, m.materials.clone(), m.integration.clone())
+            .expect("bulk");
         let mut pattern = PatternBuilder::new(dofs.num_owned_dofs(), DIM).expect("pattern");
         bulk.add_pattern(&mut pattern).expect("pattern");
         let mut jac = pattern.build().expect("matrix");

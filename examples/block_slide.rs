@@ -17,7 +17,7 @@
 //! mpirun -n 2 target/release/examples/block_slide 20 out/examples/block_slide.h5
 //! ```
 use contactlink::amplitude::Amplitude;
-use contactlink::fem::Material;
+use contactlink::fem::{Integration, Material};
 use contactlink::mesh::generate::{graded_box, BoxSpec};
 use contactlink::model::FacetLoad;
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
@@ -202,6 +202,7 @@ fn model(steps: usize) -> Result<Model, String> {
             // from the pull.
             poisson: 0.0,
         }],
+        integration: vec![Integration::Full],
         dirichlet: vec![dirichlet],
         facet_loads: vec![("block.top".into(), FacetLoad::Pressure(PRESSURE), press)],
         body_force: vec![[0.0; 3]],

@@ -16,7 +16,7 @@
 //! Another MESH.msh (format 4.1) works when it has the same physical names:
 //! volumes `block` and `sphere`, surfaces `block.bottom`, `block.top`,
 //! `sphere.top` and `sphere.curved`.
-use contactlink::fem::Material;
+use contactlink::fem::{Integration, Material};
 use contactlink::mesh::{read_gmsh, Mesh};
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
 use contactlink::model::{MasterSpec, PairSpec};
@@ -174,6 +174,7 @@ fn model(mesh: Mesh) -> Result<Model, String> {
         ],
         dirichlet,
         facet_loads: Vec::new(),
+        integration: vec![Integration::Full; bodies],
         body_force: vec![[0.0; 3]; bodies],
         body_force_fn: None,
         contact: vec![pair],

@@ -16,7 +16,7 @@
 //! FINE_SIZE is the element size in the contact zone (default 0.25, about a
 //! second; the built-in `hertz-cylinder` scene uses 0.1). With OUT.h5 the
 //! result file is written (`examples/plot_pressure.py` plots it).
-use contactlink::fem::Material;
+use contactlink::fem::{Integration, Material};
 use contactlink::hertz::{effective_modulus, HertzCheck, HertzKind};
 use contactlink::mesh::generate::{hertz_cylinder, HertzCylinderSpec};
 use contactlink::mesh::Mesh;
@@ -167,6 +167,7 @@ fn model(fine_size: f64) -> Result<Model, String> {
     Ok(Model {
         name: "hertz_cylinder example".into(),
         materials: vec![material; bodies],
+        integration: vec![Integration::Full; bodies],
         dirichlet,
         facet_loads: Vec::new(),
         body_force: vec![[0.0; 3]; bodies],

@@ -5,7 +5,7 @@
 //! Cases here need MPI and PETSc, which can be initialised once per process,
 //! so this is one program (harness = false) rather than libtest threads.
 use contactlink::dofs::{DofMap, LocalNode, DIM};
-use contactlink::fem::Material;
+use contactlink::fem::{Integration, Material};
 use contactlink::mesh::generate::{self, BoxSpec, Grading};
 use contactlink::mesh::Mesh;
 use contactlink::model::{DirichletSpec, Model, SolverSettings};
@@ -366,6 +366,7 @@ fn model_with(
         name: "mpi-test".into(),
         mesh,
         materials: vec![material; bodies],
+        integration: vec![Integration::Full; bodies],
         dirichlet,
         facet_loads: Vec::new(),
         body_force: vec![[0.0; 3]; bodies],

@@ -83,6 +83,39 @@ fn poisson_out_of_range_is_rejected() {
     );
 }
 
+/// Reduced integration is hex20's; on other cells it names the body, the
+/// key and its line. On hex20 the scene passes.
+#[test]
+fn reduced_integration_on_cells_without_a_reduced_rule_is_refused() {
+    let reduced = GOOD.replace("poisson = 0.3", "poisson = 0.3\nintegration = \"reduced\"");
+    let tet10 = reduced.replace(
+        "divisions = [2, 2, 2]",
+        "divisions = [2, 2, 2]\ncell_type = \"tet10\"",
+    );
+    check_fails_at(
+        "reduced-tet10",
+        &tet10,
+        "integration = \"reduced\"",
+        &["[[body]] 'block' integration = \"reduced\": tet10 cells have no reduced rule"],
+    );
+    let hex20 = reduced.replace(
+        "divisions = [2, 2, 2]",
+        "divisions = [2, 2, 2]\ncell_type = \"hex20\"",
+    );
+    let dir = scratch("reduced-hex20");
+    let path = write(&dir, "scene.toml", &hex20);
+    let o = run(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    check_fails(
+        "integration-name",
+        &GOOD.replace(
+            "poisson = 0.3",
+            "poisson = 0.3\nintegration = \"selective\"",
+        ),
+        &["selective", "full", "reduced"],
+    );
+}
+
 #[test]
 fn body_without_material_is_named() {
     check_fails(

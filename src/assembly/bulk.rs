@@ -5,7 +5,7 @@ use super::{MatrixSink, PatternSink};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
-use crate::fem::{self, CellType, ElementGeometry, FemError, Material, QuadRule};
+use crate::fem::{self, CellType, ElementGeometry, FemError, Integration, Material, QuadRule};
 
 /// Everything a rank needs to evaluate its cells, computed once: reference
 /// geometry (shape gradients at the quadrature points), materials and DOFs.
@@ -15,6 +15,8 @@ pub struct BulkAssembler {
     /// Material of each local cell, as an index into `materials`.
     cell_material: Vec<u32>,
     materials: Vec<Material>,
+    /// Stiffness integration of each body.
+    integration: Vec<Integration>,
     /// Local node indices per local cell, flat.
     cell_nodes: Vec<LocalNode>,
     /// Global DOFs per local cell, flat (3 per node).
@@ -24,12 +26,41 @@ pub struct BulkAssembler {
 }
 
 impl BulkAssembler {
-    /// `materials[b]` is the material of body b. Fails naming the cell when an
-    /// element is inverted in the reference configuration.
-    pub fn new(mesh: &LocalMesh, dofs: &DofMap, materials: Vec<Material>) -> Result<Self> {
+    /// `materials[b]` and `integration[b]` are the material and the
+    /// stiffness integration of body b. Fails naming the cell when an
+    /// element is inverted in the reference configuration, and naming the
+    /// body when its cell type has no reduced rule.
+    pub fn new(
+        mesh: &LocalMesh,
+        dofs: &DofMap,
+        materials: Vec<Material>,
+        integration: Vec<Integration>,
+    ) -> Result<Self> {
         let cell_type = mesh.cell_type;
         let npc = cell_type.nodes();
-        let rule = quadrature_rule(cell_type);
+        if integration.len() != materials.len() {
+            return Err(Error::Internal(format!(
+                "{} integration choices for {} bodies",
+                integration.len(),
+                materials.len()
+            )));
+        }
+        let rules = integration
+            .iter()
+            .enumerate()
+            .map(|(b, &i)| {
+                QuadRule::for_cell(cell_type, i).ok_or_else(|| {
+                    Error::scene(
+                        "integration",
+                        format!(
+                            "body {b}: {} cells have no {} integration (only hex20 has a reduced rule)",
+                            cell_type.name(),
+                            i.name()
+                        ),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
         let mut geometry = Vec::with_capacity(dofs.local_cells.len());
         let mut cell_nodes = Vec::with_capacity(dofs.local_cells.len() * npc);
         let mut cell_dofs = Vec::with_capacity(dofs.local_cells.len() * npc * 3);
@@ -38,7 +69,10 @@ impl BulkAssembler {
         for (i, &c) in dofs.local_cells.iter().enumerate() {
             let nodes = dofs.cell_local_nodes(i, npc);
             let x_ref: Vec<[f64; 3]> = nodes.iter().map(|&l| mesh.nodes[l.index()]).collect();
-            let geom = ElementGeometry::new(cell_type, &x_ref, &rule).map_err(|e| match e {
+            let rule = rules
+                .get(mesh.cell_body[i] as usize)
+                .ok_or_else(|| Error::Internal(format!("cell {c} has no body")))?;
+            let geom = ElementGeometry::new(cell_type, &x_ref, rule).map_err(|e| match e {
                 FemError::InvertedElement { qp, det_j } => {
                     Error::InvertedCell { cell: c, qp, det_j }
                 }
@@ -58,6 +92,7 @@ impl BulkAssembler {
             geometry,
             cell_material,
             materials,
+            integration,
             cell_nodes,
             cell_dofs,
             natural_cell: dofs.local_cells.clone(),
@@ -166,6 +201,9 @@ impl BulkAssembler {
         self.check_densities(density)?;
         let n = self.npc();
         let mut me = vec![0.0; 9 * n * n];
+        // The full rule integrates `N_a N_b` exactly where the mass has no
+        // rule of its own: a reduced body takes it.
+        let full_rule = QuadRule::default_for_cell(self.cell_type);
         let mass_rule = QuadRule::mass_for_cell(self.cell_type);
         for (i, stiffness_geom) in self.geometry.iter().enumerate() {
             let body = self.body(i);
@@ -183,7 +221,9 @@ impl BulkAssembler {
                 continue;
             }
             let own;
-            let geom = match &mass_rule {
+            let reduced = self.integration.get(body) == Some(&Integration::Reduced);
+            let rule = mass_rule.as_ref().or(reduced.then_some(&full_rule));
+            let geom = match rule {
                 Some(rule) => {
                     let x_ref: Vec<[f64; 3]> = self
                         .nodes(i)
@@ -326,11 +366,6 @@ impl BulkAssembler {
     }
 }
 
-/// The default rule: full integration for the element type.
-fn quadrature_rule(cell_type: CellType) -> QuadRule {
-    QuadRule::default_for_cell(cell_type)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -361,7 +396,8 @@ mod tests {
             .map(|rank| {
                 let wanted = crate::distribution::Wanted::default();
                 let (dofs, local) = DofMap::with_mesh(mesh, &partition, rank, RANKS, &wanted);
-                let bulk = BulkAssembler::new(&local, &dofs, materials.to_vec()).unwrap();
+                let full = vec![Integration::Full; materials.len()];
+                let bulk = BulkAssembler::new(&local, &dofs, materials.to_vec(), full).unwrap();
                 (dofs, bulk)
             })
             .collect()

@@ -26,7 +26,7 @@ pub use element::{
     strain_energy, ElementGeometry,
 };
 pub use material::{Material, MaterialError, Tangent};
-pub use quadrature::QuadRule;
+pub use quadrature::{Integration, QuadRule};
 pub use surface::{dead_traction, facet_area, facet_normal_at_centre, follower_pressure};
 
 use thiserror::Error;

@@ -47,6 +47,25 @@ fn gauss_legendre(n: usize) -> Option<(Vec<f64>, Vec<f64>)> {
     Some(rule)
 }
 
+/// How a body's cells integrate their stiffness: the full rule of the cell
+/// type, or the reduced one where that is the practice (hex20's 2×2×2, as
+/// Abaqus' C3D20R). The mass always takes a rule exact for `N_a N_b`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Integration {
+    #[default]
+    Full,
+    Reduced,
+}
+
+impl Integration {
+    pub fn name(self) -> &'static str {
+        match self {
+            Integration::Full => "full",
+            Integration::Reduced => "reduced",
+        }
+    }
+}
+
 impl QuadRule {
     pub fn len(&self) -> usize {
         self.weights.len()
@@ -273,6 +292,15 @@ impl QuadRule {
             CellType::Pyramid5 => Self::pyramid_collapsed(2, 2),
         };
         Self::tensor_or_empty(rule)
+    }
+
+    /// The stiffness rule of `cell` under `integration`; `None` when the
+    /// type has no reduced rule.
+    pub fn for_cell(cell: CellType, integration: Integration) -> Option<Self> {
+        match integration {
+            Integration::Full => Some(Self::default_for_cell(cell)),
+            Integration::Reduced => Self::reduced_for_cell(cell),
+        }
     }
 
     /// Reduced integration where it is the practice: hex20's 2×2×2 (Abaqus

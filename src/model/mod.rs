@@ -20,7 +20,7 @@ pub use dynamics::{DynamicsSpec, Newmark};
 pub use solver::{Reuse, SolverSettings, DEFAULT_ACCELERATION, DEFAULT_FORCING, MAX_ACCELERATION};
 
 use crate::amplitude::Amplitude;
-use crate::fem::Material;
+use crate::fem::{Integration, Material};
 use crate::hertz::HertzCheck;
 use crate::mesh::Mesh;
 
@@ -36,6 +36,8 @@ pub struct Model {
     pub mesh: Mesh,
     /// Material of each body, indexed like `mesh.bodies`.
     pub materials: Vec<Material>,
+    /// Stiffness integration of each body, indexed like `mesh.bodies`.
+    pub integration: Vec<Integration>,
     pub dirichlet: Vec<DirichletSpec>,
     /// (facet set name, load at full amplitude, amplitude).
     pub facet_loads: Vec<(String, FacetLoad, Amplitude)>,

@@ -12,7 +12,7 @@ use super::{
 };
 use crate::amplitude::Amplitude;
 use crate::error::{Error, Result};
-use crate::fem::{CellType, Material};
+use crate::fem::{CellType, Integration, Material};
 use crate::hertz::{HertzCheck, HertzKind};
 use crate::mesh::Mesh;
 
@@ -160,6 +160,7 @@ pub fn encode(model: &Model, w: &mut Writer) -> Result<()> {
         name,
         mesh,
         materials,
+        integration,
         dirichlet,
         facet_loads,
         body_force,
@@ -188,6 +189,13 @@ pub fn encode(model: &Model, w: &mut Writer) -> Result<()> {
         w.usize(tag);
         w.f64(youngs);
         w.f64(poisson);
+    }
+    w.usize(integration.len());
+    for i in integration {
+        w.usize(match i {
+            Integration::Full => 0,
+            Integration::Reduced => 1,
+        });
     }
     w.usize(dirichlet.len());
     for d in dirichlet {
@@ -273,6 +281,11 @@ pub fn decode(r: &mut Reader) -> Result<Model> {
             t => Err(bad("material", t)),
         }
     })?;
+    let integration = r.list(1, |r| match r.usize()? {
+        0 => Ok(Integration::Full),
+        1 => Ok(Integration::Reduced),
+        t => Err(bad("integration", t)),
+    })?;
     let dirichlet = r.list(4, take_dirichlet)?;
     let facet_loads = r.list(6, |r| {
         let set = r.str()?;
@@ -322,6 +335,7 @@ pub fn decode(r: &mut Reader) -> Result<Model> {
         name,
         mesh: Mesh::empty(cell_type),
         materials,
+        integration,
         dirichlet,
         facet_loads,
         body_force,

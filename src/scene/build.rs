@@ -5,9 +5,9 @@ use super::held;
 use super::limits;
 use super::lines::Seg;
 use super::mesh::MeshReport;
-use super::sections::{MaterialName, Scene};
+use super::sections::{IntegrationName, MaterialName, Scene};
 use crate::error::{Error, Result};
-use crate::fem::Material;
+use crate::fem::{Integration, Material, QuadRule};
 use crate::mesh::generate;
 use crate::mesh::Mesh;
 use crate::model::{FacetLoad, Model};
@@ -39,6 +39,7 @@ impl Scene {
             })?;
         }
         let mut materials = Vec::with_capacity(mesh.bodies.len());
+        let mut integration = Vec::with_capacity(mesh.bodies.len());
         for body in &mesh.bodies {
             let Some(i) = self.bodies.iter().position(|b| &b.name == body) else {
                 let given: Vec<&str> = self.bodies.iter().map(|b| b.name.as_str()).collect();
@@ -75,6 +76,23 @@ impl Scene {
                 )
             })?;
             materials.push(m);
+            let rule = match section.integration {
+                IntegrationName::Full => Integration::Full,
+                IntegrationName::Reduced => Integration::Reduced,
+            };
+            if QuadRule::for_cell(mesh.cell_type, rule).is_none() {
+                return Err(self.error_at(
+                    origin,
+                    &[Key("body"), Index(i), Key("integration")],
+                    format!(
+                        "[[body]] '{}' integration = \"{}\": {} cells have no reduced rule (only hex20 has: Abaqus' C3D20R)",
+                        section.name,
+                        rule.name(),
+                        mesh.cell_type.name()
+                    ),
+                ));
+            }
+            integration.push(rule);
         }
         for (i, b) in self.bodies.iter().enumerate() {
             if !mesh.bodies.contains(&b.name) {
@@ -210,6 +228,7 @@ impl Scene {
             name: self.title.clone().unwrap_or_else(|| origin.to_owned()),
             mesh,
             materials,
+            integration,
             dirichlet,
             facet_loads,
             body_force,

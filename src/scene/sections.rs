@@ -197,6 +197,19 @@ pub struct BodySection {
     pub density: Option<f64>,
     /// Initial velocity of the whole body (dynamics).
     pub initial_velocity: Option<[f64; 3]>,
+    /// Stiffness integration of the body's cells.
+    #[serde(default)]
+    pub integration: IntegrationName,
+}
+
+/// `[[body]] integration`: the cell type's full rule, or its reduced one
+/// (hex20 only: Abaqus' C3D20R).
+#[derive(Debug, Deserialize, Clone, Copy, Default, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegrationName {
+    #[default]
+    Full,
+    Reduced,
 }
 
 /// Random distortion of the generated mesh (stress tests): every node moves

@@ -239,7 +239,12 @@ pub(super) fn setup(rt: &Runtime, model: &Model, mesh: Cow<'_, Mesh>) -> Result<
     crate::memory::checkpoint("DOF map");
     let bulk = parallel::agree(
         &world,
-        BulkAssembler::new(&local, &dofs, model.materials.clone()),
+        BulkAssembler::new(
+            &local,
+            &dofs,
+            model.materials.clone(),
+            model.integration.clone(),
+        ),
     )?;
     crate::memory::checkpoint("bulk assembler (element data)");
     let mut facet_loads = Vec::new();

@@ -55,6 +55,7 @@ fn full_model() -> Model {
                 poisson: 0.49,
             },
         ],
+        integration: vec![Integration::Full, Integration::Reduced],
         dirichlet: vec![d],
         facet_loads: vec![
             ("p".into(), FacetLoad::Pressure(-2.5), Amplitude::ramp()),
