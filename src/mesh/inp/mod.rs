@@ -90,6 +90,9 @@ pub struct InpReport {
     /// first appears (`*MATERIAL (line 120)`, `*STEP (steps.inp, line 3)`,
     /// `*NSET, FREQUENCY= (line 36)`).
     pub skipped: Vec<String>,
+    /// Abaqus variants read as this program's cell with its own rule
+    /// (`C3D8R`, `C3D8I`, `C3D20R`), each once, in file order.
+    pub variants: Vec<String>,
     /// Cells that came fully inverted and were renumbered.
     pub reoriented: usize,
     /// Nodes that no 3D element uses (dropped).
@@ -107,6 +110,12 @@ impl InpReport {
             note.push_str(&format!(
                 "; not read (the scene holds the physics): {}",
                 self.skipped.join(", ")
+            ));
+        }
+        if !self.variants.is_empty() {
+            note.push_str(&format!(
+                "; {} integrated by this program's full rule, not Abaqus' (`integration = \"reduced\"` in a [[body]] gives hex20 the 2x2x2 rule)",
+                self.variants.join(", ")
             ));
         }
         if self.reoriented > 0 {
@@ -147,8 +156,22 @@ pub fn parse_inp(
             .iter()
             .map(|(keyword, at)| format!("*{keyword} ({})", reader.place(*at)))
             .collect(),
+        variants: variants(&raw),
         reoriented: counts.reoriented,
         unused_nodes: counts.unused_nodes,
     };
     Ok((mesh, report))
+}
+
+/// The element types of the file that name an Abaqus integration variant
+/// this program does not have, each once.
+fn variants(raw: &read::Raw) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for block in &raw.blocks {
+        let variant = matches!(block.ty.as_str(), "C3D8R" | "C3D8I" | "C3D20R");
+        if variant && !out.contains(&block.ty) {
+            out.push(block.ty.clone());
+        }
+    }
+    out
 }

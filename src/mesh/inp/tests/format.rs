@@ -214,3 +214,19 @@ fn nodes_no_cell_uses_are_dropped() {
     assert!(mesh.nodes.iter().all(|p| *p != [5.0, 5.0, 5.0]));
     assert_eq!(node_at(&mesh, [2.0, 1.0, 1.0]), 11);
 }
+
+#[test]
+fn abaqus_variants_are_named_once_in_the_note() {
+    let deck = TWO_HEX
+        .replace("TYPE=C3D8, ELSET=LEFT", "TYPE=C3D8R, ELSET=LEFT")
+        .replace("TYPE=C3D8, ELSET=RIGHT", "TYPE=c3d8r, ELSET=RIGHT");
+    let (mesh, report) = parse(&deck);
+    assert_eq!(mesh, parse(TWO_HEX).0);
+    assert_eq!(report.variants, ["C3D8R"]);
+    let note = report.note();
+    assert!(
+        note.contains("C3D8R integrated by this program's full rule, not Abaqus'"),
+        "{note}"
+    );
+    assert!(parse(TWO_HEX).1.variants.is_empty());
+}
