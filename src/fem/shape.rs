@@ -166,6 +166,35 @@ impl<const N: usize> FacetShape<N> {
         eval_facet(facet, xi, &mut s.n[..k], &mut s.dn[..k]);
         Some(s)
     }
+
+    /// The second derivatives (see [`eval_facet_second`]) of `facet` at
+    /// `xi`, or `None` when it has more than `N` nodes.
+    pub fn second(facet: FacetType, xi: [f64; 2]) -> Option<[[f64; 3]; N]> {
+        let k = facet.nodes();
+        if k > N {
+            return None;
+        }
+        let mut ddn = [[0.0; 3]; N];
+        eval_facet_second(facet, xi, &mut ddn[..k]);
+        Some(ddn)
+    }
+}
+
+/// Writes the second reference derivatives `[∂²N_a/∂ξ₁², ∂²N_a/∂ξ₁∂ξ₂,
+/// ∂²N_a/∂ξ₂²]` of `facet` at `xi` into `ddn`, which holds exactly
+/// `facet.nodes()` entries (zero for tri3; only the mixed one for quad4).
+pub fn eval_facet_second(facet: FacetType, xi: [f64; 2], ddn: &mut [[f64; 3]]) {
+    match facet {
+        FacetType::Quad4 => {
+            for (d, node) in ddn.iter_mut().zip(&QUAD4_REF_NODES) {
+                *d = [0.0, 0.25 * node[0] * node[1], 0.0];
+            }
+        }
+        FacetType::Tri3 => ddn.fill([0.0; 3]),
+        FacetType::Tri6 => higher::tri6_second(ddn),
+        FacetType::Quad8 => higher::quad8_second(xi, ddn),
+        FacetType::Quad9 => higher::quad9_second(xi, ddn),
+    }
 }
 
 /// Any facet's shape at `xi`.

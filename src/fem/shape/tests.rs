@@ -163,6 +163,37 @@ fn facet_gradients_match_finite_differences() {
     }
 }
 
+/// The second derivatives against central differences of the gradients
+/// (error ~h², so 1e-8 with h = 1e-6 leaves the round-off ~1e-10 room).
+#[test]
+fn facet_second_derivatives_match_finite_differences() {
+    let mut rng = Lcg::new(5);
+    for facet in FacetType::ALL {
+        for xi in facet_points(facet, &mut rng) {
+            let dd = FacetShape::<9>::second(facet, xi).unwrap();
+            for j in 0..2 {
+                let (mut xp, mut xm) = (xi, xi);
+                xp[j] += H;
+                xm[j] -= H;
+                let (sp, sm) = (facet_shape(facet, xp), facet_shape(facet, xm));
+                for a in 0..facet.nodes() {
+                    for i in 0..2 {
+                        let fd = (sp.dn[a][i] - sm.dn[a][i]) / (2.0 * H);
+                        // (i, j) in [11, 12, 22].
+                        let exact = dd[a][i + j];
+                        assert!(
+                            (fd - exact).abs() < 1e-8,
+                            "{} a={a} ({i},{j}): {fd} vs {exact}",
+                            facet.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(FacetShape::<4>::second(FacetType::Quad8, [0.0; 2]).is_none());
+}
+
 /// Σ N_a f(X_a) = f(X) for the fields the element must reproduce: linear
 /// ones for every type, complete quadratics for tet10 / hex20 / hex27 / the
 /// quadratic facets, and the wedge15's quadratics (its triangle is complete
