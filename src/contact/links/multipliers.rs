@@ -13,7 +13,7 @@
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use crate::assembly::{Halo, HaloFactory};
-use crate::contact::facet_shape;
+use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
@@ -211,7 +211,7 @@ impl Multipliers {
         let mut add_facet = |natural: &[usize], x_ref: &[[f64; 3]], first_slot: usize| {
             let points = reference_weights(slave.facet_type, x_ref, rule);
             for (q, (zeta, w)) in points.iter().enumerate() {
-                let s = facet_shape(slave.facet_type, *zeta);
+                let s = facet_shape::<MAX_FACET_NODES>(slave.facet_type, *zeta);
                 for (a, &v) in natural.iter().enumerate() {
                     if let Some(l) = owned_node(v).map(LocalNode::to_u32) {
                         let owned_slot = *slot_of.entry(l).or_insert_with(|| {

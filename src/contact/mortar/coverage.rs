@@ -9,7 +9,7 @@
 //! that matches `M` there.
 use super::segment::SegmentTerms;
 use crate::contact::autodiff::Scalar;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 
 /// Relative tolerance on a slave facet's area for its segments to cover it
 /// whole: far above the segment rules' error on bent facets, far below a

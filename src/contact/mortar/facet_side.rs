@@ -12,7 +12,7 @@ use super::rows::{signature, Rows};
 use super::system::{self, Interface, NodeState, Segment};
 use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Dual;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 use crate::error::Result;
 use crate::fem::surface::facet_normal_at_centre;
 

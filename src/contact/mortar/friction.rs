@@ -27,7 +27,7 @@ use super::system::{
     NodeState, NormalTangent, Segment, SEGMENT_DOFS,
 };
 use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 
 type D = Dual<{ super::system::SEGMENT_DOFS }>;
 /// The node aggregates the law depends on: `g̃`, `a` (3), `ũ` (3).

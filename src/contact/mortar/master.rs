@@ -4,7 +4,7 @@
 //! duties are in its own module (`facet_side`, `rigid_side`).
 use crate::contact::held_master::HeldMaster;
 use crate::contact::master::RigidMaster;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 
 /// The master side of a mortar pair at run time.
 pub(super) enum Master {

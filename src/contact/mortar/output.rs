@@ -5,7 +5,7 @@ use super::friction::Rate;
 use super::master::Master;
 use super::pair::MortarPair;
 use super::system::NodeState;
-use crate::contact::facet_shape;
+use super::facet_shape;
 use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;
 

@@ -18,7 +18,7 @@ use super::tangential::PairFriction;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::outcome::UzawaStats;
 use crate::contact::surfaces::SlaveSurface;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use crate::fem::FacetType;

@@ -26,8 +26,8 @@
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
 use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState};
 use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
-use crate::contact::facet_shape;
-use crate::contact::MAX_FACET_NODES;
+use super::facet_shape;
+use super::MAX_FACET_NODES;
 use crate::fem::{FacetType, QuadRule};
 use crate::model::RigidSurface;
 

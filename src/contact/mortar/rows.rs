@@ -10,7 +10,7 @@
 use super::friction::NodeFriction;
 use super::system::{NodalData, NodeDof, NodeState, Segment};
 use crate::assembly::MatrixSink;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 

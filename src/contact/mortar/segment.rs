@@ -22,8 +22,8 @@
 //! of the segments' sum (`system::covered_facets`).
 use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::contact::MAX_FACET_NODES;
-use crate::contact::{facet_shape, FacetShape};
+use super::MAX_FACET_NODES;
+use super::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule};
 
 /// A quadrature rule as (point, weight) pairs.

@@ -11,7 +11,7 @@ use super::tangential::PairFriction;
 use crate::assembly::RankExchange;
 use crate::contact::master::MasterSide;
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
-use crate::contact::{facet_shape, MAX_FACET_NODES};
+use super::{facet_shape, MAX_FACET_NODES};
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};

@@ -19,7 +19,7 @@ use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
 use crate::contact::autodiff::{Dual, Scalar, Seed, Vec3};
 use crate::contact::penalty::contact_pressure;
-use crate::contact::MAX_FACET_NODES;
+use super::MAX_FACET_NODES;
 use crate::fem::FacetType;
 
 /// Variables of one segment: slave nodes at `3a + i`, master nodes at

@@ -231,6 +231,30 @@ pub(super) fn quad8_second(xi: [f64; 2], ddn: &mut [[f64; 3]]) {
     }
 }
 
+/// Third derivatives of [`quad8`] as `[ξξη, ξηη]` (constant).
+pub(super) fn quad8_third(dddn: &mut [[f64; 2]]) {
+    for (a, node) in QUAD9_REF_NODES[..8].iter().enumerate() {
+        dddn[a] = if a < 4 {
+            [0.5 * node[1], 0.5 * node[0]]
+        } else if node[0] == 0.0 {
+            [-node[1], 0.0]
+        } else {
+            [0.0, -node[0]]
+        };
+    }
+}
+
+/// Third derivatives of [`quad9`] as `[ξξη, ξηη]`.
+pub(super) fn quad9_third(xi: [f64; 2], dddn: &mut [[f64; 2]]) {
+    for (a, node) in QUAD9_REF_NODES.iter().enumerate() {
+        let l = [lagrange(node[0], xi[0]), lagrange(node[1], xi[1])];
+        dddn[a] = [
+            lagrange_second(node[0]) * l[1].1,
+            l[0].1 * lagrange_second(node[1]),
+        ];
+    }
+}
+
 /// Second derivatives of [`quad9`] as `[ξξ, ξη, ηη]`.
 pub(super) fn quad9_second(xi: [f64; 2], ddn: &mut [[f64; 3]]) {
     for (a, node) in QUAD9_REF_NODES.iter().enumerate() {
