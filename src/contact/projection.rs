@@ -296,7 +296,12 @@ fn limit_step(dir: [f64; 2]) -> [f64; 2] {
 }
 
 /// Backtracking along `dir` (projected onto the box) until `φ` decreases.
-fn line_search<const M: usize>(frame: &Frame<M>, y: [f64; 3], xi: [f64; 2], dir: [f64; 2]) -> Option<[f64; 2]> {
+fn line_search<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    xi: [f64; 2],
+    dir: [f64; 2],
+) -> Option<[f64; 2]> {
     let bounds = search_box(frame.facet);
     let phi = objective(frame, y, xi);
     let mut alpha = 1.0;
@@ -323,7 +328,11 @@ fn initial_xi(facet: FacetType, start: Option<[f64; 2]>) -> [f64; 2] {
 
 /// Newton iteration; returns the final `ξ`, whether it converged, and the
 /// number of iterations (for tests of the convergence rate).
-fn newton<const M: usize>(frame: &Frame<M>, y: [f64; 3], mut xi: [f64; 2]) -> ([f64; 2], bool, usize) {
+fn newton<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    mut xi: [f64; 2],
+) -> ([f64; 2], bool, usize) {
     let bounds = search_box(frame.facet);
     // Round-off in F grows with the distance of x from the facet, so the
     // attainable accuracy of ξ does too.
@@ -403,7 +412,12 @@ fn project_in<const M: usize>(
 }
 
 /// Point, normal and gap at the final `ξ`.
-fn finish<const M: usize>(frame: &Frame<M>, y: [f64; 3], xi: [f64; 2], converged: bool) -> Projection {
+fn finish<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    xi: [f64; 2],
+    converged: bool,
+) -> Projection {
     let s = frame.surface(xi);
     let n = cross(s.t1, s.t2);
     let area = norm(n);
@@ -436,5 +450,7 @@ fn finish<const M: usize>(frame: &Frame<M>, y: [f64; 3], xi: [f64; 2], converged
     }
 }
 
+#[cfg(test)]
+mod curved_tests;
 #[cfg(test)]
 mod tests;

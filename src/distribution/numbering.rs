@@ -1,9 +1,9 @@
 //! The global numbering, computed once on the rank that holds the mesh:
 //! node owners and PETSc node numbers (two arrays of the node count), from
 //! which each rank's [`Piece`] is cut.
-use crate::fem::MAX_FACET_NODES;
 use super::local::{self, GhostFacet, LocalMesh, OutputBlock, SharedSet, SlaveSetPiece};
 use super::{even_block, Piece, Wanted};
+use crate::fem::MAX_FACET_NODES;
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;
 

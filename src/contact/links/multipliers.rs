@@ -13,8 +13,8 @@
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use crate::assembly::{Halo, HaloFactory};
-use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
+use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::Result;

@@ -260,7 +260,8 @@ mod tests {
     }
 
     fn point_on(m: &HeldMaster, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
-        let s = crate::contact::facet_shape::<{ crate::contact::MAX_FACET_NODES }>(m.facet_type, xi);
+        let s =
+            crate::contact::facet_shape::<{ crate::contact::MAX_FACET_NODES }>(m.facet_type, xi);
         let mut p = [0.0; 3];
         for (&n, nb) in m.facet_nodes(facet).iter().zip(s.n) {
             for c in 0..3 {

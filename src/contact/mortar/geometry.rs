@@ -10,8 +10,8 @@
 //! then that of the current clipping pattern, which is the derivative almost
 //! everywhere.
 use super::bilinear::Bilinear;
-use crate::contact::autodiff::{self, Scalar, Vec3};
 use super::MAX_FACET_NODES;
+use crate::contact::autodiff::{self, Scalar, Vec3};
 use crate::fem::FacetType;
 
 /// A 2-vector in the auxiliary plane.

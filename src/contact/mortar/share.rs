@@ -31,10 +31,10 @@
 //! solver fills by a scatter: the pair's slave tail first, then its master's.
 use super::master::Master;
 use super::pair::MortarPair;
+use super::MAX_FACET_NODES;
 use crate::assembly::RankExchange;
 use crate::contact::held_master::{self, record, MasterFacet};
 use crate::contact::surfaces::contact_facet_type;
-use super::MAX_FACET_NODES;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};

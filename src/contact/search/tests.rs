@@ -242,7 +242,9 @@ fn closest_node_equals_brute_force_on_random_clouds() {
             ]
         })
         .collect();
-    let facets: Vec<[u32; MAX_FACET_NODES]> = (0..200).map(|i| pad([3 * i, 3 * i + 1, 3 * i + 2, 0])).collect();
+    let facets: Vec<[u32; MAX_FACET_NODES]> = (0..200)
+        .map(|i| pad([3 * i, 3 * i + 1, 3 * i + 2, 0]))
+        .collect();
     pos.push([5.0, 5.0, 5.0]);
     let uniform = (pos, facets);
     // Strongly clustered cloud: most nodes in a tiny ball, a few spread
@@ -263,7 +265,8 @@ fn closest_node_equals_brute_force_on_random_clouds() {
             100.0 * unit(&mut rng),
         ]
     }));
-    let facets: Vec<[u32; MAX_FACET_NODES]> = (0..200).map(|i| pad([i, i + 200, i + 400, 0])).collect();
+    let facets: Vec<[u32; MAX_FACET_NODES]> =
+        (0..200).map(|i| pad([i, i + 200, i + 400, 0])).collect();
     let clustered = (pos, facets);
     for (mesh, scale) in [(&uniform, 10.0), (&clustered, 100.0)] {
         let s = surface(FacetType::Tri3, mesh);
