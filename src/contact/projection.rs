@@ -157,15 +157,15 @@ impl<const M: usize> Frame<M> {
             curved: self.curved,
             ..Surface::default()
         };
-        for b in 0..self.count() {
-            let xb = self.nodes[b];
-            out.x = add(out.x, xb.map(|c| s.n[b] * c));
-            out.t1 = add(out.t1, xb.map(|c| s.dn[b][0] * c));
-            out.t2 = add(out.t2, xb.map(|c| s.dn[b][1] * c));
-            out.t12 = add(out.t12, xb.map(|c| dd[b][1] * c));
+        let nodes = self.nodes.iter().zip(&s.n).zip(&s.dn).zip(&dd);
+        for (((xb, n), dn), ddb) in nodes.take(self.count()) {
+            out.x = add(out.x, xb.map(|c| n * c));
+            out.t1 = add(out.t1, xb.map(|c| dn[0] * c));
+            out.t2 = add(out.t2, xb.map(|c| dn[1] * c));
+            out.t12 = add(out.t12, xb.map(|c| ddb[1] * c));
             if self.curved {
-                out.t11 = add(out.t11, xb.map(|c| dd[b][0] * c));
-                out.t22 = add(out.t22, xb.map(|c| dd[b][2] * c));
+                out.t11 = add(out.t11, xb.map(|c| ddb[0] * c));
+                out.t22 = add(out.t22, xb.map(|c| ddb[2] * c));
             }
         }
         out
