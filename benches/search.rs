@@ -7,6 +7,7 @@
 //! nanoseconds per point. The search must grow like n log n or better: flat
 //! ns/point means linear. Output: CSV on stdout.
 use contactlink::contact::search::{SearchIndex, SearchSurface};
+use contactlink::contact::MAX_FACET_NODES;
 use contactlink::fem::FacetType;
 use std::time::Instant;
 
@@ -14,7 +15,7 @@ use std::time::Instant;
 /// iterations per point than a flat one.
 const WARPS: [f64; 2] = [0.05, 0.0];
 
-fn master(m: usize, warp: f64) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
+fn master(m: usize, warp: f64) -> (Vec<[f64; 3]>, Vec<[u32; MAX_FACET_NODES]>) {
     let h = 1.0 / m as f64;
     let mut x = Vec::with_capacity((m + 1) * (m + 1));
     for j in 0..=m {
@@ -27,7 +28,9 @@ fn master(m: usize, warp: f64) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
     let mut facets = Vec::with_capacity(m * m);
     for j in 0..m {
         for i in 0..m {
-            facets.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            let mut row = [0; MAX_FACET_NODES];
+            row[..4].copy_from_slice(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            facets.push(row);
         }
     }
     (x, facets)

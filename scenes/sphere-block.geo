@@ -3,6 +3,11 @@
 //
 // Regenerate scenes/sphere-block.msh with:
 //   gmsh -3 -format msh41 scenes/sphere-block.geo -o scenes/sphere-block.msh
+// and its tet10 counterpart (tests/contact_quadratic.rs, the Hertz check of
+// the links on curved second-order facets; Gmsh puts the mid-side nodes on
+// the sphere) with:
+//   gmsh -3 -order 2 -format msh41 scenes/sphere-block.geo \
+//     -o tests/data/gmsh/sphere-block-tet10.msh
 //
 // Physical names follow the solver's `<body>.<face>` convention: they are
 // used verbatim as body and set names.

@@ -140,12 +140,13 @@ value = 1.0
     fails_alike(&["run", scene.to_str().unwrap()], "nothing holds it");
 }
 
-/// Contact on second-order facets is not implemented: a pair on the quad8
-/// faces of hex20 cells is one scene error on every rank, before set-up.
+/// The mortar formulation is first-order: a mortar pair on the quad8 faces
+/// of hex20 cells is one scene error on every rank, before set-up, naming
+/// the pair and the links, which take them.
 #[test]
-fn contact_on_second_order_facets_fails_alike_on_every_rank_count() {
+fn mortar_on_second_order_facets_fails_alike_on_every_rank_count() {
     fails_alike(
         &["run", "patch-test", "--set", "mesh.cell_type=hex20"],
-        "second-order facets (quad8) are not supported by contact yet",
+        "contact pair 'interface': formulation \"mortar\" does not support second-order facets (quad8); use formulation = \"links\" for this pair",
     );
 }

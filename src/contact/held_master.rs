@@ -19,6 +19,7 @@
 //! back to their owners by the same scatter in reverse.
 use crate::assembly::RankExchange;
 use crate::contact::search;
+use crate::contact::MAX_FACET_NODES;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
@@ -29,14 +30,31 @@ use crate::fem::FacetType;
 pub struct MasterFacet {
     /// Position in the master facet set (identical on every rank).
     pub set_index: u32,
-    pub natural: [u64; 4],
-    pub dofs: [GlobalDof; 4 * DIM],
-    pub x_ref: [[f64; 3]; 4],
+    /// Per node (the facet type's count used, the rest zero).
+    pub natural: [u64; MAX_FACET_NODES],
+    pub dofs: [GlobalDof; MAX_FACET_NODES * DIM],
+    pub x_ref: [[f64; 3]; MAX_FACET_NODES],
 }
 
-/// f64 values per facet in a message: set index, natural ids, DOFs and
-/// reference coordinates of four nodes (integers below 2⁵³ are exact).
-pub const RECORD: usize = 1 + 4 + 4 * DIM + 4 * DIM;
+impl MasterFacet {
+    /// Facet `set_index` with every node slot zero.
+    pub fn empty(set_index: u32) -> Self {
+        MasterFacet {
+            set_index,
+            natural: [0; MAX_FACET_NODES],
+            dofs: [GlobalDof(0); MAX_FACET_NODES * DIM],
+            x_ref: [[0.0; 3]; MAX_FACET_NODES],
+        }
+    }
+}
+
+/// f64 values per facet of `nodes` nodes in a message: set index, natural
+/// ids, DOFs and reference coordinates (integers below 2⁵³ are exact). A
+/// message carries one facet type, so first-order facets travel without
+/// second-order slots.
+pub const fn record(nodes: usize) -> usize {
+    1 + nodes * (1 + 2 * DIM)
+}
 
 type Aabb = ([f64; 3], [f64; 3]);
 
@@ -48,7 +66,7 @@ pub struct HeldMaster {
     pub facet_type: FacetType,
     /// Facets of this rank's cells, by set index, and each one's local nodes.
     own: Vec<MasterFacet>,
-    own_local: Vec<[u32; 4]>,
+    own_local: Vec<[u32; MAX_FACET_NODES]>,
     /// Facets of the whole set (all ranks).
     pub whole: usize,
     /// The largest facet diameter over the whole set.
@@ -58,8 +76,9 @@ pub struct HeldMaster {
     /// The held facets (own inside this rank's box, and received), ordered
     /// by set index so ids and ties go as on the whole set.
     pub set_index: Vec<u32>,
-    /// Held facets as indices into the held node arrays (tri3 uses 3).
-    pub facets: Vec<[u32; 4]>,
+    /// Held facets as indices into the held node arrays (the facet type's
+    /// node count used).
+    pub facets: Vec<[u32; MAX_FACET_NODES]>,
     /// Held nodes, ordered by natural id.
     natural: Vec<u64>,
     /// Index of each held node in the extended local array.
@@ -87,13 +106,8 @@ impl HeldMaster {
         let n = facet_type.nodes();
         let (mut own, mut own_local) = (Vec::new(), Vec::new());
         for f in &refs.facets {
-            let mut facet = MasterFacet {
-                set_index: f.set_index as u32,
-                natural: [0; 4],
-                dofs: [GlobalDof(0); 4 * DIM],
-                x_ref: [[0.0; 3]; 4],
-            };
-            let mut local = [0u32; 4];
+            let mut facet = MasterFacet::empty(f.set_index as u32);
+            let mut local = [0u32; MAX_FACET_NODES];
             for (a, &l) in f.nodes.iter().enumerate().take(n) {
                 let l = LocalNode::from_u32(l);
                 local[a] = l.to_u32();
@@ -149,7 +163,11 @@ impl HeldMaster {
 
     /// A held surface given whole (tests): nodes local 0..n, no tail.
     #[cfg(test)]
-    pub fn from_parts(facet_type: FacetType, x_ref: Vec<[f64; 3]>, facets: Vec<[u32; 4]>) -> Self {
+    pub fn from_parts(
+        facet_type: FacetType,
+        x_ref: Vec<[f64; 3]>,
+        facets: Vec<[u32; MAX_FACET_NODES]>,
+    ) -> Self {
         let n = x_ref.len();
         HeldMaster {
             facet_type,
@@ -201,7 +219,7 @@ impl HeldMaster {
             .own
             .iter()
             .zip(&self.own_local)
-            .map(|(f, l)| current_box(&f.x_ref[..n], &l[..n], u_local))
+            .map(|(f, l)| current_box(self.facet_type, &f.x_ref[..n], &l[..n], u_local))
             .collect();
         let me = ranks.rank();
         let send: Vec<Vec<f64>> = boxes
@@ -213,12 +231,12 @@ impl HeldMaster {
                 }
                 let mut out = Vec::new();
                 for i in select_in_box(&current, *b) {
-                    encode(&self.own[i], &mut out);
+                    encode(&self.own[i], n, &mut out);
                 }
                 out
             })
             .collect();
-        let received = decode(&ranks.all_to_all(&send));
+        let received = decode(&ranks.all_to_all(&send), n);
         self.received = received.len();
         let mut held: Vec<MasterFacet> = select_in_box(&current, mine)
             .into_iter()
@@ -264,7 +282,7 @@ impl HeldMaster {
         self.facets = held
             .iter()
             .map(|f| {
-                let mut ids = [0u32; 4];
+                let mut ids = [0u32; MAX_FACET_NODES];
                 for (slot, v) in ids.iter_mut().zip(&f.natural[..n]) {
                     // Every node of a held facet is held.
                     *slot = self.natural.binary_search(v).unwrap_or(0) as u32;
@@ -341,11 +359,15 @@ pub fn select_in_box(boxes: &[Aabb], target: Aabb) -> Vec<usize> {
         .collect()
 }
 
-fn current_box(x_ref: &[[f64; 3]], local: &[u32], u_local: &[f64]) -> Aabb {
-    x_ref.iter().zip(local).fold(EMPTY_BOX, |b, (x, &l)| {
+/// The box of a facet's current shape (for a curved facet, of its Bézier
+/// control points, see [`search::facet_box`]).
+fn current_box(facet_type: FacetType, x_ref: &[[f64; 3]], local: &[u32], u_local: &[f64]) -> Aabb {
+    let mut x = [[0.0; 3]; MAX_FACET_NODES];
+    for ((o, xr), &l) in x.iter_mut().zip(x_ref).zip(local) {
         let u = LocalNode::from_u32(l).value(u_local);
-        grow(b, [0, 1, 2].map(|c| x[c] + u[c]))
-    })
+        *o = [0, 1, 2].map(|c| xr[c] + u[c]);
+    }
+    search::facet_box(facet_type, &x[..x_ref.len()])
 }
 
 fn grow(b: Aabb, x: [f64; 3]) -> Aabb {
@@ -365,30 +387,30 @@ fn diameter(x: &[[f64; 3]]) -> f64 {
     d
 }
 
-pub fn encode(f: &MasterFacet, out: &mut Vec<f64>) {
+/// Appends facet `f`'s first `nodes` nodes as one record (see [`record`]).
+pub fn encode(f: &MasterFacet, nodes: usize, out: &mut Vec<f64>) {
     out.push(f.set_index as f64);
-    out.extend(f.natural.iter().map(|&v| v as f64));
-    out.extend(f.dofs.iter().map(|v| v.0 as f64));
-    out.extend(f.x_ref.iter().flatten());
+    out.extend(f.natural[..nodes].iter().map(|&v| v as f64));
+    out.extend(f.dofs[..nodes * DIM].iter().map(|v| v.0 as f64));
+    out.extend(f.x_ref[..nodes].iter().flatten());
 }
 
-pub fn decode(values: &[f64]) -> Vec<MasterFacet> {
+/// The facets of records of `nodes` nodes each.
+pub fn decode(values: &[f64], nodes: usize) -> Vec<MasterFacet> {
+    let n = nodes.min(MAX_FACET_NODES);
     values
-        .chunks_exact(RECORD)
+        .chunks_exact(record(n))
         .map(|r| {
-            let mut f = MasterFacet {
-                set_index: r[0] as u32,
-                natural: [0; 4],
-                dofs: [GlobalDof(0); 4 * DIM],
-                x_ref: [[0.0; 3]; 4],
-            };
-            for (v, x) in f.natural.iter_mut().zip(&r[1..5]) {
+            let mut f = MasterFacet::empty(r[0] as u32);
+            let (natural, rest) = r[1..].split_at(n);
+            let (dofs, x_ref) = rest.split_at(n * DIM);
+            for (v, x) in f.natural.iter_mut().zip(natural) {
                 *v = *x as u64;
             }
-            for (d, x) in f.dofs.iter_mut().zip(&r[5..5 + 4 * DIM]) {
+            for (d, x) in f.dofs.iter_mut().zip(dofs) {
                 *d = GlobalDof(*x as _);
             }
-            for (p, x) in f.x_ref.iter_mut().flatten().zip(&r[5 + 4 * DIM..]) {
+            for (p, x) in f.x_ref.iter_mut().flatten().zip(x_ref) {
                 *p = *x;
             }
             f

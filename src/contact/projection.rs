@@ -1,4 +1,5 @@
-//! Closest-point projection of a point onto a quad4 / tri3 master facet.
+//! Closest-point projection of a point onto a master facet of any contact
+//! type (tri3, quad4, tri6, quad8, quad9).
 //!
 //! The facet is the fem module's isoparametric surface `x²(ξ) = Σ N_b(ξ) x_b`
 //! (node order and reference coordinates of [`FacetType`]), extended beyond
@@ -8,18 +9,21 @@
 //!
 //! The projection minimises `φ(ξ) = ½ |x − x²(ξ)|²`. Its stationarity
 //! conditions are `F_α = (x − x²)·τ_α = 0` with `τ_α = ∂x²/∂ξ_α`, and its
-//! Hessian is `H_αβ = τ_α·τ_β − (x − x²)·∂τ_α/∂ξ_β`. Newton with the full
-//! Hessian converges quadratically also on warped quads, where the second
-//! term is non-zero. Safeguards so it never diverges: when `H` is not
+//! Hessian is `H_αβ = τ_α·τ_β − (x − x²)·∂τ_α/∂ξ_β`, with every second
+//! derivative of the shape functions (only the mixed one of the bilinear
+//! quad on a first-order facet, all three on a curved second-order one).
+//! Newton with the full Hessian converges quadratically also on warped and
+//! curved facets, where the second term is non-zero. Second-order facets
+//! share the reference facet of their first-order counterpart (tri6 the
+//! triangle, quad8 and quad9 the square), so `outside` and the search box
+//! are the same. Safeguards so it never diverges: when `H` is not
 //! positive definite the metric `τ_α·τ_β` (Gauss–Newton) or the gradient is
 //! used instead, steps are limited in length, large steps must decrease `φ`
 //! (backtracking), and `ξ` is kept in a box around the reference facet. A
 //! minimiser that would lie outside that box ends as a clamped answer with
 //! `converged = false`.
 
-use crate::contact::facet_shape;
-use crate::contact::MAX_FACET_NODES;
-use crate::fem::shape::QUAD4_REF_NODES;
+use crate::contact::{facet_second, facet_shape, LINEAR_FACET_NODES, MAX_FACET_NODES};
 use crate::fem::FacetType;
 use crate::vec3::{add, cross, dot, norm, sub};
 
@@ -90,20 +94,6 @@ pub fn outside_distance(facet: FacetType, xi: [f64; 2]) -> f64 {
     violation.max(0.0)
 }
 
-/// `∂²N_b/∂ξ₁∂ξ₂`, the only non-zero second derivative of the facet shape
-/// functions (bilinear quad: `¼ ξ_b η_b`; linear tri: 0). With it the
-/// second-order Taylor expansion of `N_b` about any point is exact, which
-/// the link kernel uses to evaluate at a dual-valued `ξ`.
-pub fn mixed_second_derivative(facet: FacetType) -> [f64; MAX_FACET_NODES] {
-    let mut m = [0.0; MAX_FACET_NODES];
-    if facet.linear() == FacetType::Quad4 {
-        for (mb, node) in m.iter_mut().zip(QUAD4_REF_NODES) {
-            *mb = 0.25 * node[0] * node[1];
-        }
-    }
-    m
-}
-
 /// Box that keeps `ξ` near the reference facet: one facet width beyond each
 /// edge (quad `[-2, 2]²`, tri `[-1, 2]²`). A projection further out belongs
 /// to another facet, and the bilinear extension may fold there.
@@ -116,27 +106,29 @@ fn search_box(facet: FacetType) -> (f64, f64) {
 
 /// The facet translated so its node centroid is the origin. Working relative
 /// to the centroid keeps round-off proportional to the facet size rather
-/// than to the distance from the global origin.
-struct Frame {
+/// than to the distance from the global origin. `M`: the node capacity
+/// (four for first-order facets, so they carry no second-order slack).
+struct Frame<const M: usize> {
     facet: FacetType,
-    nodes: [[f64; 3]; MAX_FACET_NODES],
+    nodes: [[f64; 3]; M],
     centre: [f64; 3],
     /// Largest node distance from the centroid: the length scale.
     size: f64,
-    mixed: [f64; MAX_FACET_NODES],
+    /// A second-order facet: `τ_11` and `τ_22` are not zero.
+    curved: bool,
 }
 
-impl Frame {
+impl<const M: usize> Frame<M> {
     fn new(facet: FacetType, master: &[[f64; 3]]) -> Option<Self> {
         let n = facet.nodes();
-        if master.len() != n || !master.iter().flatten().all(|v| v.is_finite()) {
+        if n > M || master.len() != n || !master.iter().flatten().all(|v| v.is_finite()) {
             return None;
         }
         let mut centre = [0.0; 3];
         for p in master {
             centre = add(centre, p.map(|c| c / n as f64));
         }
-        let mut nodes = [[0.0; 3]; MAX_FACET_NODES];
+        let mut nodes = [[0.0; 3]; M];
         let mut size = 0.0f64;
         for (local, p) in nodes.iter_mut().zip(master) {
             *local = sub(*p, centre);
@@ -150,7 +142,7 @@ impl Frame {
             nodes,
             centre,
             size,
-            mixed: mixed_second_derivative(facet),
+            curved: !facet.is_linear(),
         })
     }
 
@@ -159,27 +151,38 @@ impl Frame {
     }
 
     fn surface(&self, xi: [f64; 2]) -> Surface {
-        let s = facet_shape(self.facet, xi);
-        let mut out = Surface::default();
-        for b in 0..self.count() {
-            let xb = self.nodes[b];
-            out.x = add(out.x, xb.map(|c| s.n[b] * c));
-            out.t1 = add(out.t1, xb.map(|c| s.dn[b][0] * c));
-            out.t2 = add(out.t2, xb.map(|c| s.dn[b][1] * c));
-            out.t12 = add(out.t12, xb.map(|c| self.mixed[b] * c));
+        let s = facet_shape::<M>(self.facet, xi);
+        let dd = facet_second::<M>(self.facet, xi);
+        let mut out = Surface {
+            curved: self.curved,
+            ..Surface::default()
+        };
+        let nodes = self.nodes.iter().zip(&s.n).zip(&s.dn).zip(&dd);
+        for (((xb, n), dn), ddb) in nodes.take(self.count()) {
+            out.x = add(out.x, xb.map(|c| n * c));
+            out.t1 = add(out.t1, xb.map(|c| dn[0] * c));
+            out.t2 = add(out.t2, xb.map(|c| dn[1] * c));
+            out.t12 = add(out.t12, xb.map(|c| ddb[1] * c));
+            if self.curved {
+                out.t11 = add(out.t11, xb.map(|c| ddb[0] * c));
+                out.t22 = add(out.t22, xb.map(|c| ddb[2] * c));
+            }
         }
         out
     }
 }
 
-/// Position, tangents and mixed second derivative of the surface at one `ξ`
-/// (centroid-relative).
+/// Position, tangents and second derivatives of the surface at one `ξ`
+/// (centroid-relative); `t11 = t22 = 0` on first-order facets.
 #[derive(Default)]
 struct Surface {
     x: [f64; 3],
     t1: [f64; 3],
     t2: [f64; 3],
     t12: [f64; 3],
+    t11: [f64; 3],
+    t22: [f64; 3],
+    curved: bool,
 }
 
 impl Surface {
@@ -192,13 +195,22 @@ impl Surface {
         }
     }
 
-    /// Hessian of `φ` with `d = x − x²`; `∂τ₁/∂ξ₁ = ∂τ₂/∂ξ₂ = 0` for
-    /// both facet types, so only the off-diagonal gets a curvature term.
+    /// Hessian of `φ` with `d = x − x²`; on a first-order facet
+    /// `∂τ₁/∂ξ₁ = ∂τ₂/∂ξ₂ = 0`, so only the off-diagonal gets a curvature
+    /// term.
     fn hessian(&self, d: [f64; 3]) -> Sym2 {
         let m = self.metric();
-        Sym2 {
-            b: m.b - dot(d, self.t12),
-            ..m
+        if self.curved {
+            Sym2 {
+                a: m.a - dot(d, self.t11),
+                b: m.b - dot(d, self.t12),
+                c: m.c - dot(d, self.t22),
+            }
+        } else {
+            Sym2 {
+                b: m.b - dot(d, self.t12),
+                ..m
+            }
         }
     }
 }
@@ -268,7 +280,7 @@ fn free_components(xi: [f64; 2], f: [f64; 2], (lo, hi): (f64, f64)) -> [bool; 2]
     [0, 1].map(|i| !((xi[i] <= lo && f[i] < 0.0) || (xi[i] >= hi && f[i] > 0.0)))
 }
 
-fn objective(frame: &Frame, y: [f64; 3], xi: [f64; 2]) -> f64 {
+fn objective<const M: usize>(frame: &Frame<M>, y: [f64; 3], xi: [f64; 2]) -> f64 {
     let d = sub(y, frame.surface(xi).x);
     0.5 * dot(d, d)
 }
@@ -284,7 +296,12 @@ fn limit_step(dir: [f64; 2]) -> [f64; 2] {
 }
 
 /// Backtracking along `dir` (projected onto the box) until `φ` decreases.
-fn line_search(frame: &Frame, y: [f64; 3], xi: [f64; 2], dir: [f64; 2]) -> Option<[f64; 2]> {
+fn line_search<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    xi: [f64; 2],
+    dir: [f64; 2],
+) -> Option<[f64; 2]> {
     let bounds = search_box(frame.facet);
     let phi = objective(frame, y, xi);
     let mut alpha = 1.0;
@@ -311,7 +328,11 @@ fn initial_xi(facet: FacetType, start: Option<[f64; 2]>) -> [f64; 2] {
 
 /// Newton iteration; returns the final `ξ`, whether it converged, and the
 /// number of iterations (for tests of the convergence rate).
-fn newton(frame: &Frame, y: [f64; 3], mut xi: [f64; 2]) -> ([f64; 2], bool, usize) {
+fn newton<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    mut xi: [f64; 2],
+) -> ([f64; 2], bool, usize) {
     let bounds = search_box(frame.facet);
     // Round-off in F grows with the distance of x from the facet, so the
     // attainable accuracy of ξ does too.
@@ -364,8 +385,22 @@ pub(crate) fn project_counted(
     x: [f64; 3],
     start: Option<[f64; 2]>,
 ) -> (Projection, usize) {
+    if facet.is_linear() {
+        project_in::<LINEAR_FACET_NODES>(facet, master, x, start)
+    } else {
+        project_in::<MAX_FACET_NODES>(facet, master, x, start)
+    }
+}
+
+/// [`project_counted`] in holders of `M` nodes.
+fn project_in<const M: usize>(
+    facet: FacetType,
+    master: &[[f64; 3]],
+    x: [f64; 3],
+    start: Option<[f64; 2]>,
+) -> (Projection, usize) {
     let xi0 = initial_xi(facet, start);
-    let Some(frame) = Frame::new(facet, master) else {
+    let Some(frame) = Frame::<M>::new(facet, master) else {
         return (failed(xi0), 0);
     };
     if !x.iter().all(|v| v.is_finite()) {
@@ -377,7 +412,12 @@ pub(crate) fn project_counted(
 }
 
 /// Point, normal and gap at the final `ξ`.
-fn finish(frame: &Frame, y: [f64; 3], xi: [f64; 2], converged: bool) -> Projection {
+fn finish<const M: usize>(
+    frame: &Frame<M>,
+    y: [f64; 3],
+    xi: [f64; 2],
+    converged: bool,
+) -> Projection {
     let s = frame.surface(xi);
     let n = cross(s.t1, s.t2);
     let area = norm(n);
@@ -410,5 +450,7 @@ fn finish(frame: &Frame, y: [f64; 3], xi: [f64; 2], converged: bool) -> Projecti
     }
 }
 
+#[cfg(test)]
+mod curved_tests;
 #[cfg(test)]
 mod tests;

@@ -3,7 +3,7 @@
 //! Slave facets belong to the rank that owns their cell; that rank evaluates
 //! their links. The master facets a rank holds are `held_master`'s.
 use super::autodiff;
-use crate::contact::facet_shape;
+use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::distribution::{LocalFacetSet, LocalMesh, SlaveSetPiece};
 use crate::dofs::{DofMap, GlobalDof, LocalNode, DIM};
 use crate::error::{Error, Result};
@@ -47,21 +47,16 @@ pub struct SlaveSurface {
     pub h: f64,
 }
 
-/// The one first-order facet type of a contact facet set. The scene refuses
-/// other sets before set-up (`scene/contact.rs`); this keeps a model built
-/// in code from reaching the first-order kernels with them.
+/// The one facet type of a contact facet set (any order; the scene refuses
+/// second-order facets for the mortar formulation, `scene/contact.rs`, and
+/// mixed sets for both).
 pub fn contact_facet_type(mesh: &LocalMesh, set: &str) -> Result<FacetType> {
-    match mesh.set_facet_type(set) {
-        Some(t) if t.is_linear() => Ok(t),
-        Some(t) => Err(Error::scene(
+    mesh.set_facet_type(set).ok_or_else(|| {
+        Error::scene(
             "contact",
-            format!("facet set '{set}': second-order facets ({}) are not supported by contact yet", t.name()),
-        )),
-        None => Err(Error::scene(
-            "contact",
-            format!("facet set '{set}' mixes facet types or does not exist; contact needs one type (tri3 or quad4) per surface"),
-        )),
-    }
+            format!("facet set '{set}' mixes facet types or does not exist; contact needs one type (tri3, quad4, tri6, quad8 or quad9) per surface"),
+        )
+    })
 }
 
 impl SlaveSurface {
@@ -104,7 +99,7 @@ impl SlaveSurface {
             facets.push(SlaveFacet {
                 set_index,
                 nodes,
-                h: shortest_edge(&x_ref),
+                h: shortest_edge(&x_ref, facet_type.corners()),
                 x_ref,
                 dofs: facet_dofs,
             });
@@ -143,7 +138,7 @@ impl SlaveSurface {
     /// Current position of local quadrature point `q`.
     pub fn qp_position(&self, q: usize, u_local: &[f64]) -> [f64; 3] {
         let facet = &self.facets[q / self.nqp];
-        let s = facet_shape(self.facet_type, self.qp_zeta[q]);
+        let s = facet_shape::<MAX_FACET_NODES>(self.facet_type, self.qp_zeta[q]);
         let mut x = [0.0; 3];
         for (a, (&l, xr)) in facet.nodes.iter().zip(&facet.x_ref).enumerate() {
             for c in 0..DIM {
@@ -164,7 +159,11 @@ impl SlaveSurface {
     }
 }
 
-fn shortest_edge(x: &[[f64; 3]]) -> f64 {
+/// Shortest corner-to-corner edge (the corners come first on every facet
+/// type, so a second-order facet's size is its chords', as the mesh's
+/// `mean_shortest_edge` measures it).
+fn shortest_edge(x: &[[f64; 3]], corners: usize) -> f64 {
+    let x = &x[..corners.min(x.len())];
     (0..x.len())
         .map(|i| {
             let (a, b) = (x[i], x[(i + 1) % x.len()]);
@@ -218,7 +217,7 @@ pub fn reference_weights(
         .zip(&rule.weights)
         .map(|(p, w)| {
             let zeta = [p[0], p[1]];
-            let s = facet_shape(facet, zeta);
+            let s = facet_shape::<MAX_FACET_NODES>(facet, zeta);
             let mut t = [[0.0; 3]; 2];
             for (xa, da) in x_ref.iter().zip(&s.dn) {
                 t[0] = autodiff::axpy(&t[0], da[0], xa);

@@ -36,8 +36,8 @@ pub struct LocalFacetSet {
 pub struct GhostFacet {
     pub set_index: usize,
     /// Natural node ids (`facet_type.nodes()` used).
-    pub natural: [usize; 4],
-    pub x_ref: [[f64; 3]; 4],
+    pub natural: [usize; MAX_FACET_NODES],
+    pub x_ref: [[f64; 3]; MAX_FACET_NODES],
 }
 
 /// What a rank needs of a contact slave set beyond its own facets.
@@ -191,8 +191,11 @@ pub(super) fn local_facets(
 pub(super) fn mean_shortest_edge(mesh: &Mesh, facets: &[FacetRef]) -> f64 {
     let mut sum = 0.0;
     for f in facets {
+        // The corners (they come first): a second-order facet's edges are
+        // its chords.
+        let corners = mesh.facet_type(f).corners();
         let x: Vec<[f64; 3]> = match mesh.facet_nodes_iter(f) {
-            Ok(it) => it.map(|v| mesh.nodes[v]).collect(),
+            Ok(it) => it.take(corners).map(|v| mesh.nodes[v]).collect(),
             Err(_) => continue,
         };
         sum += shortest_edge(&x);

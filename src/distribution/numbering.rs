@@ -3,6 +3,7 @@
 //! which each rank's [`Piece`] is cut.
 use super::local::{self, GhostFacet, LocalMesh, OutputBlock, SharedSet, SlaveSetPiece};
 use super::{even_block, Piece, Wanted};
+use crate::fem::MAX_FACET_NODES;
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;
 
@@ -186,10 +187,10 @@ impl Numbering {
             }
             let mut g = GhostFacet {
                 set_index,
-                natural: [0; 4],
-                x_ref: [[0.0; 3]; 4],
+                natural: [0; MAX_FACET_NODES],
+                x_ref: [[0.0; 3]; MAX_FACET_NODES],
             };
-            for (a, &v) in nodes.iter().enumerate().take(4) {
+            for (a, &v) in nodes.iter().enumerate().take(MAX_FACET_NODES) {
                 g.natural[a] = v;
                 g.x_ref[a] = mesh.nodes[v];
             }

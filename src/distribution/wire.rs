@@ -180,14 +180,15 @@ fn read_mesh(r: &mut Reader) -> Result<LocalMesh> {
         let n = r.scalar()?;
         let mut ghosts = Vec::new();
         for _ in 0..n {
-            let v = r.fixed(17)?;
+            const N: usize = MAX_FACET_NODES;
+            let v = r.fixed(1 + 4 * N)?;
             let mut g = GhostFacet {
                 set_index: v[0] as usize,
-                natural: [v[1] as usize, v[2] as usize, v[3] as usize, v[4] as usize],
-                x_ref: [[0.0; 3]; 4],
+                natural: std::array::from_fn(|k| v[1 + k] as usize),
+                x_ref: [[0.0; 3]; N],
             };
             for (k, x) in g.x_ref.iter_mut().flatten().enumerate() {
-                *x = f64::from_bits(v[5 + k]);
+                *x = f64::from_bits(v[1 + N + k]);
             }
             ghosts.push(g);
         }

@@ -166,6 +166,60 @@ impl<const N: usize> FacetShape<N> {
         eval_facet(facet, xi, &mut s.n[..k], &mut s.dn[..k]);
         Some(s)
     }
+
+    /// The second derivatives (see [`eval_facet_second`]) of `facet` at
+    /// `xi`, or `None` when it has more than `N` nodes.
+    pub fn second(facet: FacetType, xi: [f64; 2]) -> Option<[[f64; 3]; N]> {
+        let k = facet.nodes();
+        if k > N {
+            return None;
+        }
+        let mut ddn = [[0.0; 3]; N];
+        eval_facet_second(facet, xi, &mut ddn[..k]);
+        Some(ddn)
+    }
+
+    /// The third derivatives (see [`eval_facet_third`]) of `facet` at `xi`,
+    /// or `None` when it has more than `N` nodes.
+    pub fn third(facet: FacetType, xi: [f64; 2]) -> Option<[[f64; 2]; N]> {
+        let k = facet.nodes();
+        if k > N {
+            return None;
+        }
+        let mut dddn = [[0.0; 2]; N];
+        eval_facet_third(facet, xi, &mut dddn[..k]);
+        Some(dddn)
+    }
+}
+
+/// Writes the second reference derivatives `[∂²N_a/∂ξ₁², ∂²N_a/∂ξ₁∂ξ₂,
+/// ∂²N_a/∂ξ₂²]` of `facet` at `xi` into `ddn`, which holds exactly
+/// `facet.nodes()` entries (zero for tri3; only the mixed one for quad4).
+pub fn eval_facet_second(facet: FacetType, xi: [f64; 2], ddn: &mut [[f64; 3]]) {
+    match facet {
+        FacetType::Quad4 => {
+            for (d, node) in ddn.iter_mut().zip(&QUAD4_REF_NODES) {
+                *d = [0.0, 0.25 * node[0] * node[1], 0.0];
+            }
+        }
+        FacetType::Tri3 => ddn.fill([0.0; 3]),
+        FacetType::Tri6 => higher::tri6_second(ddn),
+        FacetType::Quad8 => higher::quad8_second(xi, ddn),
+        FacetType::Quad9 => higher::quad9_second(xi, ddn),
+    }
+}
+
+/// Writes the third reference derivatives `[∂³N_a/∂ξ₁²∂ξ₂,
+/// ∂³N_a/∂ξ₁∂ξ₂²]` of `facet` at `xi` into `dddn` (`facet.nodes()`
+/// entries). `∂³/∂ξ₁³` and `∂³/∂ξ₂³` vanish on every facet type (each is at
+/// most quadratic in either coordinate alone), and so do these two on the
+/// triangles and on quad4.
+pub fn eval_facet_third(facet: FacetType, xi: [f64; 2], dddn: &mut [[f64; 2]]) {
+    match facet {
+        FacetType::Quad4 | FacetType::Tri3 | FacetType::Tri6 => dddn.fill([0.0; 2]),
+        FacetType::Quad8 => higher::quad8_third(dddn),
+        FacetType::Quad9 => higher::quad9_third(xi, dddn),
+    }
 }
 
 /// Any facet's shape at `xi`.

@@ -14,31 +14,27 @@ use crate::model::{
 };
 
 /// Gauss points on quadrilateral slave facets (docs/formulation.md §2.4); on
-/// triangles, the slave nodes. Three Gauss points per triangle put about six
+/// first-order triangles, the slave nodes; on every second-order facet the
+/// facet rule of `fem` (tri6 six points, quad8 / quad9 3×3), whose weights
+/// on the curved reference facet integrate `N_a |X,₁ × X,₂|` exactly: the
+/// nodal rule has no second-order counterpart with positive weights (the
+/// tri6 corner functions integrate to zero, quad8's to −⅓). Three Gauss points per triangle put about six
 /// constraints on every slave node of a tet mesh, more than linear tets can
 /// meet: the Uzawa loop then stalls just above its tolerance (sphere-block:
 /// 361 Newton iterations and 7 cutbacks with Gauss points, 85 with one point
 /// per facet, 36 and none at the nodes).
 pub(super) fn default_quadrature(facet: FacetType) -> SlaveQuadrature {
-    match facet.linear() {
-        FacetType::Quad4 => SlaveQuadrature::Gauss,
-        _ => SlaveQuadrature::Nodal,
+    match facet {
+        FacetType::Tri3 => SlaveQuadrature::Nodal,
+        _ => SlaveQuadrature::Gauss,
     }
 }
 
-/// The one facet type of a contact surface: contact handles first-order
-/// facets (tri3, quad4) only, one type per surface. Any other set is this
-/// pair's scene error, before set-up.
+/// The one facet type of a contact surface (any order; whether the pair's
+/// formulation takes it is [`formulation`]'s question). A set that mixes
+/// facet types is this pair's scene error, before set-up.
 fn contact_facet_type(mesh: &Mesh, set: &str, name: &str) -> Result<FacetType, String> {
     let types = mesh.facet_set_types(set).map_err(|e| e.to_string())?;
-    if let Some(t) = types.iter().find(|t| !t.is_linear()) {
-        return Err(format!(
-            "contact pair '{name}': second-order facets ({}) are not supported by contact yet; \
-             set '{set}' holds them. Mesh the contact bodies with first-order cells \
-             (tet4, hex8, wedge6, pyramid5)",
-            t.name()
-        ));
-    }
     match types.as_slice() {
         [] => Ok(mesh.cell_type.face_type(0)),
         [one] => Ok(*one),
@@ -57,15 +53,13 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
     check_facet_set(mesh, &c.slave, &format!("{at} slave"))
         .map_err(|m| Bad::at(&key("slave"), m))?;
     let facet = contact_facet_type(mesh, &c.slave, &name).map_err(|m| Bad::at(&key("slave"), m))?;
+    let mut master_facet = None;
     let master = match (&c.master, &c.rigid) {
         (Some(m), None) => {
             check_facet_set(mesh, m, &format!("{at} master"))
                 .map_err(|e| Bad::at(&key("master"), e))?;
-            let master_facet =
-                contact_facet_type(mesh, m, &name).map_err(|e| Bad::at(&key("master"), e))?;
-            if master_facet != facet {
-                return Err(Bad::at(&key("master"), format!("contact pair '{name}': the slave facets are {} and the master facets {}; contact needs one facet type on both surfaces", facet.name(), master_facet.name())));
-            }
+            master_facet =
+                Some(contact_facet_type(mesh, m, &name).map_err(|e| Bad::at(&key("master"), e))?);
             if m == &c.slave {
                 return Err(Bad::at(&key("master"), format!("{at}: slave and master are the same facet set '{m}'; a surface cannot contact itself here")));
             }
@@ -114,7 +108,8 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
     }
     spec.motion_amplitude = amplitude(&c.motion_amplitude, &format!("{at} motion_amplitude"))
         .map_err(|m| Bad::at(&key("motion_amplitude"), m))?;
-    spec.formulation = formulation(facet, c, &at).map_err(|m| Bad::at(&key("formulation"), m))?;
+    spec.formulation = formulation(&name, facet, master_facet, c, &at)
+        .map_err(|m| Bad::at(&key("formulation"), m))?;
     spec.quadrature = match c.quadrature.as_deref() {
         None => default_quadrature(facet),
         Some("gauss") => SlaveQuadrature::Gauss,
@@ -127,6 +122,12 @@ pub(super) fn contact_spec(mesh: &Mesh, c: &ContactSection, index: usize) -> Che
             ))
         }
     };
+    if spec.quadrature == SlaveQuadrature::Nodal && !facet.is_linear() {
+        return Err(Bad::at(
+            &key("quadrature"),
+            format!("{at}: quadrature \"nodal\" puts the points at the corners of first-order facets; the slave facets are {} (use \"gauss\", the default, or \"centroid\")", facet.name()),
+        ));
+    }
     let positive = |v: f64, k: &'static str| {
         if v > 0.0 && v.is_finite() {
             Ok(v)
@@ -198,11 +199,14 @@ pub(super) fn rigid_point(r: &RigidSurface) -> [f64; 3] {
 }
 
 /// The pair's `formulation`, checked against what the mortar formulation
-/// supports (quad4 or tri3 facets; a master facet set or a rigid surface).
-/// Without the key a pair is a mortar pair, unless it sets `quadrature`,
-/// which only places links' points: then it asked for links.
+/// supports (quad4 or tri3 facets, the same type on both surfaces; a master
+/// facet set or a rigid surface). The links take any facet types. Without
+/// the key a pair is a mortar pair, unless it sets `quadrature`, which only
+/// places links' points: then it asked for links.
 pub(super) fn formulation(
+    name: &str,
     facet: FacetType,
+    master_facet: Option<FacetType>,
     c: &ContactSection,
     at: &str,
 ) -> std::result::Result<Formulation, String> {
@@ -217,10 +221,22 @@ pub(super) fn formulation(
             ))
         }
     };
-    if !f.supports(facet) {
+    // Mortar on quadratic facets needs a modified dual basis (the standard
+    // one has non-positive corner weights there), which is not built.
+    if let Some(t) = std::iter::once(facet)
+        .chain(master_facet)
+        .find(|t| !f.supports(*t))
+    {
         return Err(format!(
-            "{at}: formulation \"mortar\" does not support {} facets",
-            facet.name()
+            "contact pair '{name}': formulation \"mortar\" does not support second-order facets ({}); use formulation = \"links\" for this pair",
+            t.name()
+        ));
+    }
+    if let Some(m) = master_facet.filter(|m| *m != facet) {
+        return Err(format!(
+            "contact pair '{name}': the slave facets are {} and the master facets {}; formulation \"mortar\" needs one facet type on both surfaces (formulation = \"links\" takes both)",
+            facet.name(),
+            m.name()
         ));
     }
     if c.quadrature.is_some() {

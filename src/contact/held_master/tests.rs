@@ -31,15 +31,19 @@ fn an_empty_box_selects_nothing() {
 
 #[test]
 fn records_travel_unchanged() {
-    let f = MasterFacet {
-        set_index: 12345,
-        natural: [7, 8, 9_000_000_000, 10],
-        dofs: [GlobalDof(3); 4 * DIM],
-        x_ref: [[0.1, -0.2, 0.3]; 4],
-    };
-    let mut out = Vec::new();
-    encode(&f, &mut out);
-    encode(&f, &mut out);
-    assert_eq!(out.len(), 2 * RECORD);
-    assert_eq!(decode(&out), vec![f.clone(), f]);
+    for nodes in [3, 4, 6, 8, 9] {
+        let mut f = MasterFacet::empty(12345);
+        for a in 0..nodes {
+            f.natural[a] = 7 + 9_000_000_000 * (a as u64 % 2);
+            f.x_ref[a] = [0.1 * a as f64, -0.2, 0.3];
+            for c in 0..DIM {
+                f.dofs[DIM * a + c] = GlobalDof((3 + a * DIM + c) as _);
+            }
+        }
+        let mut out = Vec::new();
+        encode(&f, nodes, &mut out);
+        encode(&f, nodes, &mut out);
+        assert_eq!(out.len(), 2 * record(nodes));
+        assert_eq!(decode(&out, nodes), vec![f.clone(), f]);
+    }
 }

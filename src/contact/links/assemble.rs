@@ -5,20 +5,32 @@ use super::LinksPair;
 use crate::assembly::{MatrixSink, PatternSink};
 use crate::contact::formulation::{self, At};
 use crate::contact::master::MasterSide;
+use crate::contact::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 use std::collections::BTreeSet;
 
 /// Scratch space for one link's input (no allocation per link).
-#[derive(Default)]
 pub(super) struct LinkBuffers {
-    xs: [[f64; 3]; 4],
-    xm: [[f64; 3]; 4],
-    vs: [[f64; 3]; 4],
-    vm: [[f64; 3]; 4],
+    xs: [[f64; 3]; MAX_FACET_NODES],
+    xm: [[f64; 3]; MAX_FACET_NODES],
+    vs: [[f64; 3]; MAX_FACET_NODES],
+    vm: [[f64; 3]; MAX_FACET_NODES],
 }
 
-const MAX_LINK_NODES: usize = 8;
+impl Default for LinkBuffers {
+    fn default() -> Self {
+        let zero = [[0.0; 3]; MAX_FACET_NODES];
+        LinkBuffers {
+            xs: zero,
+            xm: zero,
+            vs: zero,
+            vm: zero,
+        }
+    }
+}
+
+const MAX_LINK_NODES: usize = 2 * MAX_FACET_NODES;
 
 const MAX_LINK_DOFS: usize = DIM * MAX_LINK_NODES;
 

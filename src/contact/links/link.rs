@@ -206,7 +206,7 @@ fn still_inside(
     const STICKY: f64 = 1e-3;
     let ids = surface.facet(facet)?;
     let n = surface.facet_type.nodes();
-    let mut xm = [[0.0; 3]; 4];
+    let mut xm = [[0.0; 3]; crate::contact::MAX_FACET_NODES];
     for (slot, &id) in xm.iter_mut().zip(&ids[..n]) {
         *slot = surface.position(id)?;
     }

@@ -13,8 +13,8 @@
 //! second halo with the same owned + ghost layout, exchanged with
 //! λN: ghosts feed the nodal tangential forces the Uzawa test compares.
 use crate::assembly::{Halo, HaloFactory};
-use crate::contact::facet_shape;
 use crate::contact::surfaces::{reference_weights, SlaveSurface};
+use crate::contact::{facet_shape, MAX_FACET_NODES};
 use crate::distribution::SlaveSetPiece;
 use crate::dofs::{DofMap, LocalNode, NaturalNode};
 use crate::error::Result;
@@ -28,7 +28,15 @@ struct NodalWeight {
     /// Position of the node in `owned_nodes`.
     owned_slot: u32,
     slot: u32,
+    /// `N_a(ζ) w`: the node's share of the point's force.
     weight: f64,
+    /// The node's weight in the nodal pressure, a weighted mean of the point
+    /// multipliers around it: `N_a w` on first-order facets (so the
+    /// pressure is force over area), `N_a² w` on second-order ones, whose
+    /// corner functions integrate to zero (tri6) or less (quad8): the
+    /// diagonal, HRZ-like weights are positive and still favour the points
+    /// nearest the node.
+    share: f64,
 }
 
 impl NodalWeight {
@@ -208,21 +216,24 @@ impl Multipliers {
         let mut owned_nodes: Vec<(u32, [f64; 3])> = Vec::new();
         let mut slot_of: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
         let nf = slave.facet_type.nodes();
+        let linear = slave.facet_type.is_linear();
         let mut add_facet = |natural: &[usize], x_ref: &[[f64; 3]], first_slot: usize| {
             let points = reference_weights(slave.facet_type, x_ref, rule);
             for (q, (zeta, w)) in points.iter().enumerate() {
-                let s = facet_shape(slave.facet_type, *zeta);
+                let s = facet_shape::<MAX_FACET_NODES>(slave.facet_type, *zeta);
                 for (a, &v) in natural.iter().enumerate() {
                     if let Some(l) = owned_node(v).map(LocalNode::to_u32) {
                         let owned_slot = *slot_of.entry(l).or_insert_with(|| {
                             owned_nodes.push((l, x_ref[a]));
                             (owned_nodes.len() - 1) as u32
                         });
+                        let weight = s.n[a] * w;
                         nodal.push(NodalWeight {
                             owned_node: l,
                             owned_slot,
                             slot: (first_slot + q) as u32,
-                            weight: s.n[a] * w,
+                            weight,
+                            share: if linear { weight } else { s.n[a] * weight },
                         });
                     }
                 }
@@ -326,13 +337,17 @@ impl Multipliers {
     }
 
     /// Nodal contact pressure of each owned slave node: its normal force over
-    /// its share of the slave area, Σ N_a w λN / Σ N_a w. Unlike the point
-    /// multipliers it is unique, and it is what the Hertz checks compare.
+    /// its share of the slave area, Σ N_a w λN / Σ N_a w, on first-order
+    /// facets; on second-order ones the mean Σ N_a² w λN / Σ N_a² w (see
+    /// `NodalWeight::share`). Unlike the point multipliers it is unique, and
+    /// it is what the Hertz checks compare.
     pub fn nodal_pressures(&self) -> Result<Vec<f64>> {
-        let forces = self.nodal_forces()?;
+        let mut forces = vec![0.0; self.owned_nodes.len()];
         let mut area = vec![0.0; forces.len()];
+        let all = self.halo.local();
         for w in &self.nodal {
-            area[w.owned_slot()] += w.weight;
+            forces[w.owned_slot()] += w.share * all[w.slot()];
+            area[w.owned_slot()] += w.share;
         }
         Ok(forces
             .iter()
@@ -355,8 +370,8 @@ impl Multipliers {
         debug_assert_eq!(all.len(), self.n_owned + self.n_ghost);
         for w in &self.nodal {
             let l = w.owned_node().index();
-            numerator[l] += w.weight * all[w.slot()];
-            denominator[l] += w.weight;
+            numerator[l] += w.share * all[w.slot()];
+            denominator[l] += w.share;
         }
         Ok(())
     }

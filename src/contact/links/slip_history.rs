@@ -167,7 +167,7 @@ fn global_facet(master: &MasterSide, facet: u32) -> u32 {
 
 /// Tangents `∂x/∂ξ_α` of a facet with nodes `x` at `xi`.
 fn facet_tangents(m: &HeldMaster, x: &[[f64; 3]], xi: [f64; 2]) -> [[f64; 3]; 2] {
-    let s = crate::contact::facet_shape(m.facet_type, xi);
+    let s = crate::contact::facet_shape::<{ crate::contact::MAX_FACET_NODES }>(m.facet_type, xi);
     let mut t = [[0.0; 3]; 2];
     for (xb, dn) in x.iter().zip(&s.dn) {
         for c in 0..3 {
@@ -190,7 +190,7 @@ fn facet_points(m: &HeldMaster, facet: u32, positions: &[[f64; 3]]) -> Vec<[f64;
 /// independent of the current displacements).
 fn rebase_origin(m: &HeldMaster, from: u32, xi: [f64; 2], to: u32, guess: [f64; 2]) -> [f64; 2] {
     let from_x = facet_points(m, from, &m.x_ref);
-    let s = crate::contact::facet_shape(m.facet_type, xi);
+    let s = crate::contact::facet_shape::<{ crate::contact::MAX_FACET_NODES }>(m.facet_type, xi);
     let mut p = [0.0; 3];
     for (xb, nb) in from_x.iter().zip(s.n) {
         for c in 0..3 {
@@ -248,12 +248,20 @@ mod tests {
                 [1.0, 1.0, 0.0],
                 [2.0, 1.0, 0.0],
             ],
-            vec![[0, 1, 4, 3], [5, 4, 1, 2]],
+            vec![[0, 1, 4, 3], [5, 4, 1, 2]]
+                .into_iter()
+                .map(|f| {
+                    let mut row = [0; crate::contact::MAX_FACET_NODES];
+                    row[..4].copy_from_slice(&f);
+                    row
+                })
+                .collect(),
         )
     }
 
     fn point_on(m: &HeldMaster, facet: u32, x: &[[f64; 3]], xi: [f64; 2]) -> [f64; 3] {
-        let s = crate::contact::facet_shape(m.facet_type, xi);
+        let s =
+            crate::contact::facet_shape::<{ crate::contact::MAX_FACET_NODES }>(m.facet_type, xi);
         let mut p = [0.0; 3];
         for (&n, nb) in m.facet_nodes(facet).iter().zip(s.n) {
             for c in 0..3 {

@@ -8,8 +8,8 @@
 //! covers in part (at the master's edge) keeps its segments' `D`, the part
 //! that matches `M` there.
 use super::segment::SegmentTerms;
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::Scalar;
-use crate::contact::MAX_FACET_NODES;
 
 /// Relative tolerance on a slave facet's area for its segments to cover it
 /// whole: far above the segment rules' error on bent facets, far below a

@@ -10,9 +10,9 @@ use super::output::OutputRows;
 use super::pair::MortarPair;
 use super::rows::{signature, Rows};
 use super::system::{self, Interface, NodeState, Segment};
+use super::MAX_FACET_NODES;
 use crate::assembly::MatrixSink;
 use crate::contact::autodiff::Dual;
-use crate::contact::MAX_FACET_NODES;
 use crate::error::Result;
 use crate::fem::surface::facet_normal_at_centre;
 

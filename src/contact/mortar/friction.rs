@@ -26,8 +26,8 @@ use super::system::{
     emit_local, for_each_slave_node, segment_nodes, Block, Interface, Merger, NodalData, NodeDof,
     NodeState, NormalTangent, Segment, SEGMENT_DOFS,
 };
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
-use crate::contact::MAX_FACET_NODES;
 
 type D = Dual<{ super::system::SEGMENT_DOFS }>;
 /// The node aggregates the law depends on: `g̃`, `a` (3), `ũ` (3).

@@ -10,8 +10,8 @@
 //! then that of the current clipping pattern, which is the derivative almost
 //! everywhere.
 use super::bilinear::Bilinear;
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::contact::MAX_FACET_NODES;
 use crate::fem::FacetType;
 
 /// A 2-vector in the auxiliary plane.
@@ -41,7 +41,7 @@ impl<T: Scalar> Plane<T> {
     /// degenerate facet (no normal at its centre).
     pub fn of_facet(facet: FacetType, x: &[Vec3<T>]) -> Option<Self> {
         let centre = crate::contact::projection::reference_centre(facet);
-        let s = crate::contact::facet_shape(facet, centre);
+        let s = super::facet_shape(facet, centre);
         let zero = autodiff::constant3::<T>([0.0; 3]);
         let (mut origin, mut t1, mut t2) = (zero, zero, zero);
         for (a, xa) in x.iter().enumerate().take(facet.nodes()) {

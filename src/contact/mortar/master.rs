@@ -2,9 +2,9 @@
 //! master: the facets of a deformable body this rank holds, or a rigid
 //! analytic surface with its prescribed motion. Each variant's run-time
 //! duties are in its own module (`facet_side`, `rigid_side`).
+use super::MAX_FACET_NODES;
 use crate::contact::held_master::HeldMaster;
 use crate::contact::master::RigidMaster;
-use crate::contact::MAX_FACET_NODES;
 
 /// The master side of a mortar pair at run time.
 pub(super) enum Master {

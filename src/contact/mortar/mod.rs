@@ -59,6 +59,16 @@ mod tangential;
 
 pub use pair::MortarPair;
 
+/// Most nodes of a mortar facet (quad4): the mortar formulation is
+/// first-order (the scene refuses second-order facets for it), so its
+/// arrays stay sized for first-order facets.
+pub const MAX_FACET_NODES: usize = crate::contact::LINEAR_FACET_NODES;
+
+/// The first-order shape functions of a mortar facet at one point.
+pub type FacetShape = crate::fem::shape::FacetShape<MAX_FACET_NODES>;
+
+pub use crate::fem::shape::linear_facet_shape as facet_shape;
+
 #[cfg(test)]
 mod friction_tests;
 #[cfg(test)]

@@ -1,11 +1,11 @@
 //! What a mortar pair hands the result file: nodal fields of the owned
 //! slave nodes, the pair's force, and point values interpolated from the
 //! nodes.
+use super::facet_shape;
 use super::friction::Rate;
 use super::master::Master;
 use super::pair::MortarPair;
 use super::system::NodeState;
-use crate::contact::facet_shape;
 use crate::contact::fields::{self, Field, PairOutput};
 use crate::contact::outcome::PairForce;
 

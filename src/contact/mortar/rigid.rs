@@ -23,11 +23,11 @@
 //! The prescribed translation of the surface enters through its placement
 //! (`RigidSurface::moved` at the current load factor) and, with friction,
 //! through the master's increment in the slip (`rigid_friction`).
+use super::facet_shape;
 use super::segment::{dual_coefficients, dual_values, MortarRules, Rule};
 use super::system::{emit_scaled_outer, NodalData, NodeDof, NodeState};
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::{self, Dual, Scalar, Seed, Vec3};
-use crate::contact::facet_shape;
-use crate::contact::MAX_FACET_NODES;
 use crate::fem::{FacetType, QuadRule};
 use crate::model::RigidSurface;
 

@@ -17,8 +17,8 @@
 use super::friction::{emit_outer, node_law, Increment, NodalFriction, NodeFriction};
 use super::rigid::{for_each_node, RigidFacet, RigidInterface, RD};
 use super::system::{NodalData, NodeDof, NodeState};
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::{self, Scalar, Seed, Vec3};
-use crate::contact::MAX_FACET_NODES;
 
 /// One facet's weighted slip per row, `Σ_k D_ak Δ_k − d_a Δc`.
 #[derive(Debug, Clone, Copy)]

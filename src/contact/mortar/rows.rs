@@ -9,8 +9,8 @@
 //! order.
 use super::friction::NodeFriction;
 use super::system::{NodalData, NodeDof, NodeState, Segment};
+use super::MAX_FACET_NODES;
 use crate::assembly::MatrixSink;
-use crate::contact::MAX_FACET_NODES;
 use crate::dofs::{GlobalDof, DIM};
 use crate::error::Result;
 

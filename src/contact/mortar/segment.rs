@@ -21,9 +21,9 @@
 //! (biorthogonality), a constant: such a facet takes that diagonal instead
 //! of the segments' sum (`system::covered_facets`).
 use super::geometry::{overlap, shape_gradients, NEAR_AFFINE};
+use super::MAX_FACET_NODES;
+use super::{facet_shape, FacetShape};
 use crate::contact::autodiff::{self, Scalar, Vec3};
-use crate::contact::MAX_FACET_NODES;
-use crate::contact::{facet_shape, FacetShape};
 use crate::fem::{FacetType, QuadRule};
 
 /// A quadrature rule as (point, weight) pairs.

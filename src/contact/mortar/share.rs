@@ -31,10 +31,10 @@
 //! solver fills by a scatter: the pair's slave tail first, then its master's.
 use super::master::Master;
 use super::pair::MortarPair;
+use super::MAX_FACET_NODES;
 use crate::assembly::RankExchange;
-use crate::contact::held_master::{self, MasterFacet, RECORD};
+use crate::contact::held_master::{self, record, MasterFacet};
 use crate::contact::surfaces::contact_facet_type;
-use crate::contact::MAX_FACET_NODES;
 use crate::distribution::LocalMesh;
 use crate::dofs::{DofMap, GlobalDof, LocalNode, NaturalNode, DIM};
 use crate::error::{Error, Result};
@@ -60,12 +60,7 @@ fn own_records(mesh: &LocalMesh, dofs: &DofMap, set: &str) -> Result<Vec<MasterF
         .facets
         .iter()
         .map(|f| {
-            let mut facet = MasterFacet {
-                set_index: f.set_index as u32,
-                natural: [0; 4],
-                dofs: [GlobalDof(0); 4 * DIM],
-                x_ref: [[0.0; 3]; 4],
-            };
+            let mut facet = MasterFacet::empty(f.set_index as u32);
             for (a, &l) in f.nodes.iter().enumerate().take(n) {
                 let l = LocalNode::from_u32(l);
                 facet.natural[a] = dofs.natural(l).0 as u64;
@@ -94,15 +89,15 @@ impl Owners {
 }
 
 /// Records `(from rank, facet)` as one message's f64 values.
-fn encode_from(from: usize, f: &MasterFacet, out: &mut Vec<f64>) {
+fn encode_from(from: usize, f: &MasterFacet, nodes: usize, out: &mut Vec<f64>) {
     out.push(from as f64);
-    held_master::encode(f, out);
+    held_master::encode(f, nodes, out);
 }
 
-fn decode_from(values: &[f64]) -> Vec<(usize, MasterFacet)> {
+fn decode_from(values: &[f64], nodes: usize) -> Vec<(usize, MasterFacet)> {
     values
-        .chunks_exact(1 + RECORD)
-        .map(|r| (r[0] as usize, held_master::decode(&r[1..]).remove(0)))
+        .chunks_exact(1 + record(nodes))
+        .map(|r| (r[0] as usize, held_master::decode(&r[1..], nodes).remove(0)))
         .collect()
 }
 
@@ -125,10 +120,10 @@ pub(super) fn slave_share(
     for f in &own {
         let to: BTreeSet<usize> = (0..nf).map(|a| node_owner(f, a)).collect();
         for r in to.into_iter().filter(|&r| r != me) {
-            encode_from(me, f, &mut send[r]);
+            encode_from(me, f, nf, &mut send[r]);
         }
     }
-    let first = decode_from(&ranks.all_to_all(&send));
+    let first = decode_from(&ranks.all_to_all(&send), nf);
     // Every facet around each owned node, as far as this rank knows them
     // (after round 1: all of them).
     let known: Vec<&MasterFacet> = own.iter().chain(first.iter().map(|(_, f)| f)).collect();
@@ -151,12 +146,12 @@ pub(super) fn slave_share(
         .map(|ks| {
             let mut out = Vec::new();
             for &k in ks {
-                held_master::encode(known[k], &mut out);
+                held_master::encode(known[k], nf, &mut out);
             }
             out
         })
         .collect();
-    let second = held_master::decode(&ranks.all_to_all(&send));
+    let second = held_master::decode(&ranks.all_to_all(&send), nf);
     let own_set: BTreeSet<u32> = own.iter().map(|f| f.set_index).collect();
     let mut facets: Vec<MasterFacet> = own
         .iter()

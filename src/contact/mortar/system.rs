@@ -17,9 +17,9 @@
 //! segment of node `j` with every other: see [`node_supports`].
 use super::coverage;
 use super::segment::{dual_coefficients, nodal_areas, segment_terms, MortarRules, SegmentTerms};
+use super::MAX_FACET_NODES;
 use crate::contact::autodiff::{Dual, Scalar, Seed, Vec3};
 use crate::contact::penalty::contact_pressure;
-use crate::contact::MAX_FACET_NODES;
 use crate::fem::FacetType;
 
 /// Variables of one segment: slave nodes at `3a + i`, master nodes at

@@ -211,7 +211,7 @@ fn dual_basis_is_biorthogonal_and_sums_to_one() {
         let n = facet.nodes();
         let (mut dm, mut d) = ([[0.0; 4]; 4], [0.0; 4]);
         for (zeta, w) in rules.facet(facet) {
-            let s = crate::contact::facet_shape(facet, *zeta);
+            let s = super::facet_shape(facet, *zeta);
             let t = |c: usize| -> [f64; 3] {
                 [0, 1, 2].map(|i| (0..n).map(|k| s.dn[k][c] * x[k][i]).sum())
             };

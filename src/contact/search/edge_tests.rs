@@ -107,7 +107,7 @@ fn bad_input_finds_nothing_and_never_panics() {
 
     // Broken facets are ignored, the good one still works.
     let mut mesh = small_flat();
-    mesh.1[0] = [0, 1, 999, 5];
+    mesh.1[0] = pad([0, 1, 999, 5]);
     mesh.1[1][2] = u32::MAX;
     mesh.0[20] = [f64::NAN, 0.0, 0.0]; // node of facet 12
     let s = surface(FacetType::Quad4, &mesh);
@@ -120,7 +120,7 @@ fn bad_input_finds_nothing_and_never_panics() {
     // Degenerate facet (all nodes equal) and a collapsed quad.
     let mesh: Mesh = (
         vec![[0.0; 3], [0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
-        vec![[0, 1, 0, 1], [0, 2, 3, 3]],
+        vec![pad([0, 1, 0, 1]), pad([0, 2, 3, 3])],
     );
     let s = surface(FacetType::Quad4, &mesh);
     let index = SearchIndex::build(&s);
@@ -143,7 +143,7 @@ fn result_does_not_depend_on_grid_layout() {
         [501.0, 1.0, 300.0],
         [500.0, 1.0, 300.0],
     ]);
-    wide.1.push([base, base + 1, base + 2, base + 3]);
+    wide.1.push(pad([base, base + 1, base + 2, base + 3]));
     let (a, b) = (
         surface(FacetType::Quad4, &mesh),
         surface(FacetType::Quad4, &wide),

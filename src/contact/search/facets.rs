@@ -3,20 +3,22 @@
 
 use super::grid::Rows;
 use super::{is_finite3, SearchSurface};
+use crate::contact::MAX_FACET_NODES;
+use crate::fem::FacetType;
 use crate::vec3::{distance, distance2, dot, sub};
 
 /// A facet whose node ids are in range and whose coordinates are finite.
 pub(super) struct UsableFacet {
     pub(super) id: u32,
-    pub(super) ids: [u32; 4],
-    pub(super) nodes: [[f64; 3]; 4],
+    pub(super) ids: [u32; MAX_FACET_NODES],
+    pub(super) nodes: [[f64; 3]; MAX_FACET_NODES],
     pub(super) k: usize,
 }
 
 pub(super) fn facet_nodes(surface: &SearchSurface, f: u32) -> Option<UsableFacet> {
     let k = surface.facet_type.nodes();
     let ids = *surface.facet(f)?;
-    let mut nodes = [[0.0; 3]; 4];
+    let mut nodes = [[0.0; 3]; MAX_FACET_NODES];
     for (slot, &n) in nodes.iter_mut().zip(&ids[..k]) {
         let p = surface.position(n)?;
         if !is_finite3(p) {
@@ -67,7 +69,7 @@ pub(super) fn facet_neighbours(surface: &SearchSurface, node_facets: &Rows) -> R
         let usable =
             u32::try_from(f).is_ok_and(|id| node_facets.row_of(conn[0]).binary_search(&id).is_ok());
         if usable {
-            let mut rows: [&[u32]; 4] = [&[]; 4];
+            let mut rows: [&[u32]; MAX_FACET_NODES] = [&[]; MAX_FACET_NODES];
             for (row, &n) in rows.iter_mut().zip(&conn[..k]) {
                 *row = node_facets.row_of(n);
             }
@@ -97,29 +99,59 @@ pub(super) fn merge_sorted_unique(lists: &mut [&[u32]], out: &mut Vec<u32>) {
     }
 }
 
-pub(super) fn mean_edge_length(facets: &[UsableFacet]) -> f64 {
+/// Mean corner-to-corner edge (the corners come first on every facet type).
+pub(super) fn mean_edge_length(facet_type: FacetType, facets: &[UsableFacet]) -> f64 {
+    let k = facet_type.corners();
     let (sum, count) = facets.iter().fold((0.0, 0usize), |(s, c), f| {
-        let x = &f.nodes[..f.k];
-        let edges = (0..f.k).map(|i| distance(x[i], x[(i + 1) % f.k]));
-        (s + edges.sum::<f64>(), c + f.k)
+        let x = &f.nodes[..k.min(f.k)];
+        let edges = (0..x.len()).map(|i| distance(x[i], x[(i + 1) % x.len()]));
+        (s + edges.sum::<f64>(), c + x.len())
     });
     sum / count.max(1) as f64
 }
 
-/// Longest edge: the length scale for the tie and pruning tolerances.
-pub(super) fn facet_size(x: &[[f64; 3]]) -> f64 {
+/// Longest corner-to-corner edge: the length scale for the tie and pruning
+/// tolerances.
+pub(super) fn facet_size(facet_type: FacetType, x: &[[f64; 3]]) -> f64 {
+    let x = &x[..facet_type.corners().min(x.len())];
     (0..x.len())
         .map(|i| distance2(x[i], x[(i + 1) % x.len()]))
         .fold(0.0, f64::max)
         .sqrt()
 }
 
-/// Distance from `x` to the facet's boundary edges (straight for both tri3
-/// and the bilinear quad4): where the clamped projection of a point lies
-/// that projects outside a flat facet.
-pub(super) fn boundary_distance(x: &[[f64; 3]], p: [f64; 3]) -> f64 {
-    (0..x.len())
-        .map(|i| segment_distance(x[i], x[(i + 1) % x.len()], p))
+/// The facet's boundary as a closed polygon of node indices: the corners,
+/// with each edge's mid-side node between its ends on a second-order facet
+/// (corner `k`'s edge to corner `k + 1` holds node `corners + k`).
+fn boundary_loop(facet_type: FacetType, out: &mut [usize; 2 * 4]) -> usize {
+    let k = facet_type.corners();
+    if facet_type.is_linear() {
+        for (i, o) in out.iter_mut().enumerate().take(k) {
+            *o = i;
+        }
+        return k;
+    }
+    for i in 0..k {
+        out[2 * i] = i;
+        out[2 * i + 1] = k + i;
+    }
+    2 * k
+}
+
+/// Distance from `p` to the facet's boundary polygon (its straight edges on
+/// tri3 and the bilinear quad4; on a second-order facet the polygon through
+/// the mid-side nodes, within the edges' sag of the curved edge): where
+/// the clamped projection of a point lies that projects outside the facet.
+pub(super) fn boundary_distance(facet_type: FacetType, x: &[[f64; 3]], p: [f64; 3]) -> f64 {
+    let mut ring = [0; 2 * 4];
+    let n = if x.len() == facet_type.nodes() {
+        boundary_loop(facet_type, &mut ring)
+    } else {
+        0
+    };
+    let ring = &ring[..n];
+    (0..n)
+        .map(|i| segment_distance(x[ring[i]], x[ring[(i + 1) % n]], p))
         .fold(f64::INFINITY, f64::min)
 }
 

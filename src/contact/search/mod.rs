@@ -63,6 +63,7 @@ mod selection;
 mod tests;
 
 use crate::contact::projection::Projection;
+use crate::contact::MAX_FACET_NODES;
 use crate::fem::FacetType;
 use crate::vec3::distance2;
 use facets::{
@@ -121,8 +122,8 @@ const EMPTY_BOX: Aabb = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
 pub struct SearchSurface<'a> {
     pub facet_type: FacetType,
     pub positions: &'a [[f64; 3]],
-    /// Tri3 uses the first 3 entries.
-    pub facets: &'a [[u32; 4]],
+    /// The facet type's node count used (tri3 the first 3 entries).
+    pub facets: &'a [[u32; MAX_FACET_NODES]],
 }
 
 impl SearchSurface<'_> {
@@ -138,7 +139,7 @@ impl SearchSurface<'_> {
     }
 
     /// Node ids of facet `f`; None past the end.
-    pub fn facet(&self, f: u32) -> Option<&[u32; 4]> {
+    pub fn facet(&self, f: u32) -> Option<&[u32; MAX_FACET_NODES]> {
         self.facets.get(f as usize)
     }
 }
@@ -220,7 +221,7 @@ impl SearchIndex {
             let cap = CELLS_PER_NODE
                 .saturating_mul(used.len())
                 .saturating_add(MIN_CELLS);
-            Grid::new(bbox, mean_edge_length(&facets), cap)
+            Grid::new(bbox, mean_edge_length(surface.facet_type, &facets), cap)
         };
         let n_cells = grid.n_cells();
 
@@ -236,8 +237,8 @@ impl SearchIndex {
         let mut node_pairs = Vec::new();
         let mut max_size: f64 = 0.0;
         for f in &facets {
-            let b = points_bounding_box_of(f.nodes[..f.k].iter().copied()).unwrap_or(EMPTY_BOX);
-            let size = facet_size(&f.nodes[..f.k]);
+            let b = self::facet_box(surface.facet_type, &f.nodes[..f.k]);
+            let size = facet_size(surface.facet_type, &f.nodes[..f.k]);
             facet_box[f.id as usize] = b;
             max_size = max_size.max(size);
             if let Some(range) = grid.cell_range(b.0, b.1) {
@@ -552,11 +553,12 @@ pub fn select_facet(
             continue;
         };
         let nodes = &facet.nodes[..facet.k];
-        let Some(b) = points_bounding_box_of(nodes.iter().copied()) else {
+        let b = facet_box(surface.facet_type, nodes);
+        if b == EMPTY_BOX {
             continue;
-        };
+        }
         let lb2 = box_distance2(&b, x);
-        let reach = sel.best + PRUNE_REL * facet_size(nodes);
+        let reach = sel.best + PRUNE_REL * facet_size(surface.facet_type, nodes);
         if lb2 <= reach * reach && !sel.contains(f) {
             order.push((lb2, f));
         }
@@ -583,6 +585,47 @@ pub fn boxes_overlap(a: ([f64; 3], [f64; 3]), b: ([f64; 3], [f64; 3]), margin: f
 /// if there are none.
 pub fn points_bounding_box(points: &[[f64; 3]]) -> Option<([f64; 3], [f64; 3])> {
     points_bounding_box_of(points.iter().copied())
+}
+
+/// A box that holds the whole facet with nodes `x` (finite ones; empty if
+/// none): the nodes' box for a first-order facet (flat or bilinear, so
+/// inside its corners' hull). A quadratic facet can bulge past its nodes
+/// (an edge whose mid-side node sits off-centre overshoots its end node),
+/// so its box is that of its Bézier control points, which hold the facet
+/// (convex-hull property): on each edge with ends `a`, `b` and mid-side
+/// node `m` the control point `2m − (a + b)/2`; on quad8 / quad9 the
+/// surface is the biquadratic one through the nine nodes (quad8's centre
+/// is its value `−¼ Σ corners + ½ Σ mid-sides` there), whose centre
+/// control point is `4c − Σ mid-sides + ¼ Σ corners`.
+pub fn facet_box(facet_type: FacetType, x: &[[f64; 3]]) -> Aabb {
+    let pts = x.iter().copied();
+    if facet_type.is_linear() || x.len() != facet_type.nodes() {
+        return points_bounding_box_of(pts).unwrap_or(EMPTY_BOX);
+    }
+    let corners = facet_type.corners();
+    let lin = |a: [f64; 3], ca: f64, b: [f64; 3], cb: f64| [0, 1, 2].map(|i| ca * a[i] + cb * b[i]);
+    let mut control = [[0.0; 3]; MAX_FACET_NODES];
+    control[..corners].copy_from_slice(&x[..corners]);
+    for k in 0..corners {
+        let (a, b, m) = (x[k], x[(k + 1) % corners], x[corners + k]);
+        control[corners + k] = lin(m, 2.0, lin(a, 0.5, b, 0.5), -1.0);
+    }
+    let mut n = 2 * corners;
+    if facet_type.linear() == FacetType::Quad4 {
+        let sum = |r: std::ops::Range<usize>| {
+            x[r].iter()
+                .fold([0.0; 3], |s, p| [0, 1, 2].map(|i| s[i] + p[i]))
+        };
+        let (sc, sm) = (sum(0..4), sum(4..8));
+        let centre = if x.len() == 9 {
+            x[8]
+        } else {
+            lin(sc, -0.25, sm, 0.5)
+        };
+        control[8] = [0, 1, 2].map(|i| 4.0 * centre[i] - sm[i] + 0.25 * sc[i]);
+        n = 9;
+    }
+    points_bounding_box_of(control[..n].iter().copied()).unwrap_or(EMPTY_BOX)
 }
 
 fn points_bounding_box_of(points: impl Iterator<Item = [f64; 3]>) -> Option<Aabb> {

@@ -99,7 +99,7 @@ pub(super) fn consider(
         return;
     };
     let nodes = &facet.nodes[..facet.k];
-    let size = facet_size(nodes);
+    let size = facet_size(surface.facet_type, nodes);
     let reach = sel.best + PRUNE_REL * size;
     if lower_bound2 > reach * reach {
         return;
@@ -110,7 +110,7 @@ pub(super) fn consider(
     let distance = if valid {
         distance(x, projection.point)
     } else {
-        boundary_distance(nodes, x)
+        boundary_distance(surface.facet_type, nodes, x)
     };
     sel.push(Candidate {
         facet: f,

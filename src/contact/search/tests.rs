@@ -7,7 +7,14 @@ use crate::contact::projection::project;
 use crate::fem::test_util::Lcg;
 use crate::vec3::distance;
 
-pub(super) type Mesh = (Vec<[f64; 3]>, Vec<[u32; 4]>);
+pub(super) type Mesh = (Vec<[f64; 3]>, Vec<[u32; MAX_FACET_NODES]>);
+
+/// A first-order facet's nodes in a contact facet row.
+pub(super) fn pad(f: [u32; 4]) -> [u32; MAX_FACET_NODES] {
+    let mut row = [0; MAX_FACET_NODES];
+    row[..4].copy_from_slice(&f);
+    row
+}
 
 pub(super) fn surface<'a>(facet_type: FacetType, mesh: &'a Mesh) -> SearchSurface<'a> {
     SearchSurface {
@@ -59,13 +66,13 @@ pub(super) fn plane_grid(
                 node(i, j + 1),
             );
             if !tri {
-                facets.push([a, b, c, d]);
+                facets.push(pad([a, b, c, d]));
             } else if (i + j) % 2 == 0 {
-                facets.push([a, b, c, 0]);
-                facets.push([a, c, d, 0]);
+                facets.push(pad([a, b, c, 0]));
+                facets.push(pad([a, c, d, 0]));
             } else {
-                facets.push([a, b, d, 0]);
-                facets.push([b, c, d, 0]);
+                facets.push(pad([a, b, d, 0]));
+                facets.push(pad([b, c, d, 0]));
             }
         }
     }
@@ -85,12 +92,12 @@ pub(super) fn cylinder(n_theta: usize, n_z: usize, r: f64, length: f64) -> Mesh 
     let mut facets = Vec::new();
     for j in 0..n_z {
         for i in 0..n_theta {
-            facets.push([
+            facets.push(pad([
                 node(i, j),
                 node(i + 1, j),
                 node(i + 1, j + 1),
                 node(i, j + 1),
-            ]);
+            ]));
         }
     }
     (pos, facets)
@@ -123,9 +130,9 @@ pub(super) fn brute_force(s: &SearchSurface, facets: &[u32], x: [f64; 3]) -> Opt
         let d = if valid {
             distance(x, p.point)
         } else {
-            boundary_distance(&nodes, x)
+            boundary_distance(s.facet_type, &nodes, x)
         };
-        all.push((f, d, valid, facet_size(&nodes)));
+        all.push((f, d, valid, facet_size(s.facet_type, &nodes)));
     }
     let dmin = all.iter().map(|a| a.1).fold(f64::INFINITY, f64::min);
     all.iter()
@@ -235,7 +242,9 @@ fn closest_node_equals_brute_force_on_random_clouds() {
             ]
         })
         .collect();
-    let facets: Vec<[u32; 4]> = (0..200).map(|i| [3 * i, 3 * i + 1, 3 * i + 2, 0]).collect();
+    let facets: Vec<[u32; MAX_FACET_NODES]> = (0..200)
+        .map(|i| pad([3 * i, 3 * i + 1, 3 * i + 2, 0]))
+        .collect();
     pos.push([5.0, 5.0, 5.0]);
     let uniform = (pos, facets);
     // Strongly clustered cloud: most nodes in a tiny ball, a few spread
@@ -256,7 +265,8 @@ fn closest_node_equals_brute_force_on_random_clouds() {
             100.0 * unit(&mut rng),
         ]
     }));
-    let facets: Vec<[u32; 4]> = (0..200).map(|i| [i, i + 200, i + 400, 0]).collect();
+    let facets: Vec<[u32; MAX_FACET_NODES]> =
+        (0..200).map(|i| pad([i, i + 200, i + 400, 0])).collect();
     let clustered = (pos, facets);
     for (mesh, scale) in [(&uniform, 10.0), (&clustered, 100.0)] {
         let s = surface(FacetType::Tri3, mesh);
@@ -293,7 +303,7 @@ fn closest_node_ties_go_to_smaller_id() {
             [1.0, 1.0, 0.0],
             [1.0, 0.0, 0.0],
         ],
-        vec![[4, 3, 2, 0], [0, 1, 2, 0]],
+        vec![pad([4, 3, 2, 0]), pad([0, 1, 2, 0])],
     );
     let s = surface(FacetType::Tri3, &mesh);
     let index = SearchIndex::build(&s);
@@ -404,8 +414,8 @@ fn large_ring_fan() {
         let t = 2.0 * std::f64::consts::PI * i as f64 / n as f64;
         pos.push([3.0 * t.cos(), 3.0 * t.sin(), 0.0]);
     }
-    let facets: Vec<[u32; 4]> = (0..n as u32)
-        .map(|i| [0, 1 + i, 1 + (i + 1) % n as u32, 0])
+    let facets: Vec<[u32; MAX_FACET_NODES]> = (0..n as u32)
+        .map(|i| pad([0, 1 + i, 1 + (i + 1) % n as u32, 0]))
         .collect();
     let mesh = (pos, facets);
     let s = surface(FacetType::Tri3, &mesh);
@@ -438,7 +448,7 @@ fn cylinder_concave_side_picks_nearest_of_two_valid() {
         let x = at(t, 9.0);
         // Both project validly: the situation under test.
         for f in [2u32, 3] {
-            let nodes: Vec<_> = mesh.1[f as usize]
+            let nodes: Vec<_> = mesh.1[f as usize][..4]
                 .iter()
                 .map(|&n| mesh.0[n as usize])
                 .collect();

@@ -74,6 +74,15 @@ fn lagrange(a: f64, t: f64) -> (f64, f64) {
     }
 }
 
+/// The second derivative of [`lagrange`] (constant).
+fn lagrange_second(a: f64) -> f64 {
+    if a == 0.0 {
+        -2.0
+    } else {
+        1.0
+    }
+}
+
 /// Barycentric coordinates of the triangle and their constant gradients.
 fn triangle(xi: [f64; 2]) -> ([f64; 3], [[f64; 2]; 3]) {
     (
@@ -117,6 +126,29 @@ pub(super) fn tet10(xi: [f64; 3], n: &mut [f64], dn: &mut [[f64; 3]]) {
 pub(super) fn tri6(xi: [f64; 2], n: &mut [f64], dn: &mut [[f64; 2]]) {
     let (l, dl) = triangle(xi);
     quadratic_simplex(&l, &dl, crate::fem::FacetType::Tri6.higher_nodes(), n, dn);
+}
+
+/// Second derivatives of tri6 (constant): corners `4 ∂L_a ∂L_a`, mid-edges
+/// `4 (∂L_i ∂L_j + ∂L_j ∂L_i)`, as `[11, 12, 22]`.
+pub(super) fn tri6_second(ddn: &mut [[f64; 3]]) {
+    let (_, dl) = triangle([0.0, 0.0]);
+    let sym = |g: [f64; 2], h: [f64; 2]| {
+        [
+            4.0 * (g[0] * h[0] + h[0] * g[0]),
+            4.0 * (g[0] * h[1] + h[0] * g[1]),
+            4.0 * (g[1] * h[1] + h[1] * g[1]),
+        ]
+    };
+    for a in 0..3 {
+        ddn[a] = sym(dl[a], dl[a]).map(|v| 0.5 * v);
+    }
+    for (k, e) in crate::fem::FacetType::Tri6
+        .higher_nodes()
+        .iter()
+        .enumerate()
+    {
+        ddn[3 + k] = sym(dl[e[0]], dl[e[1]]);
+    }
 }
 
 /// Serendipity hex: corners `⅛ Π(1 + ξ_j a_j) (Σ ξ_j a_j − 2)`, mid-edge
@@ -177,6 +209,61 @@ pub(super) fn quad8(xi: [f64; 2], n: &mut [f64], dn: &mut [[f64; 2]]) {
             n[a] = 0.5 * f[0] * (1.0 - xi[1] * xi[1]);
             dn[a] = [0.5 * node[0] * (1.0 - xi[1] * xi[1]), -xi[1] * f[0]];
         }
+    }
+}
+
+/// Second derivatives of [`quad8`] as `[ξξ, ξη, ηη]`.
+pub(super) fn quad8_second(xi: [f64; 2], ddn: &mut [[f64; 3]]) {
+    for (a, node) in QUAD9_REF_NODES[..8].iter().enumerate() {
+        let f = [1.0 + xi[0] * node[0], 1.0 + xi[1] * node[1]];
+        ddn[a] = if a < 4 {
+            let s = xi[0] * node[0] + xi[1] * node[1] - 1.0;
+            [
+                0.5 * f[1],
+                0.25 * node[0] * node[1] * (f[0] + f[1] + s),
+                0.5 * f[0],
+            ]
+        } else if node[0] == 0.0 {
+            [-f[1], -xi[0] * node[1], 0.0]
+        } else {
+            [0.0, -xi[1] * node[0], -f[0]]
+        };
+    }
+}
+
+/// Third derivatives of [`quad8`] as `[ξξη, ξηη]` (constant).
+pub(super) fn quad8_third(dddn: &mut [[f64; 2]]) {
+    for (a, node) in QUAD9_REF_NODES[..8].iter().enumerate() {
+        dddn[a] = if a < 4 {
+            [0.5 * node[1], 0.5 * node[0]]
+        } else if node[0] == 0.0 {
+            [-node[1], 0.0]
+        } else {
+            [0.0, -node[0]]
+        };
+    }
+}
+
+/// Third derivatives of [`quad9`] as `[ξξη, ξηη]`.
+pub(super) fn quad9_third(xi: [f64; 2], dddn: &mut [[f64; 2]]) {
+    for (a, node) in QUAD9_REF_NODES.iter().enumerate() {
+        let l = [lagrange(node[0], xi[0]), lagrange(node[1], xi[1])];
+        dddn[a] = [
+            lagrange_second(node[0]) * l[1].1,
+            l[0].1 * lagrange_second(node[1]),
+        ];
+    }
+}
+
+/// Second derivatives of [`quad9`] as `[ξξ, ξη, ηη]`.
+pub(super) fn quad9_second(xi: [f64; 2], ddn: &mut [[f64; 3]]) {
+    for (a, node) in QUAD9_REF_NODES.iter().enumerate() {
+        let l = [lagrange(node[0], xi[0]), lagrange(node[1], xi[1])];
+        ddn[a] = [
+            lagrange_second(node[0]) * l[1].0,
+            l[0].1 * l[1].1,
+            l[0].0 * lagrange_second(node[1]),
+        ];
     }
 }
 

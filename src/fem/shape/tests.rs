@@ -163,6 +163,76 @@ fn facet_gradients_match_finite_differences() {
     }
 }
 
+/// The second derivatives against central differences of the gradients
+/// (error ~h², so 1e-8 with h = 1e-6 leaves the round-off ~1e-10 room).
+#[test]
+fn facet_second_derivatives_match_finite_differences() {
+    let mut rng = Lcg::new(5);
+    for facet in FacetType::ALL {
+        for xi in facet_points(facet, &mut rng) {
+            let dd = FacetShape::<9>::second(facet, xi).unwrap();
+            for j in 0..2 {
+                let (mut xp, mut xm) = (xi, xi);
+                xp[j] += H;
+                xm[j] -= H;
+                let (sp, sm) = (facet_shape(facet, xp), facet_shape(facet, xm));
+                for (a, dda) in dd.iter().enumerate().take(facet.nodes()) {
+                    for i in 0..2 {
+                        let fd = (sp.dn[a][i] - sm.dn[a][i]) / (2.0 * H);
+                        // (i, j) in [11, 12, 22].
+                        let exact = dda[i + j];
+                        assert!(
+                            (fd - exact).abs() < 1e-8,
+                            "{} a={a} ({i},{j}): {fd} vs {exact}",
+                            facet.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(FacetShape::<4>::second(FacetType::Quad8, [0.0; 2]).is_none());
+}
+
+/// The third derivatives `[112, 122]` against central differences of the
+/// second ones (the second derivatives are at most quadratic, so the
+/// differences are exact up to round-off).
+#[test]
+fn facet_third_derivatives_match_finite_differences() {
+    let mut rng = Lcg::new(6);
+    for facet in FacetType::ALL {
+        for xi in facet_points(facet, &mut rng) {
+            let ddd = FacetShape::<9>::third(facet, xi).unwrap();
+            let second = |d: [f64; 2]| FacetShape::<9>::second(facet, d).unwrap();
+            for j in 0..2 {
+                let (mut xp, mut xm) = (xi, xi);
+                xp[j] += H;
+                xm[j] -= H;
+                let (sp, sm) = (second(xp), second(xm));
+                for a in 0..facet.nodes() {
+                    let fd = [0, 1, 2].map(|i| (sp[a][i] - sm[a][i]) / (2.0 * H));
+                    // ∂/∂ξ₁ of [11, 12, 22] is [111, 112, 122], ∂/∂ξ₂ is
+                    // [112, 122, 222]; 111 and 222 vanish.
+                    let exact = if j == 0 {
+                        [0.0, ddd[a][0], ddd[a][1]]
+                    } else {
+                        [ddd[a][0], ddd[a][1], 0.0]
+                    };
+                    for i in 0..3 {
+                        assert!(
+                            (fd[i] - exact[i]).abs() < 1e-8,
+                            "{} a={a} j={j} i={i}: {} vs {}",
+                            facet.name(),
+                            fd[i],
+                            exact[i]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Σ N_a f(X_a) = f(X) for the fields the element must reproduce: linear
 /// ones for every type, complete quadratics for tet10 / hex20 / hex27 / the
 /// quadratic facets, and the wedge15's quadratics (its triangle is complete

@@ -2,26 +2,27 @@
 //! f64 (residual only) and dual (residual and exact tangent).
 
 use super::friction::{friction_traction, slip_increment};
-use super::input::{dof_count, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory};
+use super::input::{
+    dof_count, first_order, master_x, nodes_as, seed, FrictionState, LinkInput, SlipHistory,
+};
 use super::kinematics::{kinematics, tangential, Frame, Kinematics};
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
-use crate::contact::facet_shape;
 use crate::contact::penalty::trial_pressure;
-use crate::contact::MAX_FACET_NODES;
+use crate::contact::{facet_shape, LINEAR_FACET_NODES, MAX_FACET_NODES};
 
 /// The contact forces of one link (normal, plus friction when the input has
 /// it), handed to `emit(dof, value)` once per DOF. Slave node `a` gets
 /// `N¹_a (g − pN ν) w`; master node `b` gets `(pN ν − g) N²_b w + (x¹ − x²)
 /// c^α N²_b,α w`, where `g = τ_α c^α` (facet) or `Jᵀ tT` (rigid) is the
 /// friction's generalized force and `c = H⁻¹ [tT·τ_α]`.
-pub(super) fn link_forces<T: Scalar>(
+pub(super) fn link_forces<T: Scalar, const M: usize>(
     input: &LinkInput,
-    kin: &Kinematics<T>,
+    kin: &Kinematics<T, M>,
     slave: &[Vec3<T>],
     master: &[Vec3<T>],
     mut emit: impl FnMut(usize, T),
 ) -> Option<FrictionState> {
-    let s = facet_shape(input.slave_facet, input.zeta);
+    let s = facet_shape::<M>(input.slave_facet, input.zeta);
     let ns = input.slave_facet.nodes();
     let n_master = master.len();
     // Closed branch (the caller decided it from the f64 gap): pN = λN − εN gN.
@@ -37,7 +38,7 @@ pub(super) fn link_forces<T: Scalar>(
     } else {
         autodiff::scale(&kin.normal, -pressure)
     };
-    let mut master_extra = [T::from_f64(0.0); MAX_FACET_NODES];
+    let mut master_extra = [T::from_f64(0.0); M];
     let mut state = None;
     if let Some(friction) = &input.friction {
         let slip = slip_increment(input, friction, kin, slave, master);
@@ -120,11 +121,24 @@ pub(super) fn residual_f64(
     xi_bar: [f64; 2],
     r: &mut [f64],
 ) -> Option<Option<FrictionState>> {
+    if first_order(input) {
+        residual_f64_in::<LINEAR_FACET_NODES>(input, xi_bar, r)
+    } else {
+        residual_f64_in::<MAX_FACET_NODES>(input, xi_bar, r)
+    }
+}
+
+/// [`residual_f64`] in holders of `M` nodes.
+fn residual_f64_in<const M: usize>(
+    input: &LinkInput,
+    xi_bar: [f64; 2],
+    r: &mut [f64],
+) -> Option<Option<FrictionState>> {
     let ns = input.slave_facet.nodes();
     let xm = master_x(input);
-    let slave = nodes_as::<f64>(input.slave_x);
-    let master = nodes_as::<f64>(xm);
-    let kin = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
+    let slave = nodes_as::<f64, M>(input.slave_x);
+    let master = nodes_as::<f64, M>(xm);
+    let kin = kinematics::<f64, M>(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
     Some(link_forces(
         input,
         &kin,
@@ -138,8 +152,9 @@ pub(super) fn residual_f64(
     ))
 }
 
-/// Residual and tangent with `N` = number of link DOFs.
-fn residual_dual<const N: usize>(
+/// Residual and tangent with `N` = number of link DOFs, in holders of `M`
+/// nodes.
+fn residual_dual<const N: usize, const M: usize>(
     input: &LinkInput,
     xi_bar: [f64; 2],
     r: &mut [f64],
@@ -147,9 +162,9 @@ fn residual_dual<const N: usize>(
 ) -> Option<Option<FrictionState>> {
     let ns = input.slave_facet.nodes();
     let xm = master_x(input);
-    let slave = seed::<N>(input.slave_x, 0);
-    let master = seed::<N>(xm, 3 * ns);
-    let kin = kinematics(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
+    let slave = seed::<N, M>(input.slave_x, 0);
+    let master = seed::<N, M>(xm, 3 * ns);
+    let kin = kinematics::<Dual<N>, M>(input, &slave[..ns], &master[..xm.len()], xi_bar)?;
     Some(link_forces(
         input,
         &kin,
@@ -167,19 +182,36 @@ fn residual_dual<const N: usize>(
 }
 
 /// Monomorphised for the possible link sizes so the dual arrays are exactly
-/// as long as needed: quad–quad 24, quad–tri 21, tri–tri 18, rigid 12 / 9.
+/// as long as needed. First-order facets (holders of four nodes): quad–quad
+/// 24, quad–tri 21, tri–tri 18, rigid 12 / 9. A link with a second-order
+/// facet (holders of nine): `3 (n_s + n_m)` for slave and master node
+/// counts in {3, 4, 6, 8, 9} (0 for a rigid master), one of them second
+/// order: tri6 / quad8 / quad9 against a rigid master 18 / 24 / 27,
+/// tri6–tri6 36, quad8–quad8 48, quad9–quad9 54, mixed pairs in between.
 pub(super) fn residual_tangent_sized(
     input: &LinkInput,
     xi_bar: [f64; 2],
     r: &mut [f64],
     k: &mut [f64],
 ) -> Option<Option<FrictionState>> {
-    match dof_count(input) {
-        24 => residual_dual::<24>(input, xi_bar, r, k),
-        21 => residual_dual::<21>(input, xi_bar, r, k),
-        18 => residual_dual::<18>(input, xi_bar, r, k),
-        12 => residual_dual::<12>(input, xi_bar, r, k),
-        9 => residual_dual::<9>(input, xi_bar, r, k),
-        _ => None,
+    const L: usize = LINEAR_FACET_NODES;
+    if first_order(input) {
+        return match dof_count(input) {
+            24 => residual_dual::<24, L>(input, xi_bar, r, k),
+            21 => residual_dual::<21, L>(input, xi_bar, r, k),
+            18 => residual_dual::<18, L>(input, xi_bar, r, k),
+            12 => residual_dual::<12, L>(input, xi_bar, r, k),
+            9 => residual_dual::<9, L>(input, xi_bar, r, k),
+            _ => None,
+        };
     }
+    macro_rules! second_order {
+        ($($n:literal)*) => {
+            match dof_count(input) {
+                $($n => residual_dual::<$n, MAX_FACET_NODES>(input, xi_bar, r, k),)*
+                _ => None,
+            }
+        };
+    }
+    second_order!(18 24 27 30 33 36 39 42 45 48 51 54)
 }

@@ -20,15 +20,15 @@ fn interpolated_velocity<T: Scalar>(n: &[T], x: &[Vec3<T>], v: &[[f64; 3]], dv_d
 }
 
 /// Slip increment ΔgT of the slave relative to the master.
-pub(super) fn slip_increment<T: Scalar>(
+pub(super) fn slip_increment<T: Scalar, const M: usize>(
     input: &LinkInput,
     friction: &Friction,
-    kin: &Kinematics<T>,
+    kin: &Kinematics<T, M>,
     slave: &[Vec3<T>],
     master: &[Vec3<T>],
 ) -> Vec3<T> {
     if let Some(rate) = &friction.rate {
-        let s = facet_shape(input.slave_facet, input.zeta);
+        let s = facet_shape::<M>(input.slave_facet, input.zeta);
         let n_slave = s.n.map(T::from_f64);
         let v1 = interpolated_velocity(&n_slave[..slave.len()], slave, rate.slave_v, rate.dv_dx);
         let v2 = match kin.frame {
@@ -57,7 +57,10 @@ pub(super) fn slip_increment<T: Scalar>(
 }
 
 /// λT as a vector in the current tangent plane.
-fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Vec3<T> {
+fn multiplier_vector<T: Scalar, const M: usize>(
+    history: SlipHistory,
+    kin: &Kinematics<T, M>,
+) -> Vec3<T> {
     match (&kin.frame, history) {
         (
             Frame::Facet {
@@ -85,9 +88,9 @@ fn multiplier_vector<T: Scalar>(history: SlipHistory, kin: &Kinematics<T>) -> Ve
 
 /// The friction law at one link: trial, stick/slip decision (on the f64
 /// value) and return map. Returns `tT` (the traction resisting the slip).
-pub(super) fn friction_traction<T: Scalar>(
+pub(super) fn friction_traction<T: Scalar, const M: usize>(
     friction: &Friction,
-    kin: &Kinematics<T>,
+    kin: &Kinematics<T, M>,
     pressure: T,
     slip: &Vec3<T>,
 ) -> (Vec3<T>, bool) {

@@ -6,7 +6,6 @@
 use thiserror::Error;
 
 use crate::contact::autodiff::{self, Dual, Scalar, Vec3};
-use crate::contact::MAX_FACET_NODES;
 use crate::fem::FacetType;
 use crate::model::RigidSurface;
 
@@ -214,6 +213,16 @@ pub enum LinkError {
     },
 }
 
+/// Both of the link's facets are first-order (a rigid master has none):
+/// the kernel then runs in holders of `contact::LINEAR_FACET_NODES` nodes.
+pub(super) fn first_order(input: &LinkInput) -> bool {
+    input.slave_facet.is_linear()
+        && match input.master {
+            LinkMaster::Facet { facet, .. } => facet.is_linear(),
+            _ => true,
+        }
+}
+
 /// Number of link DOFs `n = 3 (n_s + n_m)`.
 pub fn dof_count(input: &LinkInput) -> usize {
     3 * (input.slave_facet.nodes() + master_nodes(&input.master))
@@ -368,8 +377,9 @@ pub fn check_buffers(
     k_len.map_or(Ok(()), |len| length("k", n * n, len))
 }
 
-pub(super) fn nodes_as<T: Scalar>(x: &[[f64; 3]]) -> [Vec3<T>; MAX_FACET_NODES] {
-    let mut out = [autodiff::constant3([0.0; 3]); MAX_FACET_NODES];
+/// Nodal positions as constants in `T`, in a holder of `M` nodes.
+pub(super) fn nodes_as<T: Scalar, const M: usize>(x: &[[f64; 3]]) -> [Vec3<T>; M] {
+    let mut out = [autodiff::constant3([0.0; 3]); M];
     for (o, p) in out.iter_mut().zip(x) {
         *o = autodiff::constant3(*p);
     }
@@ -377,11 +387,11 @@ pub(super) fn nodes_as<T: Scalar>(x: &[[f64; 3]]) -> [Vec3<T>; MAX_FACET_NODES] 
 }
 
 /// Nodal positions as dual variables, variable index `offset + 3a + i`.
-pub(super) fn seed<const N: usize>(
+pub(super) fn seed<const N: usize, const M: usize>(
     x: &[[f64; 3]],
     offset: usize,
-) -> [Vec3<Dual<N>>; MAX_FACET_NODES] {
-    let mut out = [[Dual::constant(0.0); 3]; MAX_FACET_NODES];
+) -> [Vec3<Dual<N>>; M] {
+    let mut out = [[Dual::constant(0.0); 3]; M];
     for (a, (o, p)) in out.iter_mut().zip(x).enumerate() {
         for (i, (oi, pi)) in o.iter_mut().zip(p).enumerate() {
             *oi = Dual::variable(*pi, offset + 3 * a + i);

@@ -3,18 +3,28 @@
 //! and potential.
 
 use super::evaluate;
-use super::input::{check_input, nodes_as, LinkInput, LinkMaster, LinkState};
+use super::input::{check_input, first_order, nodes_as, LinkInput, LinkMaster, LinkState};
 use super::kinematics::{rigid_kinematics, slave_point};
 use crate::contact::penalty::{contact_pressure, trial_pressure};
 use crate::contact::projection;
+use crate::contact::{LINEAR_FACET_NODES, MAX_FACET_NODES};
 
 /// Gap, normal, pressure and open/closed, without the friction state.
 pub(super) fn evaluate_normal(input: &LinkInput) -> LinkState {
+    if first_order(input) {
+        evaluate_normal_in::<LINEAR_FACET_NODES>(input)
+    } else {
+        evaluate_normal_in::<MAX_FACET_NODES>(input)
+    }
+}
+
+/// [`evaluate_normal`] in holders of `M` nodes.
+fn evaluate_normal_in<const M: usize>(input: &LinkInput) -> LinkState {
     if check_input(input).is_err() {
         return LinkState::invalid();
     }
-    let slave = nodes_as::<f64>(input.slave_x);
-    let x1 = slave_point(
+    let slave = nodes_as::<f64, M>(input.slave_x);
+    let x1 = slave_point::<f64, M>(
         input.slave_facet,
         input.zeta,
         &slave[..input.slave_facet.nodes()],
@@ -35,7 +45,7 @@ pub(super) fn evaluate_normal(input: &LinkInput) -> LinkState {
                 friction: None,
             }
         }
-        _ => match rigid_kinematics::<f64>(&x1, &input.master) {
+        _ => match rigid_kinematics::<f64, M>(&x1, &input.master) {
             Some(kin) => LinkState {
                 gap: kin.gap,
                 normal: kin.normal,

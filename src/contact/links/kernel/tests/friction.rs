@@ -5,7 +5,7 @@ use super::*;
 /// Adds friction to a closed case: a slip history a little away from the
 /// current master point, a λT, and μ chosen so that `|tT*| = ratio · μ pN`
 /// (ratio < 1 sticks, > 1 slips; far from the kink either way).
-fn with_friction(case: &Case, ratio: f64, dynamic: bool, rng: &mut Lcg) -> Case {
+pub(super) fn with_friction(case: &Case, ratio: f64, dynamic: bool, rng: &mut Lcg) -> Case {
     let mut c = case.clone();
     let s = evaluate(&c.input());
     let history = match &c.master {

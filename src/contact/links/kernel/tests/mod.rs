@@ -3,6 +3,7 @@
 //! and invariance, closed forms, bad input. This file holds the random test
 //! cases; `normal.rs` the frictionless tests, `friction.rs` the Coulomb ones.
 
+mod curved;
 mod friction;
 mod normal;
 
