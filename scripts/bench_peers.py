@@ -1,13 +1,13 @@
 #!/usr/bin/python3
 """contactlink side by side with CalculiX on the same mesh.
 
-usage: bench_peers.py [--cases line,sphere,tet10] [--sizes 5,10,20,40]
-                      [--sphere-sizes 0.5,0.35] [--tet10-sizes 0.5] [--np 1] [--repeats 1]
+usage: bench_peers.py [--cases line,sphere] [--sizes 5,10,20,40]
+                      [--sphere-sizes 0.5,0.35] [--np 1] [--repeats 1]
                       [--sphere-repeats 1] [--dry-run]
                       [--out bench-results/peers] [--bin target/release/contactlink]
                       [--table-dir docs/tables | --no-table]
 
-Three cases, each at a few mesh sizes:
+Two cases, each at a few mesh sizes:
 
 line    The Hertz line contact (plane strain, one hex8 layer, half model): a
         quarter disc R = 1 pressed on a 4R x 4R block (the half of 8R x 4R),
@@ -20,10 +20,6 @@ sphere  The Hertz point contact of the built-in `hertz-sphere` scene: a
         over a 2 x 2 zone at the contact point. CalculiX gets the mesh that
         contactlink's own result file holds (nodes and cells in natural order,
         the facet and node sets), so both codes solve the same mesh.
-tet10   The same point contact on the generator's mesh of tet10 cells (each
-        hex split into tets, second-order nodes at the mean of their corners);
-        contactlink's links on the tri6 facets, CalculiX's C3D10 with its
-        surface-to-surface contact on the same faces (--tet10-sizes).
 
 For each size the script
 
@@ -31,7 +27,7 @@ For each size the script
      of the same mesh, materials, conditions and solver without the contact
      pair (one linear-elastic step, as benches/solve_costs.rs defines it);
      on one rank (--np 1) the program is started directly, without mpirun;
-  2. writes a CalculiX deck of the same mesh: the same nodes, C3D8 (C3D10) cells,
+  2. writes a CalculiX deck of the same mesh: the same nodes, C3D8 cells,
      element-face surfaces and boundary conditions, a penalty
      surface-to-surface contact pair with the linear pressure-overclosure
      slope 10 E / h_c, and runs `ccx` on one thread (OMP_NUM_THREADS=1);
@@ -174,7 +170,6 @@ block_height = 10.0
 fine_size = {hc}
 fine_half_width = 2.0
 level = 0
-cell_type = "{cell}"
 """ + BODIES + """
 [[dirichlet]]
 set = "block.bottom"
@@ -189,7 +184,7 @@ SPHERE_CONTACT = """
 name = "hertz"
 slave = "sphere.curved"
 master = "block.top"
-{formulation}"""
+"""
 
 SPHERE_TAIL = """
 [steps]
@@ -341,34 +336,26 @@ def one_line(a, divisor):
     return row
 
 
-def one_sphere(a, hc, cell="hex8"):
-    """The point contact on the hertz-sphere generator's mesh of `cell`s
-    (hex8; tet10: each hex split into tets, second-order nodes at the mean
-    of their corners)."""
-    tag = "" if cell == "hex8" else f"-{cell}"
-    stem = os.path.join(a.out, f"sphere{tag}-h{hc:g}")
-    # Contact on second-order facets is the links' (the mortar's dual basis
-    # is first order).
-    formulation = 'formulation = "links"\n' if cell in ("tet10", "hex20") else ""
+def one_sphere(a, hc):
+    stem = os.path.join(a.out, f"sphere-h{hc:g}")
     scene, plain = write_scenes(stem, SPHERE_SCENE, SPHERE_CONTACT, SPHERE_TAIL, SPHERE_HERTZ,
                                 hc=hc, e=YOUNGS, nu=POISSON, indenter="sphere",
-                                radius=SPHERE_RADIUS, push=-SPHERE_PUSH, cell=cell,
-                                formulation=formulation)
+                                radius=SPHERE_RADIUS, push=-SPHERE_PUSH)
     # The plain solve first: its result file holds the mesh the deck is
     # written from (the contact solve's is the same mesh).
     p = median_run(a, plain, 1 if a.dry_run else a.sphere_repeats, contact=False)
-    nodes, cells, facets, node_sets = meshes.read_result_mesh(plain[:-5] + ".h5")
+    nodes, hexes, facets, node_sets = meshes.read_result_mesh(plain[:-5] + ".h5")
     nsets = {"NBOTTOM": node_sets["block.bottom"], "NTOP": node_sets["sphere.top"]}
     surfaces = {"SSLAVE": facets["sphere.curved"], "SMASTER": facets["block.top"]}
     fixed = ["NBOTTOM, 1, 3, 0.0"]
     step = ["NTOP, 1, 2, 0.0", f"NTOP, 3, 3, {-SPHERE_PUSH}"]
-    deck = os.path.join(a.out, f"ccx-sphere{tag}-h{hc:g}.inp")
-    ccx.write_deck(deck, f"Hertz point contact, built-in hertz-sphere mesh of {cell}", nodes,
-                   cells, ["block", "sphere"], nsets, surfaces, fixed, step, "NTOP",
-                   (YOUNGS, POISSON), pair=("SSLAVE", "SMASTER", 10.0 * YOUNGS / hc))
-    row = {"case": "sphere" if cell == "hex8" else cell, "size": f"h={hc:g}", "hc": hc,
-           "hc_mesh": hc, "deck": deck, "plain_wall": p["wall"], "plain_cpu": p["cpu"],
-           "plain_solve": p["solve"], "plain_newton": p["newton"]}
+    deck = os.path.join(a.out, f"ccx-sphere-h{hc:g}.inp")
+    ccx.write_deck(deck, "Hertz point contact, built-in hertz-sphere mesh", nodes, hexes,
+                   ["block", "sphere"], nsets, surfaces, fixed, step, "NTOP", (YOUNGS, POISSON),
+                   pair=("SSLAVE", "SMASTER", 10.0 * YOUNGS / hc))
+    row = {"case": "sphere", "size": f"h={hc:g}", "hc": hc, "hc_mesh": hc, "deck": deck,
+           "plain_wall": p["wall"], "plain_cpu": p["cpu"], "plain_solve": p["solve"],
+           "plain_newton": p["newton"]}
     if a.dry_run:
         return row
     row.update(median_run(a, scene, a.sphere_repeats))
@@ -378,10 +365,6 @@ def one_sphere(a, hc, cell="hex8"):
         deck[:-4], nodes, [t for q in facets["sphere.curved"] for t in q],
         lambda f: abs(f[2]), lambda f: hertz.point(f, SPHERE_RADIUS, E_STAR), True)
     return row
-
-
-def one_tet10(a, hc):
-    return one_sphere(a, hc, "tet10")
 
 
 def print_row(r):
@@ -419,11 +402,9 @@ def write_table(a, prov, case, title, repeats, rows):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="line,sphere",
-                    help="comma-separated: line, sphere, tet10")
+    ap.add_argument("--cases", default="line,sphere", help="line, sphere or both")
     ap.add_argument("--sizes", default="5,10,20,40", help="line: h_c = b / each")
     ap.add_argument("--sphere-sizes", default="0.5,0.35", help="sphere: h_c, each")
-    ap.add_argument("--tet10-sizes", default="0.5", help="tet10: h_c, each")
     ap.add_argument("--np", type=int, default=1, help="contactlink ranks (CalculiX: one thread)")
     ap.add_argument("--repeats", type=int, default=1, help="runs per line size (median)")
     ap.add_argument("--sphere-repeats", type=int, default=1, help="runs per sphere size (median)")
@@ -441,25 +422,23 @@ def main():
     a.extra = [x for s in a.extra for x in ("--set", s)]
     cases = [c.strip() for c in a.cases.split(",") if c.strip()]
     for c in cases:
-        if c not in ("line", "sphere", "tet10"):
-            sys.exit(f"--cases: '{c}' is not line, sphere or tet10")
+        if c not in ("line", "sphere"):
+            sys.exit(f"--cases: '{c}' is not line or sphere")
     for tool in ("gmsh",) * ("line" in cases) + (() if a.dry_run else ("ccx",)):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
             sys.exit(f"{tool} not found: run `bash scripts/install-deps.sh --peers`")
-    if "sphere" in cases or "tet10" in cases:
+    if "sphere" in cases:
         try:
             import h5py  # noqa: F401 (the sphere's mesh is read from a result file)
         except ImportError:
-            sys.exit(f"--cases sphere and tet10 read contactlink's result file with h5py, which "
+            sys.exit(f"--cases sphere reads contactlink's result file with h5py, which "
                      f"{sys.executable} lacks: run it with /usr/bin/python3 (Debian's "
                      f"python3-h5py, which `make bench-peers` uses)")
     os.makedirs(a.out, exist_ok=True)
     plan = [("line", one_line, [int(v) for v in a.sizes.split(",")], a.repeats,
              "Hertz line contact, half model, b ≈ 0.1 R"),
             ("sphere", one_sphere, [float(v) for v in a.sphere_sizes.split(",")],
-             a.sphere_repeats, "Hertz point contact, built-in hertz-sphere mesh, a ≈ 0.1 R"),
-            ("tet10", one_tet10, [float(v) for v in a.tet10_sizes.split(",")],
-             a.sphere_repeats, "Hertz point contact, hertz-sphere mesh of tet10, a ≈ 0.1 R")]
+             a.sphere_repeats, "Hertz point contact, built-in hertz-sphere mesh, a ≈ 0.1 R")]
     rows = []
     for case, run, sizes, repeats, title in plan:
         if case not in cases:
