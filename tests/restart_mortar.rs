@@ -7,7 +7,7 @@
 mod common;
 use common::*;
 use contactlink::output::{layout, list_steps, read_nodal};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn run_ok(ranks: usize, args: &[&str]) {
     let o = mpirun(ranks, args);
@@ -16,25 +16,6 @@ fn run_ok(ranks: usize, args: &[&str]) {
         "{args:?} on {ranks} ranks failed:\n{}",
         text(&o)
     );
-}
-
-/// A copy of `full` holding only its first `keep` steps: what a run killed
-/// after step `keep` leaves behind.
-fn cut_after(full: &Path, keep: usize, name: &str) -> PathBuf {
-    let cut = full.with_file_name(name);
-    std::fs::copy(full, &cut).expect("copy result file");
-    let file = hdf5::File::open_rw(&cut).expect("open copy");
-    let steps = file.group(layout::STEPS_NAME).expect("/steps");
-    for step in list_steps(full)
-        .expect("steps")
-        .into_iter()
-        .filter(|&s| s > keep)
-    {
-        steps
-            .unlink(&layout::step_group_name(step))
-            .expect("unlink step");
-    }
-    cut
 }
 
 fn field(path: &Path, step: usize, name: &str) -> Vec<f64> {
